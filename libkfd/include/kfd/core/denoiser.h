@@ -1,0 +1,70 @@
+// Clustering denoise of a keyframe (Algorithm 2 + cluster filter), in two selectable variants.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "kfd/core/clusters.h"
+#include "kfd/core/range_aware_clustering.h"
+#include "kfd/core/ring_clustering.h"
+#include "kfd/core/scan.h"
+
+namespace kfd {
+
+enum class DenoiseVariant : std::uint8_t {
+    Reference,  // the paper's Algorithm 2 exactly as published (RingClustering + fixed m_threshold)
+    RangeAware,  // kfd's improved variant (RangeAwareClustering + range-adaptive threshold)
+};
+const char* toString(DenoiseVariant v);
+/// Parses "reference" or "range_aware"; throws std::invalid_argument otherwise.
+DenoiseVariant parseDenoiseVariant(const std::string& s);
+
+class Denoiser {
+  public:
+    struct Params {
+        DenoiseVariant variant = DenoiseVariant::Reference;
+        std::size_t rings = 5;           // t (Sec. 3.2.1), reference variant
+        double ring_r_max = 0.0;         // m; 0 = farthest valid point (Formulas 6-8)
+        double angle_gap_factor = 10.0;  // theta_threshold = factor x resolution (Sec. 3.2.2)
+        double merge_distance_m = 0.0;   // d_threshold (Formula 10); 0 = automatic
+        std::size_t m_threshold = 10;    // minimum cluster size, points (Sec. 3.2.4)
+        // Range-aware variant only:
+        double jump_lambda_deg = 10.0;     // breakpoint incidence limit (deg)
+        double jump_sigma_m = 0.03;        // range noise (m)
+        double min_object_size_m = 0.10;   // a cluster must be this wide in beams at its range
+        std::size_t min_points_floor = 3;  // ... but never fewer points than this
+    };
+
+    struct Result {
+        DenoiseVariant variant = DenoiseVariant::Reference;
+        std::size_t points_in = 0;       // valid beams before
+        std::size_t clusters = 0;        // all clusters found
+        std::size_t noise_clusters = 0;  // clusters removed
+        std::size_t points_removed = 0;  // beams invalidated
+        std::size_t blocks = 0;          // reference: blocks before merging
+        std::size_t merges = 0;          // unions across rings / bridging points / seam
+        double r_max = 0.0;              // m, reference: ring radius used
+        double theta_threshold = 0.0;    // rad
+    };
+
+    Denoiser() { initialize(Params{}); }
+    explicit Denoiser(const Params& p) { initialize(p); }
+    void initialize(const Params& p);  // std::invalid_argument on bad values
+    const Params& params() const { return params_; }
+
+    /// Clusters the scan and clears the valid flag of every noise point.
+    Result filter(Scan& scan);
+
+    /// Clusters of the last filtered scan (labels per beam, noise flags), e.g. for rendering.
+    const Clusters& clusters() const { return clusters_; }
+
+  private:
+    Params params_;
+    RingClustering reference_;
+    RangeAwareClustering range_aware_;
+    ClusterFilterParams filter_;
+    Clusters clusters_;
+};
+
+}  // namespace kfd

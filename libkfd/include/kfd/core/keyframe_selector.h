@@ -1,0 +1,95 @@
+// Keyframe selection: Sec. 3.1.4, Formula 3, plus guards the paper lacks.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "kfd/core/histogram.h"
+#include "kfd/core/scan.h"
+
+namespace kfd {
+
+/// Why a scan was kept or dropped.
+enum class KeyframeReason : std::uint8_t {
+    First,        // first scan of the stream (or after reset): always a keyframe
+    Dissimilar,   // P_common < P_threshold (Formula 3): new information
+    MaxDrops,     // guard: too many consecutive drops
+    MaxInterval,  // guard: too long since the last keyframe
+    Translation,  // guard: odometry moved too far since the last keyframe
+    Rotation,     // guard: odometry turned too far since the last keyframe (rotation in place)
+    Similar,      // P_common >= P_threshold: dropped
+};
+const char* toString(KeyframeReason r);
+
+/// Outcome of one keyframe decision, with diagnostics.
+struct KeyframeDecision {
+    bool keyframe = true;
+    KeyframeReason reason = KeyframeReason::First;
+    double p_common = 0.0;        // product of clamped correlations with the window (Formula 3)
+    double p_threshold = 0.0;     // P_pair^k, k = references compared
+    double min_similarity = 0.0;  // the weakest pairwise similarity in the window
+    std::size_t references = 0;   // k: keyframes compared against (<= window)
+    std::size_t consecutive_drops = 0;  // drops since the last keyframe, this one included
+};
+
+/// Sliding window of the m latest keyframe histograms (Sec. 3.1.4).
+///
+/// For a target scan with histogram h, P_common = prod_j max(0, pearson(h, K_j)) over the k <= m
+/// keyframes K_j in the window (Formula 3); the scan is dropped when P_common >= P_pair^k and is a
+/// keyframe otherwise (then it enters the window, evicting the oldest). With k < m references the
+/// threshold is P_pair^k, so a short window is not made artificially permissive.
+///
+/// Guards (each 0 = off) force a keyframe even when the scan looks similar; the paper has none,
+/// and without them a robot rotating in place in a symmetric room, standing still for minutes,
+/// or driving down a featureless corridor would produce no keyframe at all.
+class KeyframeSelector {
+  public:
+    struct Params {
+        std::size_t bins = 20;   // n, histogram columns (Sec. 3.1.2)
+        std::size_t window = 8;  // m, sliding-window size (Sec. 3.1.4, Formulas 4-5)
+        double p_pair = 0.985;   // P_pair; P_threshold = P_pair^m (Formula 3)
+        // Guards (beyond the paper). 0 disables a guard.
+        std::size_t max_consecutive_drops = 40;  // K: force a keyframe after K drops in a row
+        double max_interval_s = 2.0;             // T (s) since the last keyframe
+        double max_translation_m = 0.5;          // D (m) of odometry travel since the last keyframe
+        double max_rotation_deg = 15.0;          // A (deg) of odometry turn since the last keyframe
+    };
+
+    KeyframeSelector() { initialize(Params{}); }
+    explicit KeyframeSelector(const Params& p) { initialize(p); }
+
+    /// Validates and applies parameters (std::invalid_argument naming the field), then resets.
+    void initialize(const Params& p);
+    const Params& params() const { return params_; }
+
+    /// Forgets every keyframe: the next scan is a keyframe (KeyframeReason::First).
+    void reset();
+
+    /// Decides on a histogram (size = bins) and updates the window when it is a keyframe.
+    KeyframeDecision decide(const std::vector<double>& histogram, double timestamp,
+                            const std::optional<Pose2D>& odometry);
+
+    /// Builds the scan's histogram (Sec. 3.1.2) and decides. Does not modify the scan.
+    KeyframeDecision filter(const Scan& scan);
+
+    std::size_t windowSize() const { return count_; }
+    const std::vector<double>& lastHistogram() const { return scratch_; }
+
+  private:
+    const double* slot(std::size_t i) const { return &window_[i * params_.bins]; }
+
+    Params params_;
+    Histogram histogram_;
+    std::vector<double> window_;   // window * bins, ring buffer of keyframe histograms
+    std::vector<double> scratch_;  // the latest histogram
+    std::size_t head_ = 0;         // next slot to overwrite
+    std::size_t count_ = 0;        // keyframes held (<= window)
+    std::size_t drops_ = 0;        // consecutive drops since the last keyframe
+    double last_stamp_ = 0.0;
+    bool have_stamp_ = false;
+    std::optional<Pose2D> last_odometry_;
+};
+
+}  // namespace kfd

@@ -1,0 +1,70 @@
+// kfd core: the scan representation shared by every stage (std only).
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <vector>
+
+namespace kfd {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// Planar pose (odometry), metres and radians.
+struct Pose2D {
+    double x = 0.0;    // m
+    double y = 0.0;    // m
+    double phi = 0.0;  // rad
+};
+
+/// Geometry of a 2D range scan, with MRPT's convention (CObservation2DRangeScan::getScanAngle):
+/// beam i points at angle(i) = -aperture/2 + i * aperture/(beams-1), mirrored when
+/// right_to_left is false.
+struct ScanGeometry {
+    std::size_t beams = 0;
+    double aperture = kPi;  // rad, field of view
+    bool right_to_left = true;
+
+    /// Signed angle between consecutive beams (rad).
+    double step() const {
+        if (beams < 2) return 0.0;
+        const double s = aperture / static_cast<double>(beams - 1);
+        return right_to_left ? s : -s;
+    }
+    /// Angular resolution (rad), always >= 0.
+    double resolution() const { return std::abs(step()); }
+    /// Direction of beam i (rad), 0 = forward.
+    double angle(std::size_t i) const {
+        const double first = right_to_left ? -0.5 * aperture : 0.5 * aperture;
+        return first + step() * static_cast<double>(i);
+    }
+    /// Angle (rad) between the last beam and the first one going on around the circle
+    /// (2*pi - aperture); small for a 360-degree scanner.
+    double seamGap() const { return 2.0 * kPi - aperture; }
+
+    bool operator==(const ScanGeometry& o) const {
+        return beams == o.beams && aperture == o.aperture && right_to_left == o.right_to_left;
+    }
+    bool operator!=(const ScanGeometry& o) const { return !(*this == o); }
+};
+
+/// One scan as the core sees it. `valid[i] != 0` means beam i holds a usable range.
+/// Stages never delete beams: removing a point clears its valid flag.
+struct Scan {
+    ScanGeometry geometry;
+    std::vector<float> range;         // m, one per beam
+    std::vector<std::uint8_t> valid;  // 1 = usable, 0 = invalid or removed
+    double timestamp = std::numeric_limits<double>::quiet_NaN();  // s (any epoch), NaN = unknown
+    std::optional<Pose2D> odometry;  // absolute odometry at the scan, when known
+
+    std::size_t size() const { return range.size(); }
+    std::size_t countValid() const {
+        std::size_t n = 0;
+        for (const auto v : valid) n += (v != 0);
+        return n;
+    }
+};
+
+}  // namespace kfd

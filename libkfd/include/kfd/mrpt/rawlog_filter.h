@@ -1,0 +1,70 @@
+// Filtering a whole rawlog file (the logic behind kfd-filter), streaming object by object.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+#include "kfd/core/pipeline.h"
+#include "kfd/mrpt/stream_filter.h"
+
+namespace kfd {
+
+/// Bad input or output: missing/unreadable file, not a rawlog, truncated rawlog, write failure.
+class RawlogError : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+struct RawlogProgress {
+    std::uint64_t bytes_read = 0;   // compressed bytes consumed
+    std::uint64_t bytes_total = 0;  // input file size
+    std::size_t objects = 0;
+    std::size_t scans_in = 0;
+    std::size_t scans_kept = 0;
+};
+
+struct RawlogFilterOptions {
+    std::string input;      // .rawlog (plain or gzip), either MRPT layout
+    std::string output;     // written to a temporary file, renamed on success
+    std::string stats_csv;  // optional per-scan CSV
+    Pipeline::Params pipeline;
+    int compress_level = 1;  // gzip level of the output (0 = store, 9 = smallest)
+    /// Called about every `progress_every` objects and once at the end.
+    std::function<void(const RawlogProgress&)> on_progress;
+    std::size_t progress_every = 2000;
+};
+
+struct RawlogFilterSummary {
+    std::string layout;               // "actions+sensory-frames", "observations", or "mixed"
+    std::size_t objects_in = 0;       // top-level objects read
+    std::size_t objects_out = 0;      // top-level objects written
+    std::size_t objects_dropped = 0;  // sensory frames / observations dropped whole
+    std::size_t actions_merged = 0;   // odometry actions composed into a later kept action
+    std::size_t scans_in = 0;
+    std::size_t scans_kept = 0;
+    std::size_t scans_dropped = 0;
+    std::size_t geometry_resets = 0;
+    std::size_t sensors = 0;
+    std::size_t points_in = 0;             // valid beams in all input scans
+    std::size_t points_removed_range = 0;  // by Algorithm 1, in kept scans
+    std::size_t points_removed_noise = 0;  // by the denoiser, in kept scans
+    double filter_seconds = 0.0;           // time inside the pipeline
+    double wall_seconds = 0.0;             // whole run, I/O included
+    double droppedPercent() const {
+        return scans_in ? 100.0 * static_cast<double>(scans_dropped) / scans_in : 0.0;
+    }
+};
+
+/// Reads `input` object by object (never loading it whole), runs every 2D range scan through a
+/// StreamFilter, and writes every other object unchanged and in order. Non-keyframe scans are
+/// removed; a sensory frame left empty is dropped and its odometry action is composed into the
+/// next kept action, so the output's odometry still adds up. The input is never modified; on
+/// any error no output file is left behind. Throws RawlogError or ConfigError.
+class RawlogFilter {
+  public:
+    RawlogFilterSummary run(const RawlogFilterOptions& opts);
+};
+
+}  // namespace kfd

@@ -1,0 +1,22 @@
+// Conversion between MRPT's CObservation2DRangeScan and kfd's core Scan.
+#pragma once
+
+#include <mrpt/obs/CObservation2DRangeScan.h>
+
+#include "kfd/core/scan.h"
+
+namespace kfd {
+
+/// Geometry (beam count, aperture, direction) of an MRPT scan.
+ScanGeometry geometryOf(const mrpt::obs::CObservation2DRangeScan& obs);
+
+/// Copies ranges, validity, geometry and timestamp into `out` (buffers reused, no allocation
+/// once sized). Odometry is left as it is.
+void toCore(const mrpt::obs::CObservation2DRangeScan& obs, Scan& out);
+
+/// Writes the core scan's valid flags back: beams the filters removed become invalid. Ranges,
+/// beam count and angles are untouched, and no beam is ever made valid again.
+/// Returns the number of beams newly invalidated.
+std::size_t applyValidity(const Scan& scan, mrpt::obs::CObservation2DRangeScan& obs);
+
+}  // namespace kfd

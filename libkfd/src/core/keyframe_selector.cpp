@@ -1,0 +1,128 @@
+#include "kfd/core/keyframe_selector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "kfd/core/correlation.h"
+
+namespace kfd {
+
+const char* toString(KeyframeReason r) {
+    switch (r) {
+        case KeyframeReason::First:
+            return "first";
+        case KeyframeReason::Dissimilar:
+            return "dissimilar";
+        case KeyframeReason::MaxDrops:
+            return "max_drops";
+        case KeyframeReason::MaxInterval:
+            return "max_interval";
+        case KeyframeReason::Translation:
+            return "translation";
+        case KeyframeReason::Rotation:
+            return "rotation";
+        case KeyframeReason::Similar:
+            return "similar";
+    }
+    return "unknown";
+}
+
+void KeyframeSelector::initialize(const Params& p) {
+    auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
+    if (p.bins < 2) bad("bins must be >= 2 (a correlation needs at least two columns)");
+    if (p.window < 1) bad("window must be >= 1");
+    if (!(p.p_pair > 0.0 && p.p_pair <= 1.0)) bad("p_pair must be in (0, 1]");
+    if (!(p.max_interval_s >= 0.0)) bad("max_interval_s must be >= 0 (0 = off)");
+    if (!(p.max_translation_m >= 0.0)) bad("max_translation_m must be >= 0 (0 = off)");
+    if (!(p.max_rotation_deg >= 0.0)) bad("max_rotation_deg must be >= 0 (0 = off)");
+    params_ = p;
+    histogram_.initialize(Histogram::Params{p.bins});
+    window_.assign(p.window * p.bins, 0.0);
+    scratch_.assign(p.bins, 0.0);
+    reset();
+}
+
+void KeyframeSelector::reset() {
+    head_ = 0;
+    count_ = 0;
+    drops_ = 0;
+    have_stamp_ = false;
+    last_odometry_.reset();
+}
+
+KeyframeDecision KeyframeSelector::decide(const std::vector<double>& h, double timestamp,
+                                          const std::optional<Pose2D>& odometry) {
+    if (h.size() != params_.bins)
+        throw std::invalid_argument("histogram size does not match the configured bins");
+    KeyframeDecision d;
+    d.references = count_;
+    if (count_ == 0) {
+        d.keyframe = true;
+        d.reason = KeyframeReason::First;
+        d.p_common = 0.0;
+        d.p_threshold = 1.0;
+    } else {
+        // Formula 3: P_common = prod_j P(target, K_j), compared with P_pair^k.
+        double p = 1.0, pmin = 1.0;
+        for (std::size_t j = 0; j < count_; ++j) {
+            const double s = similarity(h.data(), slot(j), params_.bins);
+            p *= s;
+            pmin = std::min(pmin, s);
+        }
+        d.p_common = p;
+        d.min_similarity = pmin;
+        d.p_threshold = std::pow(params_.p_pair, static_cast<double>(count_));
+        d.keyframe = p < d.p_threshold;
+        d.reason = d.keyframe ? KeyframeReason::Dissimilar : KeyframeReason::Similar;
+        if (!d.keyframe) {
+            // Guards, in order of precedence.
+            const double dt = timestamp - last_stamp_;
+            if (params_.max_consecutive_drops > 0 && drops_ + 1 > params_.max_consecutive_drops) {
+                d.keyframe = true;
+                d.reason = KeyframeReason::MaxDrops;
+            } else if (params_.max_interval_s > 0.0 && have_stamp_ && std::isfinite(timestamp) &&
+                       dt >= params_.max_interval_s) {
+                d.keyframe = true;
+                d.reason = KeyframeReason::MaxInterval;
+            } else if (odometry && last_odometry_) {
+                const double dx = odometry->x - last_odometry_->x;
+                const double dy = odometry->y - last_odometry_->y;
+                const double dphi = std::remainder(odometry->phi - last_odometry_->phi, 2.0 * kPi);
+                if (params_.max_translation_m > 0.0 &&
+                    std::hypot(dx, dy) >= params_.max_translation_m) {
+                    d.keyframe = true;
+                    d.reason = KeyframeReason::Translation;
+                } else if (params_.max_rotation_deg > 0.0 &&
+                           std::abs(dphi) * 180.0 / kPi >= params_.max_rotation_deg) {
+                    d.keyframe = true;
+                    d.reason = KeyframeReason::Rotation;
+                }
+            }
+        }
+    }
+
+    if (d.keyframe) {
+        std::copy(h.begin(), h.end(), window_.begin() + head_ * params_.bins);
+        head_ = (head_ + 1) % params_.window;
+        count_ = std::min(count_ + 1, params_.window);
+        drops_ = 0;
+        if (std::isfinite(timestamp)) {
+            last_stamp_ = timestamp;
+            have_stamp_ = true;
+        }
+        if (odometry) last_odometry_ = odometry;
+    } else {
+        ++drops_;
+    }
+    d.consecutive_drops = drops_;
+    return d;
+}
+
+KeyframeDecision KeyframeSelector::filter(const Scan& scan) {
+    histogram_.compute(scan, scratch_);
+    return decide(scratch_, scan.timestamp, scan.odometry);
+}
+
+}  // namespace kfd

@@ -1,0 +1,123 @@
+#include "kfd/core/range_aware_clustering.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace kfd {
+
+void RangeAwareClustering::initialize(const Params& p) {
+    if (!(p.angle_gap_factor > 0.0) || !std::isfinite(p.angle_gap_factor))
+        throw std::invalid_argument("angle_gap_factor must be > 0");
+    if (!(p.jump_lambda_deg > 0.0 && p.jump_lambda_deg < 90.0))
+        throw std::invalid_argument("jump_lambda_deg must be in (0, 90)");
+    if (!(p.jump_sigma_m >= 0.0) || !std::isfinite(p.jump_sigma_m))
+        throw std::invalid_argument("jump_sigma_m must be >= 0");
+    params_ = p;
+    sin_lambda_ = std::sin(p.jump_lambda_deg * kPi / 180.0);
+    half_lambda_ = 0.5 * p.jump_lambda_deg * kPi / 180.0;
+}
+
+double RangeAwareClustering::jumpDistance(double ra, double rb, double dtheta) const {
+    // The angle stops counting at lambda/2: over wider gaps (10 beams at 1 deg resolution) the
+    // bound would otherwise reach min(ra, rb) and link objects at twice the depth.
+    const double a = std::min(dtheta, half_lambda_);
+    return std::min(ra, rb) * std::sin(a) / sin_lambda_ + 3.0 * params_.jump_sigma_m;
+}
+
+void RangeAwareClustering::updateTables(const ScanGeometry& g) {
+    if (g == table_geometry_ && cos_.size() == g.beams) return;
+    table_geometry_ = g;
+    cos_.resize(g.beams);
+    sin_.resize(g.beams);
+    for (std::size_t i = 0; i < g.beams; ++i) {
+        const double a = g.angle(i);
+        cos_[i] = static_cast<float>(std::cos(a));
+        sin_[i] = static_cast<float>(std::sin(a));
+    }
+}
+
+RangeAwareClustering::Result RangeAwareClustering::cluster(const Scan& scan, Clusters& out) {
+    Result res;
+    const ScanGeometry& g = scan.geometry;
+    const std::size_t n = scan.range.size();
+    ScanGeometry geom = g;
+    geom.beams = n;  // tables follow the actual data length
+    updateTables(geom);
+    const double res_ang = g.resolution();
+    const double theta = params_.angle_gap_factor * res_ang;
+    res.theta_threshold = theta;
+    const bool wraps = n > 1 && g.seamGap() <= theta + 1e-12;
+
+    sets_.clear();
+    provisional_.assign(n, -1);
+    open_.clear();
+
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!scan.valid[i]) continue;
+        const float r = scan.range[i];
+        const float x = r * cos_[i], y = r * sin_[i];
+        // Close clusters whose last point is more than theta behind.
+        open_.erase(std::remove_if(open_.begin(), open_.end(),
+                                   [&](const Open& o) {
+                                       return static_cast<double>(i - o.beam) * res_ang >
+                                              theta + 1e-12;
+                                   }),
+                    open_.end());
+        int best = -1;
+        double best_d = 0.0;
+        for (std::size_t k = 0; k < open_.size(); ++k) {
+            const Open& o = open_[k];
+            const double d = std::hypot(x - o.x, y - o.y);
+            const double dtheta = static_cast<double>(i - o.beam) * res_ang;
+            if (d <= jumpDistance(r, o.r, dtheta)) {
+                if (best < 0 || d < best_d) {
+                    best = static_cast<int>(k);
+                    best_d = d;
+                }
+            } else {
+                ++res.splits;
+            }
+        }
+        if (best < 0) {
+            const std::uint32_t id = sets_.add();
+            provisional_[i] = static_cast<std::int32_t>(id);
+            open_.push_back(Open{id, static_cast<std::uint32_t>(i), x, y, r});
+            continue;
+        }
+        // Join the nearest; clusters that this point also reaches become one.
+        const std::uint32_t id = open_[best].id;
+        for (std::size_t k = 0; k < open_.size(); ++k) {
+            if (static_cast<int>(k) == best) continue;
+            const Open& o = open_[k];
+            const double dtheta = static_cast<double>(i - o.beam) * res_ang;
+            if (std::hypot(x - o.x, y - o.y) <= jumpDistance(r, o.r, dtheta))
+                res.merges += sets_.unite(id, o.id) ? 1 : 0;
+        }
+        ++res.links;
+        provisional_[i] = static_cast<std::int32_t>(id);
+        open_[best] = Open{id, static_cast<std::uint32_t>(i), x, y, r};
+    }
+
+    // Across the seam: clusters open at the end of the scan against the first beams.
+    if (wraps) {
+        for (const Open& o : open_) {
+            for (std::size_t j = 0; j < n; ++j) {
+                const double dtheta =
+                    (static_cast<double>(n - 1 - o.beam + j)) * res_ang + g.seamGap();
+                if (dtheta > theta + 1e-12) break;
+                if (!scan.valid[j] || provisional_[j] < 0) continue;
+                const float r = scan.range[j];
+                const double d = std::hypot(r * cos_[j] - o.x, r * sin_[j] - o.y);
+                if (d <= jumpDistance(r, o.r, std::max(dtheta, 0.0)))
+                    res.merges +=
+                        sets_.unite(o.id, static_cast<std::uint32_t>(provisional_[j])) ? 1 : 0;
+            }
+        }
+    }
+
+    out.finalize(scan, provisional_, sets_);
+    return res;
+}
+
+}  // namespace kfd

@@ -1,0 +1,346 @@
+#include "kfd/mrpt/rawlog_filter.h"
+
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPose2D.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <random>
+
+namespace kfd {
+namespace {
+
+namespace fs = std::filesystem;
+using mrpt::obs::CActionCollection;
+using mrpt::obs::CActionRobotMovement2D;
+using mrpt::obs::CObservation2DRangeScan;
+using mrpt::obs::CObservationOdometry;
+using mrpt::obs::CSensoryFrame;
+using mrpt::poses::CPose2D;
+
+Pose2D toPose(const CPose2D& p) { return Pose2D{p.x(), p.y(), p.phi()}; }
+
+// MRPT nests exception texts ("==== MRPT exception ==== Message: ..."); keep the innermost
+// message line, which says what actually failed.
+std::string lastMessage(const std::string& what) {
+    const auto pos = what.rfind("Message:");
+    if (pos == std::string::npos) return what.substr(0, what.find('\n'));
+    std::string line = what.substr(pos + 8, what.find('\n', pos) - pos - 8);
+    const auto b = line.find_first_not_of(' ');
+    return b == std::string::npos ? line : line.substr(b);
+}
+
+// Removes the temporary output unless released.
+struct TempFile {
+    fs::path path;
+    bool keep = false;
+    ~TempFile() {
+        if (!keep && !path.empty()) {
+            std::error_code ec;
+            fs::remove(path, ec);
+        }
+    }
+};
+
+class CsvWriter {
+  public:
+    void open(const std::string& path) {
+        out_.open(path);
+        if (!out_) throw RawlogError("cannot write the stats file " + path);
+        out_ << "index,timestamp,sensor,keyframe,reason,p_common,p_threshold,references,"
+                "points_in,removed_range,clusters,noise_clusters,removed_noise,points_out,"
+                "microseconds\n";
+    }
+    bool isOpen() const { return out_.is_open(); }
+    void row(std::size_t index, double stamp, const StreamResult& r) {
+        const ScanReport& s = r.report;
+        char buf[512];
+        std::snprintf(
+            buf, sizeof(buf), "%zu,%.6f,%s,%d,%s,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu,%zu,%zu,%.2f\n",
+            index, stamp, r.sensor_label.c_str(), r.keep ? 1 : 0,
+            s.keyframe_evaluated ? toString(s.keyframe.reason) : "none", s.keyframe.p_common,
+            s.keyframe.p_threshold, s.keyframe.references, s.points_in,
+            s.distance.removed_non_finite + s.distance.removed_out_of_range, s.denoise.clusters,
+            s.denoise.noise_clusters, s.denoise.points_removed, s.points_out, s.microseconds);
+        out_ << buf;
+    }
+    void close() {
+        if (!out_.is_open()) return;
+        out_.close();
+        if (out_.fail()) throw RawlogError("failed writing the stats file");
+    }
+
+  private:
+    std::ofstream out_;
+};
+
+class Run {
+  public:
+    Run(const RawlogFilterOptions& o, RawlogFilterSummary& s)
+        : opts_(o), sum_(s), filter_(o.pipeline) {}
+
+    void execute();
+
+  private:
+    void handleActions(const std::shared_ptr<CActionCollection>& acts);
+    void handleFrame(const std::shared_ptr<CSensoryFrame>& sf);
+    // Processes one scan; returns true when kept.
+    bool handleScan(CObservation2DRangeScan& scan);
+    void write(const mrpt::serialization::CSerializable& obj);
+    void flushPendingAction(bool frame_kept);
+
+    const RawlogFilterOptions& opts_;
+    RawlogFilterSummary& sum_;
+    StreamFilter filter_;
+    CsvWriter csv_;
+    mrpt::io::CFileGZOutputStream out_;
+    std::optional<mrpt::serialization::CArchiveStreamBase<mrpt::io::CFileGZOutputStream>> arch_;
+    std::shared_ptr<CActionCollection> pending_;  // action waiting for its sensory frame
+    CPose2D carry_;                               // odometry of dropped frames, not yet written
+    bool have_carry_ = false;
+    std::optional<Pose2D> odometry_;  // absolute odometry, for the motion guards
+    CPose2D odo_accum_;               // integrated action increments (actions layout)
+    bool saw_frames_ = false, saw_observations_ = false;
+    std::size_t scan_index_ = 0;
+};
+
+void Run::write(const mrpt::serialization::CSerializable& obj) {
+    try {
+        (*arch_) << obj;
+    } catch (const std::exception& e) {
+        throw RawlogError(std::string("failed writing the output: ") + e.what());
+    }
+    ++sum_.objects_out;
+}
+
+bool Run::handleScan(CObservation2DRangeScan& scan) {
+    ++sum_.scans_in;
+    const double stamp =
+        scan.timestamp == mrpt::Clock::time_point() ? 0.0 : mrpt::Clock::toDouble(scan.timestamp);
+    StreamResult r;
+    try {
+        r = filter_.process(scan, odometry_);
+    } catch (const std::invalid_argument& e) {
+        throw RawlogError("scan " + std::to_string(scan_index_) + ": " + e.what());
+    }
+    sum_.points_in += r.report.points_in;
+    sum_.filter_seconds += r.report.microseconds * 1e-6;
+    sum_.geometry_resets += r.geometry_reset ? 1 : 0;
+    if (r.keep) {
+        ++sum_.scans_kept;
+        sum_.points_removed_range +=
+            r.report.distance.removed_non_finite + r.report.distance.removed_out_of_range;
+        sum_.points_removed_noise += r.report.denoise.points_removed;
+    } else {
+        ++sum_.scans_dropped;
+    }
+    if (csv_.isOpen()) csv_.row(scan_index_, stamp, r);
+    ++scan_index_;
+    return r.keep;
+}
+
+void Run::handleActions(const std::shared_ptr<CActionCollection>& acts) {
+    // Two actions in a row (no frame between): the first stands on its own.
+    if (pending_) flushPendingAction(true);
+    pending_ = acts;
+    if (auto mv = acts->getBestMovementEstimation()) {
+        odo_accum_ = odo_accum_ + mv->rawOdometryIncrementReading;
+        odometry_ = toPose(odo_accum_);
+    }
+}
+
+// Writes the pending action (with any carried odometry composed in) or, when its frame was
+// dropped, folds its motion into the carry for the next kept action.
+void Run::flushPendingAction(bool frame_kept) {
+    if (!pending_) return;
+    auto acts = pending_;
+    pending_.reset();
+    auto mv = acts->getBestMovementEstimation();
+    if (!frame_kept) {
+        if (mv) {
+            carry_ = have_carry_ ? carry_ + mv->rawOdometryIncrementReading
+                                 : mv->rawOdometryIncrementReading;
+            have_carry_ = true;
+        }
+        ++sum_.actions_merged;
+        return;
+    }
+    if (have_carry_) {
+        if (mv) {
+            auto copy = std::make_shared<CActionRobotMovement2D>(*mv);
+            copy->computeFromOdometry(carry_ + mv->rawOdometryIncrementReading,
+                                      mv->motionModelConfiguration);
+            // Replace the movement in a copy of the collection, keeping other actions.
+            auto merged = std::make_shared<CActionCollection>();
+            for (std::size_t i = 0; i < acts->size(); ++i) {
+                auto a = acts->get(i);
+                if (a.get() == mv.get())
+                    merged->insert(*copy);
+                else
+                    merged->insert(*a);
+            }
+            acts = merged;
+        } else {
+            CActionRobotMovement2D m;
+            m.computeFromOdometry(carry_, CActionRobotMovement2D::TMotionModelOptions());
+            auto merged = std::make_shared<CActionCollection>(*acts);
+            merged->insert(m);
+            acts = merged;
+        }
+        have_carry_ = false;
+        carry_ = CPose2D();
+    }
+    write(*acts);
+}
+
+void Run::handleFrame(const std::shared_ptr<CSensoryFrame>& sf) {
+    std::size_t scans = 0, dropped = 0;
+    for (auto it = sf->begin(); it != sf->end();) {
+        auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(*it);
+        if (!scan) {
+            ++it;
+            continue;
+        }
+        ++scans;
+        if (handleScan(*scan)) {
+            ++it;
+        } else {
+            it = sf->erase(it);
+            ++dropped;
+        }
+    }
+    const bool frame_kept = !(scans > 0 && sf->size() == 0);
+    flushPendingAction(frame_kept);
+    if (frame_kept)
+        write(*sf);
+    else
+        ++sum_.objects_dropped;
+}
+
+void Run::execute() {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::error_code ec;
+    if (!fs::is_regular_file(opts_.input, ec))
+        throw RawlogError("input rawlog not found: " + opts_.input);
+    if (opts_.output.empty()) throw RawlogError("no output file given");
+    if (fs::exists(opts_.output, ec) && fs::equivalent(opts_.input, opts_.output, ec))
+        throw RawlogError("the output must not be the input file: " + opts_.output);
+
+    mrpt::io::CFileGZInputStream in;
+    if (!in.open(opts_.input)) throw RawlogError("cannot open the input rawlog: " + opts_.input);
+    const std::uint64_t total = fs::file_size(opts_.input, ec);
+    if (total == 0) throw RawlogError("the input is empty: " + opts_.input);
+
+    TempFile tmp;
+    {
+        std::random_device rd;
+        const fs::path outp(opts_.output);
+        tmp.path = outp.parent_path() /
+                   (outp.filename().string() + ".tmp-" + std::to_string(rd() % 1000000));
+    }
+    if (!out_.open(tmp.path.string(), opts_.compress_level))
+        throw RawlogError("cannot write the output next to " + opts_.output);
+    arch_.emplace(out_);
+    if (!opts_.stats_csv.empty()) csv_.open(opts_.stats_csv);
+
+    auto in_arch = mrpt::serialization::archiveFrom(in);
+    RawlogProgress progress;
+    progress.bytes_total = total;
+    for (;;) {
+        mrpt::serialization::CSerializable::Ptr obj;
+        try {
+            obj = in_arch.ReadObject();
+        } catch (const mrpt::serialization::CExceptionEOF&) {
+            break;
+        } catch (const std::exception& e) {
+            const std::string what = lastMessage(e.what());
+            throw RawlogError("cannot read object #" + std::to_string(sum_.objects_in) + " of " +
+                              opts_.input +
+                              (sum_.objects_in == 0 ? " (is it an MRPT rawlog?): "
+                                                    : " (truncated or corrupt file?): ") +
+                              what);
+        }
+        if (!obj) continue;
+        ++sum_.objects_in;
+        if (auto acts = std::dynamic_pointer_cast<CActionCollection>(obj)) {
+            saw_frames_ = true;
+            handleActions(acts);
+        } else if (auto sf = std::dynamic_pointer_cast<CSensoryFrame>(obj)) {
+            saw_frames_ = true;
+            handleFrame(sf);
+        } else if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(obj)) {
+            saw_observations_ = true;
+            flushPendingAction(true);
+            if (handleScan(*scan))
+                write(*scan);
+            else
+                ++sum_.objects_dropped;
+        } else {
+            if (auto odo = std::dynamic_pointer_cast<CObservationOdometry>(obj))
+                odometry_ = toPose(odo->odometry);
+            if (std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj)) saw_observations_ = true;
+            flushPendingAction(true);
+            write(*obj);
+        }
+        if (opts_.on_progress &&
+            sum_.objects_in % std::max<std::size_t>(1, opts_.progress_every) == 0) {
+            progress.bytes_read = in.getPosition();
+            progress.objects = sum_.objects_in;
+            progress.scans_in = sum_.scans_in;
+            progress.scans_kept = sum_.scans_kept;
+            opts_.on_progress(progress);
+        }
+    }
+    if (sum_.objects_in == 0) throw RawlogError("no objects in " + opts_.input + ": not a rawlog?");
+    flushPendingAction(true);
+    if (have_carry_) {  // the last frames were dropped: keep their motion as a final action
+        CActionCollection acts;
+        CActionRobotMovement2D m;
+        m.computeFromOdometry(carry_, CActionRobotMovement2D::TMotionModelOptions());
+        acts.insert(m);
+        write(acts);
+        --sum_.actions_merged;  // that motion was written, not merged away
+        have_carry_ = false;
+    }
+    arch_.reset();
+    out_.close();
+    csv_.close();
+    std::error_code rec;
+    fs::rename(tmp.path, opts_.output, rec);
+    if (rec) throw RawlogError("cannot move the output into place: " + rec.message());
+    tmp.keep = true;
+
+    sum_.layout = saw_frames_ && saw_observations_ ? "mixed"
+                  : saw_frames_                    ? "actions+sensory-frames"
+                                                   : "observations";
+    sum_.sensors = filter_.sensorCount();
+    sum_.wall_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (opts_.on_progress) {
+        progress.bytes_read = total;
+        progress.objects = sum_.objects_in;
+        progress.scans_in = sum_.scans_in;
+        progress.scans_kept = sum_.scans_kept;
+        opts_.on_progress(progress);
+    }
+}
+
+}  // namespace
+
+RawlogFilterSummary RawlogFilter::run(const RawlogFilterOptions& opts) {
+    RawlogFilterSummary sum;
+    Run(opts, sum).execute();
+    return sum;
+}
+
+}  // namespace kfd

@@ -1,0 +1,48 @@
+#include "kfd/mrpt/stream_filter.h"
+
+#include <stdexcept>
+
+#include "kfd/mrpt/scan_adapter.h"
+
+namespace kfd {
+
+StreamFilter::StreamFilter(const Pipeline::Params& params, StageFactory extra)
+    : params_(params), extra_(std::move(extra)) {
+    Pipeline check(params_);  // validate now, not at the first scan
+}
+
+StreamFilter::Sensor& StreamFilter::sensorFor(const std::string& label) {
+    auto it = sensors_.find(label);
+    if (it != sensors_.end()) return it->second;
+    Sensor s;
+    s.pipeline = std::make_unique<Pipeline>(params_);
+    if (extra_) extra_(*s.pipeline);
+    return sensors_.emplace(label, std::move(s)).first->second;
+}
+
+StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
+                                   const std::optional<Pose2D>& odometry) {
+    if (obs.getScanSize() == 0) throw std::invalid_argument("scan has no beams");
+    StreamResult res;
+    res.sensor_label = obs.sensorLabel;
+    Sensor& s = sensorFor(obs.sensorLabel);
+    const ScanGeometry g = geometryOf(obs);
+    if (s.geometry.beams != 0 && g != s.geometry) {
+        s.pipeline->reset();
+        res.geometry_reset = true;
+    }
+    s.geometry = g;
+    toCore(obs, s.scan);
+    s.scan.odometry = odometry;
+    res.report = s.pipeline->process(s.scan);
+    res.keep = res.report.keep;
+    applyValidity(s.scan, obs);
+    return res;
+}
+
+const Clusters* StreamFilter::lastClusters(const std::string& sensor_label) const {
+    const auto it = sensors_.find(sensor_label);
+    return it == sensors_.end() ? nullptr : it->second.pipeline->lastClusters();
+}
+
+}  // namespace kfd

@@ -1,0 +1,153 @@
+// Configuration loaders: every shipped config, key validation, INI/YAML agreement.
+#include <gtest/gtest.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/containers/yaml.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "kfd/mrpt/config.h"
+
+namespace {
+
+kfd::Pipeline::Params fromIniText(const std::string& text) {
+    mrpt::config::CConfigFileMemory cfg(text);
+    return kfd::loadIni(cfg);
+}
+
+std::string errorKey(const std::string& text) {
+    try {
+        fromIniText(text);
+    } catch (const kfd::ConfigError& e) {
+        return e.key();
+    }
+    return "<no error>";
+}
+
+}  // namespace
+
+TEST(Config, EveryShippedConfigLoads) {
+    std::size_t n = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(KFD_SHARE_DIR)) {
+        SCOPED_TRACE(entry.path().string());
+        EXPECT_NO_THROW(kfd::loadConfigFile(entry.path().string()));
+        ++n;
+    }
+    EXPECT_GE(n, 4u);  // default.ini, default.yaml and the two paper presets
+}
+
+TEST(Config, PaperPresetsHoldThePublishedValues) {
+    const auto a = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/paper-mit-0.752.ini");
+    EXPECT_EQ(a.keyframe.window, 8u);
+    EXPECT_EQ(a.keyframe.bins, 20u);
+    EXPECT_DOUBLE_EQ(a.keyframe.p_pair, 0.985);
+    const auto b = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/paper-mit-0.575.ini");
+    EXPECT_EQ(b.keyframe.window, 9u);
+    EXPECT_EQ(b.keyframe.bins, 15u);
+    EXPECT_DOUBLE_EQ(b.keyframe.p_pair, 0.99);
+    for (const auto& p : {a, b}) {
+        EXPECT_EQ(p.denoise.rings, 5u);
+        EXPECT_DOUBLE_EQ(p.denoise.angle_gap_factor, 10.0);
+        EXPECT_EQ(p.denoise.m_threshold, 10u);
+        EXPECT_EQ(p.denoise.variant, kfd::DenoiseVariant::Reference);
+        // The published method has no guards.
+        EXPECT_EQ(p.keyframe.max_consecutive_drops, 0u);
+        EXPECT_EQ(p.keyframe.max_interval_s, 0.0);
+        EXPECT_EQ(p.keyframe.max_translation_m, 0.0);
+        EXPECT_EQ(p.keyframe.max_rotation_deg, 0.0);
+    }
+}
+
+TEST(Config, YamlAndIniDefaultsAgree) {
+    const auto ini = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.ini");
+    const auto yml = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.yaml");
+    EXPECT_EQ(kfd::toIni(ini), kfd::toIni(yml));
+    EXPECT_EQ(ini.denoise.variant, kfd::DenoiseVariant::RangeAware);
+}
+
+TEST(Config, MissingKeysKeepTheBuiltInDefaults) {
+    const auto p = fromIniText("[KFD]\nwindow = 3\n");
+    EXPECT_EQ(p.keyframe.window, 3u);
+    EXPECT_EQ(kfd::toIni(p), kfd::toIni([] {
+                  kfd::Pipeline::Params d;
+                  d.keyframe.window = 3;
+                  return d;
+              }()));
+}
+
+TEST(Config, UnknownKeyIsRejectedByName) {
+    EXPECT_EQ(errorKey("[KFD]\nwindw = 3\n"), "windw");
+    try {
+        fromIniText("[KFD]\nwindw = 3\n");
+        FAIL();
+    } catch (const kfd::ConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("windw"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("window"), std::string::npos);  // lists known keys
+    }
+}
+
+TEST(Config, OutOfRangeValuesNameTheKey) {
+    EXPECT_EQ(errorKey("[KFD]\nwindow = 0\n"), "window");
+    EXPECT_EQ(errorKey("[KFD]\np_pair = 1.5\n"), "p_pair");
+    EXPECT_EQ(errorKey("[KFD]\np_pair = 0\n"), "p_pair");
+    EXPECT_EQ(errorKey("[KFD]\nbins = 1\n"), "bins");
+    EXPECT_EQ(errorKey("[KFD]\nmin_range = -1\n"), "min_range");
+    EXPECT_EQ(errorKey("[KFD]\nrings = 0\n"), "rings");
+    EXPECT_EQ(errorKey("[KFD]\nmax_rotation_deg = 400\n"), "max_rotation_deg");
+    EXPECT_EQ(errorKey("[KFD]\nmin_range = 5\nmax_range = 2\n"), "max_range");
+}
+
+TEST(Config, MalformedValuesNameTheKey) {
+    EXPECT_EQ(errorKey("[KFD]\nwindow = eight\n"), "window");
+    EXPECT_EQ(errorKey("[KFD]\nwindow = 2.5\n"), "window");
+    EXPECT_EQ(errorKey("[KFD]\nmax_range = 30m\n"), "max_range");
+    EXPECT_EQ(errorKey("[KFD]\nvariant = fancy\n"), "variant");
+    EXPECT_EQ(errorKey("[KFD]\npipeline = distance, smooth\n"), "pipeline");
+    EXPECT_EQ(errorKey("[KFD]\npipeline = keyframe, keyframe\n"), "pipeline");
+}
+
+TEST(Config, PipelineOrderIsRead) {
+    const auto p = fromIniText("[KFD]\npipeline = distance, denoise\n");
+    ASSERT_EQ(p.stages.size(), 2u);
+    EXPECT_EQ(p.stages[0], "distance");
+    EXPECT_EQ(p.stages[1], "denoise");
+}
+
+TEST(Config, OtherSectionsAreIgnoredButTheSectionMustExist) {
+    EXPECT_NO_THROW(fromIniText("[ICP]\nfoo = 1\n[KFD]\nwindow = 2\n"));
+    EXPECT_THROW(fromIniText("[ICP]\nfoo = 1\n"), kfd::ConfigError);
+}
+
+TEST(Config, YamlTopLevelOrKfdMap) {
+    auto top = mrpt::containers::yaml::FromText("window: 4\nvariant: range_aware\n");
+    EXPECT_EQ(kfd::loadYaml(top).keyframe.window, 4u);
+    auto nested = mrpt::containers::yaml::FromText("kfd:\n  window: 5\n");
+    EXPECT_EQ(kfd::loadYaml(nested).keyframe.window, 5u);
+    auto bad = mrpt::containers::yaml::FromText("kfd:\n  windoww: 5\n");
+    try {
+        kfd::loadYaml(bad);
+        FAIL();
+    } catch (const kfd::ConfigError& e) {
+        EXPECT_EQ(e.key(), "windoww");
+    }
+}
+
+TEST(Config, FileErrorsAreClear) {
+    EXPECT_THROW(kfd::loadConfigFile("/nonexistent/kfd.ini"), kfd::ConfigError);
+    const auto tmp = std::filesystem::temp_directory_path() / "kfd_config_test.toml";
+    std::ofstream(tmp) << "window = 3\n";
+    EXPECT_THROW(kfd::loadConfigFile(tmp.string()), kfd::ConfigError);
+    std::filesystem::remove(tmp);
+}
+
+TEST(Config, PrintedConfigReadsBackTheSame) {
+    const auto p = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/paper-mit-0.575.ini");
+    EXPECT_EQ(kfd::toIni(fromIniText(kfd::toIni(p))), kfd::toIni(p));
+}
+
+TEST(Config, EveryKeyIsDocumented) {
+    for (const auto& k : kfd::configKeys()) {
+        EXPECT_FALSE(k.help.empty()) << k.name;
+        EXPECT_FALSE(k.range.empty()) << k.name;
+    }
+}

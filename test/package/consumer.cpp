@@ -1,0 +1,8 @@
+#include <kfd/core/window_helper.h>
+#include <kfd/mrpt/stream_filter.h>
+
+int main() {
+    kfd::StreamFilter filter;
+    const auto s = kfd::suggestWindow(0.752, 40.0, 0.985);
+    return (filter.sensorCount() == 0 && s.m_max == 8) ? 0 : 1;
+}

@@ -1,0 +1,335 @@
+// kfd-filter end to end: RawlogFilter on real rawlogs, error handling, and the CLI.
+#include <gtest/gtest.h>
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "kfd/mrpt/config.h"
+#include "kfd/mrpt/rawlog_filter.h"
+
+namespace fs = std::filesystem;
+using mrpt::obs::CObservation2DRangeScan;
+
+namespace {
+
+const std::string kSena =
+    std::string(KFD_MRPT_DATASETS_DIR) + "/2006-01ENE-21-SENA_Telecom Faculty_one_loop_only.rawlog";
+const std::string kMitCsail = std::string(KFD_DATASETS_DIR) + "/mit-csail/mit-csail.rawlog";
+
+std::vector<mrpt::serialization::CSerializable::Ptr> readAll(const std::string& path) {
+    mrpt::io::CFileGZInputStream in(path);
+    auto arch = mrpt::serialization::archiveFrom(in);
+    std::vector<mrpt::serialization::CSerializable::Ptr> v;
+    for (;;) {
+        try {
+            v.push_back(arch.ReadObject());
+        } catch (const mrpt::serialization::CExceptionEOF&) {
+            break;
+        }
+    }
+    return v;
+}
+
+std::vector<std::shared_ptr<CObservation2DRangeScan>> scansOf(
+    const std::vector<mrpt::serialization::CSerializable::Ptr>& objs) {
+    std::vector<std::shared_ptr<CObservation2DRangeScan>> scans;
+    for (const auto& o : objs) {
+        if (auto s = std::dynamic_pointer_cast<CObservation2DRangeScan>(o)) scans.push_back(s);
+        if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(o))
+            for (const auto& ob : *sf)
+                if (auto s = std::dynamic_pointer_cast<CObservation2DRangeScan>(ob))
+                    scans.push_back(s);
+    }
+    return scans;
+}
+
+mrpt::poses::CPose2D integratedOdometry(
+    const std::vector<mrpt::serialization::CSerializable::Ptr>& objs) {
+    mrpt::poses::CPose2D p;
+    for (const auto& o : objs)
+        if (auto a = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(o))
+            if (auto mv = a->getBestMovementEstimation()) p = p + mv->rawOdometryIncrementReading;
+    return p;
+}
+
+std::string fileBytes(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+struct TempDir {
+    fs::path path;
+    TempDir() {
+        path = fs::temp_directory_path() /
+               ("kfd_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~TempDir() { fs::remove_all(path); }
+    std::string operator/(const std::string& f) const { return (path / f).string(); }
+};
+
+// Checks what every filtered rawlog must satisfy against its input.
+void checkConservation(const std::string& in, const std::string& out,
+                       const kfd::RawlogFilterSummary& s) {
+    const auto objs_in = readAll(in);
+    const auto objs_out = readAll(out);
+    EXPECT_EQ(objs_in.size(), s.objects_in);
+    EXPECT_EQ(objs_out.size(), s.objects_out);
+    EXPECT_EQ(s.objects_in, s.objects_out + s.objects_dropped + s.actions_merged);
+    EXPECT_EQ(s.scans_in, s.scans_kept + s.scans_dropped);
+    const auto scans_in = scansOf(objs_in);
+    const auto scans_out = scansOf(objs_out);
+    EXPECT_EQ(scans_in.size(), s.scans_in);
+    ASSERT_EQ(scans_out.size(), s.scans_kept);
+
+    // Kept scans are a subsequence of the input (by timestamp), with the same beams and ranges;
+    // filtering only ever clears valid flags.
+    std::size_t j = 0, cleared = 0;
+    for (const auto& so : scans_out) {
+        while (j < scans_in.size() && scans_in[j]->timestamp != so->timestamp) ++j;
+        ASSERT_LT(j, scans_in.size()) << "output scan not found in the input, in order";
+        const auto& si = scans_in[j++];
+        ASSERT_EQ(so->getScanSize(), si->getScanSize());
+        EXPECT_EQ(so->aperture, si->aperture);
+        for (std::size_t i = 0; i < so->getScanSize(); ++i) {
+            ASSERT_EQ(so->getScanRange(i), si->getScanRange(i));
+            if (so->getScanRangeValidity(i)) {
+                ASSERT_TRUE(si->getScanRangeValidity(i));
+            }
+            cleared += si->getScanRangeValidity(i) && !so->getScanRangeValidity(i);
+        }
+    }
+    EXPECT_EQ(cleared, s.points_removed_range + s.points_removed_noise);
+
+    // Every non-scan observation survives, in order (observations layout).
+    std::vector<std::string> others_in, others_out;
+    for (const auto& o : objs_in)
+        if (!std::dynamic_pointer_cast<CObservation2DRangeScan>(o) &&
+            !std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(o) &&
+            !std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(o))
+            others_in.push_back(o->GetRuntimeClass()->className);
+    for (const auto& o : objs_out)
+        if (!std::dynamic_pointer_cast<CObservation2DRangeScan>(o) &&
+            !std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(o) &&
+            !std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(o))
+            others_out.push_back(o->GetRuntimeClass()->className);
+    EXPECT_EQ(others_in, others_out);
+
+    // No odometry is lost: the composed actions add up to the same motion.
+    const auto oi = integratedOdometry(objs_in), oo = integratedOdometry(objs_out);
+    EXPECT_NEAR(oi.x(), oo.x(), 1e-6);
+    EXPECT_NEAR(oi.y(), oo.y(), 1e-6);
+    EXPECT_NEAR(oi.phi(), oo.phi(), 1e-6);
+}
+
+kfd::RawlogFilterOptions optionsFor(const std::string& in, const std::string& out) {
+    kfd::RawlogFilterOptions o;
+    o.input = in;
+    o.output = out;
+    o.pipeline = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.ini");
+    return o;
+}
+
+int run(const std::string& cmd, std::string* output = nullptr) {
+    FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+    if (!p) return -1;
+    std::string text;
+    char buf[4096];
+    while (std::fgets(buf, sizeof(buf), p)) text += buf;
+    const int status = pclose(p);
+    if (output) *output = text;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+}  // namespace
+
+TEST(RawlogFilter, SenaSampleActionsLayoutConservesEverything) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing (install mrpt-common): " << kSena;
+    TempDir dir;
+    auto o = optionsFor(kSena, dir / "out.rawlog");
+    o.stats_csv = dir / "stats.csv";
+    std::size_t progress_calls = 0;
+    o.on_progress = [&](const kfd::RawlogProgress&) { ++progress_calls; };
+    o.progress_every = 50;
+    const auto s = kfd::RawlogFilter().run(o);
+    EXPECT_EQ(s.layout, "actions+sensory-frames");
+    EXPECT_EQ(s.scans_in, 225u);
+    EXPECT_GT(s.scans_dropped, 0u);
+    EXPECT_GT(s.actions_merged, 0u);  // dropped frames had odometry to carry forward
+    EXPECT_GT(progress_calls, 2u);
+    checkConservation(kSena, o.output, s);
+
+    // One CSV row per input scan, plus the header; column 4 is the keyframe flag.
+    std::ifstream csv(o.stats_csv);
+    std::size_t lines = 0, kept = 0;
+    std::string line;
+    std::getline(csv, line);
+    EXPECT_EQ(line.rfind("index,timestamp,sensor,keyframe,", 0), 0u) << line;
+    ++lines;
+    while (std::getline(csv, line)) {
+        ++lines;
+        std::stringstream fields(line);
+        std::string field;
+        for (int col = 0; col < 4; ++col) std::getline(fields, field, ',');
+        kept += field == "1";
+    }
+    EXPECT_EQ(lines, s.scans_in + 1);
+    EXPECT_EQ(kept, s.scans_kept);
+}
+
+TEST(RawlogFilter, MitCsailObservationsLayoutConservesEverything) {
+    if (!fs::exists(kMitCsail)) GTEST_SKIP() << "dataset missing: " << kMitCsail;
+    TempDir dir;
+    const auto o = optionsFor(kMitCsail, dir / "out.rawlog");
+    const auto s = kfd::RawlogFilter().run(o);
+    EXPECT_EQ(s.layout, "observations");
+    EXPECT_EQ(s.scans_in, 1988u);  // datasets/README.md
+    EXPECT_GT(s.scans_dropped, 0u);
+    EXPECT_GT(s.points_removed_noise, 0u);
+    checkConservation(kMitCsail, o.output, s);
+}
+
+TEST(RawlogFilter, OutputOpensInRawlogEdit) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    if (run("command -v rawlog-edit") != 0) GTEST_SKIP() << "rawlog-edit not installed (mrpt-apps)";
+    TempDir dir;
+    const auto o = optionsFor(kSena, dir / "out.rawlog");
+    const auto s = kfd::RawlogFilter().run(o);
+    std::string text;
+    ASSERT_EQ(run("rawlog-edit --info -i " + quoted(o.output), &text), 0) << text;
+    EXPECT_NE(text.find("Overall number of objects         : " + std::to_string(s.objects_out)),
+              std::string::npos)
+        << text;
+}
+
+TEST(RawlogFilter, TwoSensorsAndAGeometryChangeInOneLog) {
+    TempDir dir;
+    const std::string in = dir / "synthetic.rawlog";
+    {
+        mrpt::io::CFileGZOutputStream f(in);
+        auto arch = mrpt::serialization::archiveFrom(f);
+        for (int k = 0; k < 30; ++k) {
+            for (const char* label : {"FRONT", "REAR"}) {
+                CObservation2DRangeScan s;
+                s.sensorLabel = label;
+                s.timestamp = mrpt::Clock::fromDouble(1000.0 + 0.1 * k);
+                const std::size_t beams = (k >= 20 && label[0] == 'F') ? 541 : 361;
+                s.aperture = static_cast<float>(M_PI);
+                s.resizeScanAndAssign(beams, 4.0f, true);
+                arch << s;
+            }
+            mrpt::obs::CObservationOdometry odo;
+            odo.timestamp = mrpt::Clock::fromDouble(1000.0 + 0.1 * k);
+            arch << odo;
+        }
+    }
+    auto o = optionsFor(in, dir / "out.rawlog");
+    const auto s = kfd::RawlogFilter().run(o);
+    EXPECT_EQ(s.sensors, 2u);
+    EXPECT_EQ(s.geometry_resets, 1u);
+    EXPECT_EQ(s.scans_in, 60u);
+    // A first scan per sensor, plus the first scan after FRONT's geometry change.
+    EXPECT_GE(s.scans_kept, 3u);
+    checkConservation(in, o.output, s);
+}
+
+TEST(RawlogFilter, MissingInputIsAnError) {
+    TempDir dir;
+    auto o = optionsFor(dir / "nothere.rawlog", dir / "out.rawlog");
+    EXPECT_THROW(kfd::RawlogFilter().run(o), kfd::RawlogError);
+    EXPECT_FALSE(fs::exists(o.output));
+}
+
+TEST(RawlogFilter, NonRawlogInputLeavesNoOutput) {
+    TempDir dir;
+    const std::string in = dir / "notes.rawlog";
+    std::ofstream(in) << "this is not a rawlog\n";
+    auto o = optionsFor(in, dir / "out.rawlog");
+    try {
+        kfd::RawlogFilter().run(o);
+        FAIL() << "expected RawlogError";
+    } catch (const kfd::RawlogError& e) {
+        EXPECT_NE(std::string(e.what()).find("rawlog"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(o.output));
+    for (const auto& e : fs::directory_iterator(dir.path))
+        EXPECT_EQ(e.path().filename().string().find("out.rawlog"), std::string::npos)
+            << "temporary file left behind: " << e.path();
+}
+
+TEST(RawlogFilter, TruncatedInputIsAnErrorAndLeavesNoOutput) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    const std::string in = dir / "truncated.rawlog";
+    const std::string bytes = fileBytes(kSena);
+    std::ofstream(in, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+    auto o = optionsFor(in, dir / "out.rawlog");
+    EXPECT_THROW(kfd::RawlogFilter().run(o), kfd::RawlogError);
+    EXPECT_FALSE(fs::exists(o.output));
+}
+
+TEST(RawlogFilter, NeverWritesOverTheInput) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    const std::string in = dir / "in.rawlog";
+    fs::copy_file(kSena, in);
+    const std::string before = fileBytes(in);
+    auto o = optionsFor(in, in);
+    EXPECT_THROW(kfd::RawlogFilter().run(o), kfd::RawlogError);
+    EXPECT_EQ(fileBytes(in), before);
+    o.output = dir / "out.rawlog";
+    kfd::RawlogFilter().run(o);
+    EXPECT_EQ(fileBytes(in), before);
+}
+
+TEST(KfdFilterCli, HelpAndUsageErrors) {
+    std::string text;
+    EXPECT_EQ(run(quoted(KFD_FILTER_EXE) + " --help", &text), 0);
+    EXPECT_NE(text.find("--stats"), std::string::npos);
+    EXPECT_EQ(run(quoted(KFD_FILTER_EXE), &text), 2);
+    EXPECT_NE(text.find("no input"), std::string::npos) << text;
+    EXPECT_EQ(run(quoted(KFD_FILTER_EXE) + " --bogus", &text), 2);
+}
+
+TEST(KfdFilterCli, BadConfigNamesTheKeyAndFails) {
+    TempDir dir;
+    std::ofstream(dir / "bad.ini") << "[KFD]\nwindw = 3\n";
+    std::string text;
+    EXPECT_EQ(run(quoted(KFD_FILTER_EXE) + " -c " + quoted(dir / "bad.ini") + " -i " +
+                      quoted(kSena) + " -o " + quoted(dir / "out.rawlog"),
+                  &text),
+              1);
+    EXPECT_NE(text.find("windw"), std::string::npos) << text;
+    EXPECT_FALSE(fs::exists(dir / "out.rawlog"));
+}
+
+TEST(KfdFilterCli, FiltersAndPrintsASummary) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    std::string text;
+    ASSERT_EQ(
+        run(quoted(KFD_FILTER_EXE) + " -c " + quoted(std::string(KFD_SHARE_DIR) + "/default.ini") +
+                " -i " + quoted(kSena) + " -o " + quoted(dir / "out.rawlog"),
+            &text),
+        0)
+        << text;
+    EXPECT_NE(text.find("scans    in 225"), std::string::npos) << text;
+    EXPECT_TRUE(fs::exists(dir / "out.rawlog"));
+}
