@@ -23,12 +23,23 @@ bool DenoiseStage::filter(Scan& scan, ScanReport& report) {
     return true;
 }
 
+bool MotionStage::filter(Scan& scan, ScanReport&) {
+    return algo_.keep(scan.timestamp, scan.odometry);
+}
+
+bool DbscanStage::filter(Scan& scan, ScanReport& report) {
+    report.dbscan = algo_.filter(scan);
+    return true;
+}
+
 void Pipeline::initialize(const Params& p) {
     // Validate every stage's parameters, listed or not, so a bad value in a config file is
     // reported even while its stage is switched off.
     DistanceFilter{p.distance};
     KeyframeSelector{p.keyframe};
     Denoiser{p.denoise};
+    MotionFilter{p.motion};
+    DbscanFilter{p.dbscan};
     std::vector<std::unique_ptr<ScanFilter>> stages;
     for (const auto& name : p.stages) {
         for (const auto& s : stages)
@@ -46,9 +57,17 @@ void Pipeline::initialize(const Params& p) {
             auto s = std::make_unique<DenoiseStage>();
             s->initialize(p.denoise);
             stages.push_back(std::move(s));
+        } else if (name == "motion") {
+            auto s = std::make_unique<MotionStage>();
+            s->initialize(p.motion);
+            stages.push_back(std::move(s));
+        } else if (name == "dbscan") {
+            auto s = std::make_unique<DbscanStage>();
+            s->initialize(p.dbscan);
+            stages.push_back(std::move(s));
         } else {
             throw std::invalid_argument("pipeline: unknown stage '" + name +
-                                        "' (known: distance, keyframe, denoise)");
+                                        "' (known: distance, keyframe, denoise, motion, dbscan)");
         }
     }
     stages_ = std::move(stages);

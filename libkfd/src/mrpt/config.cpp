@@ -84,7 +84,8 @@ Key integer(const std::string& name, const std::string& help, double lo, double 
 std::vector<Key> buildKeys() {
     using P = Pipeline::Params;
     std::vector<Key> k;
-    k.push_back(Key{{"pipeline", "stages in order, comma separated", "distance, keyframe, denoise"},
+    k.push_back(Key{{"pipeline", "stages in order, comma separated",
+                     "distance, keyframe, denoise, motion, dbscan"},
                     [](P& p, const std::string& text) {
                         std::vector<std::string> stages;
                         std::stringstream ss(text);
@@ -92,10 +93,11 @@ std::vector<Key> buildKeys() {
                         while (std::getline(ss, item, ',')) {
                             item = trim(item);
                             if (item.empty()) continue;
-                            if (item != "distance" && item != "keyframe" && item != "denoise")
+                            if (item != "distance" && item != "keyframe" && item != "denoise" &&
+                                item != "motion" && item != "dbscan")
                                 throw ConfigError("pipeline", "unknown stage '" + item +
                                                                   "' (known: distance, keyframe, "
-                                                                  "denoise)");
+                                                                  "denoise, motion, dbscan)");
                             for (const auto& s : stages)
                                 if (s == item)
                                     throw ConfigError("pipeline", "stage '" + item + "' repeated");
@@ -163,6 +165,17 @@ std::vector<Key> buildKeys() {
                      [](P& p) -> double& { return p.denoise.min_object_size_m; }));
     k.push_back(integer("min_points_floor", "range_aware: fewest points a kept cluster may have", 1,
                         1e6, [](P& p) -> std::size_t& { return p.denoise.min_points_floor; }));
+    // Baselines
+    k.push_back(real("motion_distance_m", "motion stage: keep after D metres of odometry (0 = off)",
+                     0, 1e6, false, [](P& p) -> double& { return p.motion.max_distance_m; }));
+    k.push_back(real("motion_angle_deg", "motion stage: keep after A degrees of odometry (0 = off)",
+                     0, 360, false, [](P& p) -> double& { return p.motion.max_angle_deg; }));
+    k.push_back(real("motion_interval_s", "motion stage: keep after T seconds (0 = off)", 0, 1e9,
+                     false, [](P& p) -> double& { return p.motion.max_interval_s; }));
+    k.push_back(real("dbscan_eps_m", "dbscan stage: neighbourhood radius Eps (m)", 0, 100, true,
+                     [](P& p) -> double& { return p.dbscan.eps_m; }));
+    k.push_back(integer("dbscan_min_pts", "dbscan stage: minPts (the point itself included)", 1,
+                        1e6, [](P& p) -> std::size_t& { return p.dbscan.min_pts; }));
     return k;
 }
 

@@ -5,9 +5,11 @@
 #include <string>
 #include <vector>
 
+#include "kfd/core/dbscan.h"
 #include "kfd/core/denoiser.h"
 #include "kfd/core/distance_filter.h"
 #include "kfd/core/keyframe_selector.h"
+#include "kfd/core/motion_filter.h"
 #include "kfd/core/scan.h"
 
 namespace kfd {
@@ -21,9 +23,10 @@ struct ScanReport {
     DistanceFilter::Result distance;
     KeyframeDecision keyframe;
     Denoiser::Result denoise;
-    std::size_t points_in = 0;   // valid beams on input
-    std::size_t points_out = 0;  // valid beams on output
-    double microseconds = 0.0;   // wall time spent in the chain
+    DbscanFilter::Result dbscan;  // when the dbscan stage ran
+    std::size_t points_in = 0;    // valid beams on input
+    std::size_t points_out = 0;   // valid beams on output
+    double microseconds = 0.0;    // wall time spent in the chain
 };
 
 /// One stage of the chain, as in mp2p_icp's filter pipelines: configured once, then called for
@@ -72,14 +75,40 @@ class DenoiseStage : public ScanFilter {
     Denoiser algo_;
 };
 
+/// The odometry motion filter (baseline) as a stage. Drops scans taken before enough motion.
+class MotionStage : public ScanFilter {
+  public:
+    void initialize(const MotionFilter::Params& p) { algo_.initialize(p); }
+    const char* name() const override { return "motion"; }
+    bool filter(Scan& scan, ScanReport& report) override;
+    void reset() override { algo_.reset(); }
+
+  private:
+    MotionFilter algo_;
+};
+
+/// DBSCAN denoise (baseline) as a stage. Never drops a scan; invalidates noise points.
+class DbscanStage : public ScanFilter {
+  public:
+    void initialize(const DbscanFilter::Params& p) { algo_.initialize(p); }
+    const char* name() const override { return "dbscan"; }
+    bool filter(Scan& scan, ScanReport& report) override;
+
+  private:
+    DbscanFilter algo_;
+};
+
 class Pipeline {
   public:
     struct Params {
-        /// Stage names in order; known: "distance", "keyframe", "denoise". Each at most once.
+        /// Stage names in order, each at most once. kfd's: "distance", "keyframe", "denoise";
+        /// baselines: "motion" (odometry motion filter), "dbscan" (DBSCAN denoise).
         std::vector<std::string> stages{"distance", "keyframe", "denoise"};
         DistanceFilter::Params distance;
         KeyframeSelector::Params keyframe;
         Denoiser::Params denoise;
+        MotionFilter::Params motion;
+        DbscanFilter::Params dbscan;
     };
 
     Pipeline() { initialize(Params{}); }

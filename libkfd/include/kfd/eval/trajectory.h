@@ -1,0 +1,45 @@
+// Stamped 2D trajectories: SE(2) helpers, TUM file I/O and lookup by timestamp. std only.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "kfd/core/scan.h"
+
+namespace kfd {
+
+/// A file that cannot be read or parsed (path and line in the message).
+class EvalError : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+struct StampedPose {
+    double t = 0.0;  // s
+    Pose2D pose;
+};
+using Trajectory = std::vector<StampedPose>;
+
+/// a (+) b: b expressed in a's frame, composed onto a.
+Pose2D compose(const Pose2D& a, const Pose2D& b);
+/// The inverse transform of a.
+Pose2D inverse(const Pose2D& a);
+/// b in the frame of a: inverse(a) (+) b.
+Pose2D between(const Pose2D& a, const Pose2D& b);
+/// Wraps an angle into (-pi, pi].
+double wrapAngle(double a);
+
+/// TUM format: one "t x y z qx qy qz qw" line per pose ('#' comments allowed); the yaw is read
+/// from the quaternion. Throws EvalError with the line number on malformed input.
+Trajectory readTum(const std::string& path);
+void writeTum(const std::string& path, const Trajectory& traj);
+
+/// Index of the pose whose stamp is nearest to t, if within max_dt (s). The trajectory must be
+/// sorted by time (see sortByTime).
+std::optional<std::size_t> nearest(const Trajectory& traj, double t, double max_dt);
+void sortByTime(Trajectory& traj);
+
+}  // namespace kfd

@@ -1,0 +1,89 @@
+// ICP-SLAM over a rawlog with a kfd pre-filter in front (the paper's Figure 1).
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "kfd/core/pipeline.h"
+#include "kfd/eval/relations.h"
+
+namespace kfd {
+
+/// How scans are pre-filtered before scan matching.
+enum class PrefilterMode {
+    None,      // plain ICP-SLAM, identical to MRPT's icp-slam
+    Odometry,  // drop by travelled distance/angle (motion stage), a baseline
+    Keyframe,  // keyframe extraction only (distance + keyframe stages)
+    Kfd,       // the full method: the [KFD] pipeline (distance, keyframe, denoise)
+    Dbscan,    // the paper's comparison: DBSCAN denoise of every scan (distance + dbscan)
+};
+const char* toString(PrefilterMode m);
+/// "none", "odometry", "keyframe", "kfd", "dbscan"; std::invalid_argument otherwise.
+PrefilterMode parsePrefilterMode(const std::string& s);
+
+/// The pipeline a mode runs, built from the [KFD] parameters.
+Pipeline::Params pipelineForMode(PrefilterMode mode, const Pipeline::Params& kfd);
+
+struct IcpSlamProgress {
+    std::size_t entries = 0, scans_in = 0, scans_kept = 0;
+    double fraction = 0.0;  // of the input file consumed
+};
+
+struct IcpSlamOptions {
+    std::string config_file;  // icp-slam .ini: [ICP], [MappingApplication], maps, optional [KFD]
+    std::string rawlog;       // empty: [MappingApplication] rawlog_file
+    std::string output_dir;   // empty: [MappingApplication] logOutput_dir
+    PrefilterMode mode = PrefilterMode::Kfd;
+    /// Odometry mode only: choose the motion thresholds (distance D, angle 30 deg/m x D) so
+    /// that this percentage of scans is dropped (e.g. kfd's drop rate on the same log).
+    std::optional<double> odometry_target_drop_pct;
+    std::string relations;           // ground truth (.relations), optional
+    double relations_max_dt = 1e-3;  // s, stamp matching tolerance
+    bool write_map = true;           // .simplemap and occupancy-grid PNG
+    std::function<void(const IcpSlamProgress&)> on_progress;
+};
+
+struct IcpSlamSummary {
+    PrefilterMode mode = PrefilterMode::Kfd;
+    std::string rawlog, output_dir;
+    std::size_t entries = 0;
+    std::size_t scans_in = 0, scans_kept = 0;
+    double dropped_pct = 0.0;
+    std::size_t points_in = 0, points_removed = 0;
+    double prefilter_us_per_scan = 0.0;  // mean over input scans
+    double icp_ms_per_scan = 0.0;        // map-builder time / input scans
+    double icp_ms_per_kept_scan = 0.0;   // map-builder time / kept scans
+    double cpu_s_total = 0.0;            // process CPU time of the run (I/O included)
+    double wall_s_total = 0.0;
+    Pipeline::Params pipeline;  // what ran
+    std::optional<RelationsError> relations;
+    std::string relations_file;
+};
+
+/// Bad input, configuration or output (message says which).
+class SlamError : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+/// Runs CMetricMapBuilderICP over a rawlog exactly like MRPT's icp-slam (same config sections,
+/// same call sequence), with the pre-filter deciding which scans reach scan matching. A dropped
+/// scan in an actions+sensory-frames log is removed from its frame and the frame's odometry
+/// action is still processed; in an observations log the scan is skipped and odometry
+/// observations are still processed. Every input scan gets a pose (the map builder's estimate,
+/// propagated with odometry for dropped scans).
+///
+/// Writes into the output folder: trajectory.tum (one pose per input scan, TUM format),
+/// log_estimated_path.txt (icp-slam's "step x y phi", one per rawlog entry), scans.csv,
+/// summary.json, and with write_map final_map.simplemap and map.png (occupancy grid).
+class IcpSlamRunner {
+  public:
+    IcpSlamSummary run(const IcpSlamOptions& opts);
+};
+
+/// summary.json's text.
+std::string toJson(const IcpSlamSummary& s);
+
+}  // namespace kfd

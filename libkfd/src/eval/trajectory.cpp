@@ -1,0 +1,78 @@
+#include "kfd/eval/trajectory.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+namespace kfd {
+
+Pose2D compose(const Pose2D& a, const Pose2D& b) {
+    const double c = std::cos(a.phi), s = std::sin(a.phi);
+    return Pose2D{a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, wrapAngle(a.phi + b.phi)};
+}
+
+Pose2D inverse(const Pose2D& a) {
+    const double c = std::cos(a.phi), s = std::sin(a.phi);
+    return Pose2D{-c * a.x - s * a.y, s * a.x - c * a.y, wrapAngle(-a.phi)};
+}
+
+Pose2D between(const Pose2D& a, const Pose2D& b) { return compose(inverse(a), b); }
+
+double wrapAngle(double a) {
+    a = std::remainder(a, 2.0 * kPi);
+    return a <= -kPi ? a + 2.0 * kPi : a;
+}
+
+Trajectory readTum(const std::string& path) {
+    std::ifstream f(path);
+    if (!f) throw EvalError("cannot open trajectory " + path);
+    Trajectory traj;
+    std::string line;
+    std::size_t lineno = 0;
+    while (std::getline(f, line)) {
+        ++lineno;
+        const auto b = line.find_first_not_of(" \t\r");
+        if (b == std::string::npos || line[b] == '#') continue;
+        std::istringstream ss(line);
+        double t, x, y, z, qx, qy, qz, qw;
+        if (!(ss >> t >> x >> y >> z >> qx >> qy >> qz >> qw))
+            throw EvalError(path + ":" + std::to_string(lineno) +
+                            ": expected 't x y z qx qy qz qw'");
+        const double yaw = std::atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz));
+        traj.push_back(StampedPose{t, Pose2D{x, y, yaw}});
+    }
+    return traj;
+}
+
+void writeTum(const std::string& path, const Trajectory& traj) {
+    std::ofstream f(path);
+    if (!f) throw EvalError("cannot write trajectory " + path);
+    f << "# timestamp x y z qx qy qz qw\n";
+    char buf[256];
+    for (const auto& p : traj) {
+        std::snprintf(buf, sizeof(buf), "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", p.t, p.pose.x, p.pose.y,
+                      std::sin(0.5 * p.pose.phi), std::cos(0.5 * p.pose.phi));
+        f << buf;
+    }
+    if (!f) throw EvalError("failed writing " + path);
+}
+
+std::optional<std::size_t> nearest(const Trajectory& traj, double t, double max_dt) {
+    if (traj.empty()) return std::nullopt;
+    const auto it = std::lower_bound(traj.begin(), traj.end(), t,
+                                     [](const StampedPose& p, double v) { return p.t < v; });
+    std::size_t best = static_cast<std::size_t>(it - traj.begin());
+    if (best == traj.size()) best = traj.size() - 1;
+    if (best > 0 && std::abs(traj[best - 1].t - t) <= std::abs(traj[best].t - t)) --best;
+    if (std::abs(traj[best].t - t) > max_dt) return std::nullopt;
+    return best;
+}
+
+void sortByTime(Trajectory& traj) {
+    std::stable_sort(traj.begin(), traj.end(),
+                     [](const StampedPose& a, const StampedPose& b) { return a.t < b.t; });
+}
+
+}  // namespace kfd
