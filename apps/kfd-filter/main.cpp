@@ -1,13 +1,12 @@
 // kfd-filter: keyframe extraction + clustering denoise of every 2D scan of a rawlog.
 // All logic lives in kfd::RawlogFilter; this file parses arguments and reports.
-#include <unistd.h>
-
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <string>
 
+#include "common/progress.h"
 #include "kfd/core/window_helper.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/rawlog_filter.h"
@@ -149,29 +148,18 @@ int main(int argc, char** argv) {
     if (opts.input.empty()) return usageError("no input rawlog (-i)");
     if (opts.output.empty()) return usageError("no output rawlog (-o)");
 
-    const bool tty = isatty(fileno(stderr));
-    int last_decile = -1;
+    kfd::app::ProgressPrinter progress("kfd-filter");
     if (!quiet) {
         opts.on_progress = [&](const kfd::RawlogProgress& p) {
-            const double frac =
-                p.bytes_total ? static_cast<double>(p.bytes_read) / p.bytes_total : 0.0;
-            const int pct = static_cast<int>(100.0 * std::min(1.0, frac));
-            if (tty) {
-                std::fprintf(stderr, "\r[kfd-filter] %3d%%  %zu scans, %zu kept", pct, p.scans_in,
-                             p.scans_kept);
-                if (pct >= 100) std::fputc('\n', stderr);
-            } else if (pct / 10 != last_decile) {
-                last_decile = pct / 10;
-                std::fprintf(stderr, "[kfd-filter] %3d%%  %zu scans, %zu kept\n", pct, p.scans_in,
-                             p.scans_kept);
-            }
+            progress.update(p.bytes_total ? static_cast<double>(p.bytes_read) / p.bytes_total : 0.0,
+                            p.scans_in, p.scans_kept);
         };
     }
     try {
         const auto summary = kfd::RawlogFilter().run(opts);
         printSummary(opts, summary);
     } catch (const std::exception& e) {
-        if (tty && !quiet) std::fputc('\n', stderr);
+        if (!quiet) progress.abort();
         std::fprintf(stderr, "kfd-filter: %s\n", e.what());
         return 1;
     }

@@ -1,11 +1,10 @@
 // kfd-icp-slam: MRPT ICP-SLAM over a rawlog with the kfd pre-filter in front.
 // All logic lives in kfd::IcpSlamRunner; this file parses arguments and reports.
-#include <unistd.h>
-
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
+#include "common/progress.h"
 #include "kfd/slam/icp_slam_runner.h"
 
 namespace {
@@ -91,20 +90,10 @@ int main(int argc, char** argv) {
     if (o.odometry_target_drop_pct && o.mode != kfd::PrefilterMode::Odometry)
         return usageError("--match-drop applies to --mode odometry only");
 
-    const bool tty = isatty(fileno(stderr));
-    int last_decile = -1;
+    kfd::app::ProgressPrinter progress("kfd-icp-slam");
     if (!quiet) {
         o.on_progress = [&](const kfd::IcpSlamProgress& p) {
-            const int pct = static_cast<int>(100.0 * std::min(1.0, p.fraction));
-            if (tty) {
-                std::fprintf(stderr, "\r[kfd-icp-slam] %3d%%  %zu scans, %zu kept", pct, p.scans_in,
-                             p.scans_kept);
-                if (pct >= 100) std::fputc('\n', stderr);
-            } else if (pct / 10 != last_decile) {
-                last_decile = pct / 10;
-                std::fprintf(stderr, "[kfd-icp-slam] %3d%%  %zu scans, %zu kept\n", pct, p.scans_in,
-                             p.scans_kept);
-            }
+            progress.update(p.fraction, p.scans_in, p.scans_kept);
         };
     }
     try {
@@ -126,7 +115,7 @@ int main(int argc, char** argv) {
                 r.used, r.unmatched, r.trans_mean, r.trans_std, r.rot_mean_deg, r.rot_std_deg);
         }
     } catch (const std::exception& e) {
-        if (tty && !quiet) std::fputc('\n', stderr);
+        if (!quiet) progress.abort();
         std::fprintf(stderr, "kfd-icp-slam: %s\n", e.what());
         return 1;
     }

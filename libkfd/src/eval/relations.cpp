@@ -1,8 +1,6 @@
 #include "kfd/eval/relations.h"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 namespace kfd {
 namespace {
@@ -26,23 +24,11 @@ struct Stats {
 }  // namespace
 
 std::vector<Relation> readRelations(const std::string& path) {
-    std::ifstream f(path);
-    if (!f) throw EvalError("cannot open relations file " + path);
     std::vector<Relation> rel;
-    std::string line;
-    std::size_t lineno = 0;
-    while (std::getline(f, line)) {
-        ++lineno;
-        const auto b = line.find_first_not_of(" \t\r");
-        if (b == std::string::npos || line[b] == '#') continue;
-        std::istringstream ss(line);
-        Relation r;
-        double z, roll, pitch;
-        if (!(ss >> r.t1 >> r.t2 >> r.delta.x >> r.delta.y >> z >> roll >> pitch >> r.delta.phi))
-            throw EvalError(path + ":" + std::to_string(lineno) +
-                            ": expected 't1 t2 x y z roll pitch yaw'");
-        rel.push_back(r);
-    }
+    // t1 t2 x y z roll pitch yaw (z, roll, pitch are 0 in 2D benchmarks)
+    readNumericRows(path, "relations file", 8, "t1 t2 x y z roll pitch yaw", [&](const double* v) {
+        rel.push_back(Relation{v[0], v[1], {v[2], v[3], v[7]}});
+    });
     return rel;
 }
 

@@ -25,10 +25,11 @@ double wrapAngle(double a) {
     return a <= -kPi ? a + 2.0 * kPi : a;
 }
 
-Trajectory readTum(const std::string& path) {
+void readNumericRows(const std::string& path, const std::string& what, std::size_t n,
+                     const std::string& expected, const std::function<void(const double*)>& row) {
     std::ifstream f(path);
-    if (!f) throw EvalError("cannot open trajectory " + path);
-    Trajectory traj;
+    if (!f) throw EvalError("cannot open " + what + " " + path);
+    std::vector<double> v(n);
     std::string line;
     std::size_t lineno = 0;
     while (std::getline(f, line)) {
@@ -36,13 +37,21 @@ Trajectory readTum(const std::string& path) {
         const auto b = line.find_first_not_of(" \t\r");
         if (b == std::string::npos || line[b] == '#') continue;
         std::istringstream ss(line);
-        double t, x, y, z, qx, qy, qz, qw;
-        if (!(ss >> t >> x >> y >> z >> qx >> qy >> qz >> qw))
-            throw EvalError(path + ":" + std::to_string(lineno) +
-                            ": expected 't x y z qx qy qz qw'");
-        const double yaw = std::atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz));
-        traj.push_back(StampedPose{t, Pose2D{x, y, yaw}});
+        for (auto& x : v)
+            if (!(ss >> x))
+                throw EvalError(path + ":" + std::to_string(lineno) + ": expected '" + expected +
+                                "'");
+        row(v.data());
     }
+}
+
+Trajectory readTum(const std::string& path) {
+    Trajectory traj;
+    readNumericRows(path, "trajectory", 8, "t x y z qx qy qz qw", [&](const double* v) {
+        const double qx = v[4], qy = v[5], qz = v[6], qw = v[7];
+        const double yaw = std::atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz));
+        traj.push_back(StampedPose{v[0], Pose2D{v[1], v[2], yaw}});
+    });
     return traj;
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -36,6 +37,12 @@ double wrapAngle(double a);
 /// from the quaternion. Throws EvalError with the line number on malformed input.
 Trajectory readTum(const std::string& path);
 void writeTum(const std::string& path, const Trajectory& traj);
+
+/// Reads the data lines of a text file (blank lines and '#' comments skipped) as `n` numbers
+/// each and calls `row(values)` for every one. `what` names the file kind in errors; a line with
+/// fewer than n numbers throws EvalError naming path and line ("path:line: expected ...").
+void readNumericRows(const std::string& path, const std::string& what, std::size_t n,
+                     const std::string& expected, const std::function<void(const double*)>& row);
 
 /// Index of the pose whose stamp is nearest to t, if within max_dt (s). The trajectory must be
 /// sorted by time (see sortByTime).
