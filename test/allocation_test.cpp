@@ -128,3 +128,26 @@ TEST(Allocation, StreamFilterAllocatesNothingInSteadyState) {
     }
     EXPECT_EQ(allocations, 0u);
 }
+
+TEST(Allocation, RadiusAndSorStagesAllocateNothingInSteadyState) {
+    for (const char* stage : {"radius", "sor"}) {
+        SCOPED_TRACE(stage);
+        kfd::Pipeline::Params p;
+        p.stages = {"distance", stage};
+        kfd::Pipeline pipe(p);
+        const auto scans = randomScans(20, 1081, 13);
+        std::vector<kfd::Scan> work = scans;
+        std::size_t removed = 0;
+        for (auto& s : work) {  // warm-up: buffers grow to their final size
+            const auto r = pipe.process(s);
+            removed += r.radius.points_removed + r.sor.points_removed;
+        }
+        EXPECT_GT(removed, 0u);
+        work = scans;
+        g_allocations = 0;
+        g_counting = true;
+        for (auto& s : work) pipe.process(s);
+        g_counting = false;
+        EXPECT_EQ(g_allocations.load(), 0u);
+    }
+}

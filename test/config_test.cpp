@@ -5,6 +5,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "kfd/mrpt/config.h"
 
@@ -150,4 +152,74 @@ TEST(Config, EveryKeyIsDocumented) {
         EXPECT_FALSE(k.help.empty()) << k.name;
         EXPECT_FALSE(k.range.empty()) << k.name;
     }
+}
+
+TEST(Config, RadiusAndSorKeysLoadAndAreRangeChecked) {
+    // Built-in defaults when absent.
+    const auto d = fromIniText("[KFD]\nwindow = 2\n");
+    EXPECT_EQ(d.radius.radius_m, 0.3);
+    EXPECT_EQ(d.radius.min_neighbors, 3u);
+    EXPECT_EQ(d.sor.k, 8u);
+    EXPECT_EQ(d.sor.std_mul, 1.0);
+
+    const auto p = fromIniText(
+        "[KFD]\npipeline = distance, radius, sor\nradius_m = 0.45\nradius_min_neighbors = 5\n"
+        "sor_k = 12\nsor_std_mul = 2.5\n");
+    EXPECT_EQ(p.stages, (std::vector<std::string>{"distance", "radius", "sor"}));
+    EXPECT_DOUBLE_EQ(p.radius.radius_m, 0.45);
+    EXPECT_EQ(p.radius.min_neighbors, 5u);
+    EXPECT_EQ(p.sor.k, 12u);
+    EXPECT_DOUBLE_EQ(p.sor.std_mul, 2.5);
+    EXPECT_EQ(kfd::toIni(fromIniText(kfd::toIni(p))), kfd::toIni(p));  // printed and read back
+    EXPECT_NE(kfd::toIni(p).find("radius_min_neighbors = 5"), std::string::npos);
+
+    auto yml = mrpt::containers::yaml::FromText(
+        "kfd:\n  pipeline: [distance, sor]\n  sor_k: 4\n  sor_std_mul: 0\n  radius_m: 1\n");
+    const auto y = kfd::loadYaml(yml);
+    EXPECT_EQ(y.stages, (std::vector<std::string>{"distance", "sor"}));
+    EXPECT_EQ(y.sor.k, 4u);
+    EXPECT_EQ(y.sor.std_mul, 0.0);
+    EXPECT_EQ(y.radius.radius_m, 1.0);
+
+    // Limits are inclusive where documented.
+    EXPECT_NO_THROW(fromIniText("[KFD]\nradius_m = 100\nradius_min_neighbors = 1\n"));
+    EXPECT_NO_THROW(fromIniText("[KFD]\nsor_k = 1\nsor_std_mul = 0\n"));
+    EXPECT_NO_THROW(fromIniText("[KFD]\nsor_k = 1000\nsor_std_mul = 100\n"));
+
+    EXPECT_EQ(errorKey("[KFD]\nradius_m = 0\n"), "radius_m");
+    EXPECT_EQ(errorKey("[KFD]\nradius_m = -0.3\n"), "radius_m");
+    EXPECT_EQ(errorKey("[KFD]\nradius_m = 100.5\n"), "radius_m");
+    EXPECT_EQ(errorKey("[KFD]\nradius_m = wide\n"), "radius_m");
+    EXPECT_EQ(errorKey("[KFD]\nradius_min_neighbors = 0\n"), "radius_min_neighbors");
+    EXPECT_EQ(errorKey("[KFD]\nradius_min_neighbors = 2.5\n"), "radius_min_neighbors");
+    EXPECT_EQ(errorKey("[KFD]\nsor_k = 0\n"), "sor_k");
+    EXPECT_EQ(errorKey("[KFD]\nsor_k = 1001\n"), "sor_k");
+    EXPECT_EQ(errorKey("[KFD]\nsor_k = 3.5\n"), "sor_k");
+    EXPECT_EQ(errorKey("[KFD]\nsor_std_mul = -0.1\n"), "sor_std_mul");
+    EXPECT_EQ(errorKey("[KFD]\nsor_std_mul = 100.5\n"), "sor_std_mul");
+    EXPECT_EQ(errorKey("[KFD]\npipeline = radius, sor, radius\n"), "pipeline");
+    EXPECT_EQ(errorKey("[KFD]\npipeline = distance, pcl\n"), "pipeline");
+    try {
+        fromIniText("[KFD]\npipeline = distance, pcl\n");
+        FAIL();
+    } catch (const kfd::ConfigError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("radius"), std::string::npos) << what;
+        EXPECT_NE(what.find("sor"), std::string::npos) << what;
+    }
+
+    // Listed with units in their help texts, and the pipeline key lists the new stages.
+    std::size_t found = 0;
+    for (const auto& k : kfd::configKeys()) {
+        if (k.name == "radius_m" || k.name == "radius_min_neighbors" || k.name == "sor_k" ||
+            k.name == "sor_std_mul") {
+            ++found;
+            EXPECT_NE(k.help.find('('), std::string::npos) << k.name << ": " << k.help;
+        }
+        if (k.name == "pipeline") {
+            EXPECT_NE(k.range.find("radius"), std::string::npos) << k.range;
+            EXPECT_NE(k.range.find("sor"), std::string::npos) << k.range;
+        }
+    }
+    EXPECT_EQ(found, 4u);
 }

@@ -467,3 +467,29 @@ TEST(DbscanFilter, MatchesPlainDbscanOnRandomScans) {
 
 }  // namespace
 }  // namespace kfd
+
+namespace kfd {
+namespace {
+
+TEST(DbscanFilter, ValidBeamsWithoutAFiniteRangeAreNoise) {
+    // Without the distance stage in front, a NaN or inf range flagged valid has no position;
+    // it is removed instead of entering the k-d tree.
+    Scan scan = test::emptyScan(181, kPi);
+    for (std::size_t i = 40; i <= 140; ++i) {
+        scan.range[i] = 2.0f;
+        scan.valid[i] = 1;
+    }
+    scan.range[90] = std::numeric_limits<float>::quiet_NaN();
+    scan.range[91] = std::numeric_limits<float>::infinity();
+    DbscanFilter f;
+    const auto r = f.filter(scan);
+    EXPECT_EQ(r.points_in, 101u);
+    EXPECT_EQ(r.points_removed, 2u);
+    EXPECT_FALSE(scan.valid[90]);
+    EXPECT_FALSE(scan.valid[91]);
+    EXPECT_TRUE(scan.valid[89]);
+    EXPECT_TRUE(scan.valid[92]);
+}
+
+}  // namespace
+}  // namespace kfd

@@ -204,3 +204,62 @@ TEST(KfdIcpSlamCli, UsageErrorsAndHelp) {
     EXPECT_EQ(run("x.ini --mode fast"), 2);
     EXPECT_EQ(run("/nonexistent.ini"), 1);
 }
+
+TEST(IcpSlamRunner, RadiusAndSorModesParseAndMapToPipelines) {
+    EXPECT_EQ(kfd::parsePrefilterMode("radius"), kfd::PrefilterMode::Radius);
+    EXPECT_EQ(kfd::parsePrefilterMode("sor"), kfd::PrefilterMode::Sor);
+    EXPECT_STREQ(kfd::toString(kfd::PrefilterMode::Radius), "radius");
+    EXPECT_STREQ(kfd::toString(kfd::PrefilterMode::Sor), "sor");
+    EXPECT_THROW(kfd::parsePrefilterMode("Radius"), std::invalid_argument);
+    EXPECT_THROW(kfd::parsePrefilterMode("statistical"), std::invalid_argument);
+    try {
+        kfd::parsePrefilterMode("fast");
+        FAIL();
+    } catch (const std::invalid_argument& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("radius"), std::string::npos) << what;
+        EXPECT_NE(what.find("sor"), std::string::npos) << what;
+    }
+    kfd::Pipeline::Params p;  // the [KFD] parameters carry over into the modes
+    p.radius.radius_m = 0.5;
+    p.sor.k = 5;
+    const auto radius = kfd::pipelineForMode(kfd::PrefilterMode::Radius, p);
+    EXPECT_EQ(radius.stages, (std::vector<std::string>{"distance", "radius"}));
+    EXPECT_EQ(radius.radius.radius_m, 0.5);
+    const auto sor = kfd::pipelineForMode(kfd::PrefilterMode::Sor, p);
+    EXPECT_EQ(sor.stages, (std::vector<std::string>{"distance", "sor"}));
+    EXPECT_EQ(sor.sor.k, 5u);
+    EXPECT_EQ(kfd::Pipeline(radius).stages().size(), 2u);  // both build
+    EXPECT_EQ(kfd::Pipeline(sor).stages().size(), 2u);
+    // The command line accepts them: a missing config is bad input (1), not bad usage (2).
+    auto run = [](const std::string& args) {
+        const std::string cmd =
+            std::string("'") + KFD_ICP_SLAM_EXE + "' " + args + " > /dev/null 2>&1";
+        const int st = std::system(cmd.c_str());
+        return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    };
+    EXPECT_EQ(run("/nonexistent.ini --mode radius"), 1);
+    EXPECT_EQ(run("/nonexistent.ini --mode sor"), 1);
+    EXPECT_EQ(run("/nonexistent.ini --mode rad"), 2);
+}
+
+TEST(IcpSlamRunner, RadiusAndSorModesRunAndKeepEveryScan) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    for (auto mode : {kfd::PrefilterMode::Radius, kfd::PrefilterMode::Sor}) {
+        SCOPED_TRACE(kfd::toString(mode));
+        auto o = options(kSena, dir / kfd::toString(mode), mode);
+        o.write_map = false;
+        const auto s = kfd::IcpSlamRunner().run(o);
+        EXPECT_EQ(s.scans_in, 224u);
+        EXPECT_EQ(s.scans_kept, s.scans_in);  // denoisers never drop scans
+        // Out-of-range and noise removals together (the noise alone is checked in
+        // rawlog_filter_test's BaselineDenoisersCountTheirNoise).
+        EXPECT_GT(s.points_removed, 0u);
+        EXPECT_LT(s.points_removed, s.points_in / 2);
+        EXPECT_EQ(s.pipeline.stages, (std::vector<std::string>{"distance", kfd::toString(mode)}));
+        const std::string json = text(dir / (std::string(kfd::toString(mode)) + "/summary.json"));
+        EXPECT_NE(json.find(std::string("\"mode\": \"") + kfd::toString(mode) + "\""),
+                  std::string::npos);
+    }
+}

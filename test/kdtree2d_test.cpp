@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -281,6 +282,154 @@ TEST(KdTree2D, OutputIsClearedFirst) {
     out.assign(4, 9);
     t.radius(0.0f, 0.0f, 0.5f, out);
     EXPECT_EQ(out, Indices{0});
+}
+
+// --- k nearest neighbours ---------------------------------------------------------------------
+
+struct Knn {
+    Indices idx;
+    std::vector<float> dist2;
+};
+
+/// The min(k, n) points nearest to (qx, qy) by exhaustive search: squared distances in float as
+/// the tree computes them, ordered by (distance, index).
+Knn bruteKnn(const Cloud& c, float qx, float qy, std::size_t k) {
+    std::vector<std::pair<float, std::uint32_t>> all;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+        const float dx = c.x[i] - qx, dy = c.y[i] - qy;
+        all.emplace_back(dx * dx + dy * dy, static_cast<std::uint32_t>(i));
+    }
+    std::sort(all.begin(), all.end());
+    Knn out;
+    for (std::size_t i = 0; i < std::min(k, all.size()); ++i) {
+        out.dist2.push_back(all[i].first);
+        out.idx.push_back(all[i].second);
+    }
+    return out;
+}
+
+Knn treeKnn(const KdTree2D& t, float qx, float qy, std::size_t k) {
+    Knn out;
+    out.idx = {12345u, 7u};  // must be cleared by the query
+    out.dist2 = {-1.0f};
+    t.knn(qx, qy, k, out.idx, out.dist2);
+    return out;
+}
+
+/// Compares knn with the brute force for the given queries and every k in `ks` (one exhaustive
+/// sort per query, sliced for each k). Counts the queries where the k-th and (k+1)-th nearest
+/// are equally far (the index tie-break decides), so callers can check that ties are exercised.
+void compareKnn(const KdTree2D& t, const Cloud& c, const std::vector<std::vector<float>>& queries,
+                const std::vector<std::size_t>& ks, const std::string& what,
+                std::size_t& boundaryTies) {
+    for (const auto& q : queries) {
+        const Knn all = bruteKnn(c, q[0], q[1], c.size());
+        for (const std::size_t k : ks) {
+            const std::size_t kept = std::min(k, c.size());
+            const Indices wantIdx(all.idx.begin(), all.idx.begin() + kept);
+            const std::vector<float> wantD2(all.dist2.begin(), all.dist2.begin() + kept);
+            const Knn got = treeKnn(t, q[0], q[1], k);
+            ASSERT_EQ(got.idx, wantIdx)
+                << what << ": query (" << q[0] << ", " << q[1] << ") k " << k << ", n " << c.size();
+            ASSERT_EQ(got.dist2, wantD2)
+                << what << ": query (" << q[0] << ", " << q[1] << ") k " << k << ", n " << c.size();
+            boundaryTies += k > 0 && k < c.size() && all.dist2[k] == all.dist2[k - 1];
+        }
+    }
+}
+
+TEST(KdTree2DKnn, EmptyTreeAndKZero) {
+    KdTree2D t;
+    const std::vector<float> none;
+    t.build(none.data(), none.data(), 0);
+    Knn r = treeKnn(t, 0.0f, 0.0f, 5);
+    EXPECT_TRUE(r.idx.empty());
+    EXPECT_TRUE(r.dist2.empty());
+    const std::vector<float> x{1.0f, 2.0f}, y{0.0f, 0.0f};
+    t.build(x.data(), y.data(), 2);
+    r = treeKnn(t, 0.0f, 0.0f, 0);
+    EXPECT_TRUE(r.idx.empty());
+    EXPECT_TRUE(r.dist2.empty());
+}
+
+TEST(KdTree2DKnn, HandMadeOrderTiesAndShortSets) {
+    // Points on the x axis at 0, 1, 2, 3 and a copy of 1 (index 4); a query at 1.
+    const std::vector<float> x{0.0f, 1.0f, 2.0f, 3.0f, 1.0f}, y(5, 0.0f);
+    KdTree2D t;
+    t.build(x.data(), y.data(), x.size());
+    Knn r = treeKnn(t, 1.0f, 0.0f, 1);
+    EXPECT_EQ(r.idx, Indices{1});  // itself, not excluded; the copy loses the index tie
+    EXPECT_EQ(r.dist2, std::vector<float>{0.0f});
+    r = treeKnn(t, 1.0f, 0.0f, 3);
+    EXPECT_EQ(r.idx, (Indices{1, 4, 0}));  // 0 and 2 tie at distance 1: the lower index wins
+    EXPECT_EQ(r.dist2, (std::vector<float>{0.0f, 0.0f, 1.0f}));
+    r = treeKnn(t, 1.0f, 0.0f, 4);
+    EXPECT_EQ(r.idx, (Indices{1, 4, 0, 2}));
+    r = treeKnn(t, 1.0f, 0.0f, 50);  // k > n: every point, nearest first
+    EXPECT_EQ(r.idx, (Indices{1, 4, 0, 2, 3}));
+    EXPECT_EQ(r.dist2, (std::vector<float>{0.0f, 0.0f, 1.0f, 1.0f, 4.0f}));
+    r = treeKnn(t, 2.6f, 0.0f, 2);  // off the data points
+    EXPECT_EQ(r.idx, (Indices{3, 2}));
+}
+
+TEST(KdTree2DKnn, AllPointsIdenticalReturnsTheLowestIndices) {
+    const std::vector<float> x(300, 3.25f), y(300, -1.5f);
+    KdTree2D t;
+    t.build(x.data(), y.data(), x.size());
+    for (const std::size_t k : {1u, 9u, 299u, 300u, 400u}) {
+        const Knn r = treeKnn(t, 3.25f, -1.5f, k);
+        ASSERT_EQ(r.idx.size(), std::min<std::size_t>(k, 300));
+        for (std::size_t i = 0; i < r.idx.size(); ++i) {
+            EXPECT_EQ(r.idx[i], i);
+            EXPECT_EQ(r.dist2[i], 0.0f);
+        }
+    }
+}
+
+TEST(KdTree2DKnn, MatchesBruteForceOnRandomSets) {
+    const std::size_t sizes[] = {1, 2, 3, 4, 5, 7, 8, 9, 16, 17, 31, 64, 100, 257, 400};
+    KdTree2D t;  // one tree, rebuilt for every set
+    std::size_t sets = 0, ties = 0;
+    for (unsigned seed = 1; seed <= 8; ++seed) {
+        std::mt19937 rng(1000 + seed);
+        for (int kind = 0; kind <= 6; ++kind) {
+            for (const std::size_t n : sizes) {
+                const Cloud c = randomCloud(rng, kind, n);
+                t.build(c.x.data(), c.y.data(), c.size());
+                const std::string what = "seed " + std::to_string(seed) + " kind " +
+                                         std::to_string(kind) + " n " + std::to_string(n);
+                std::vector<std::size_t> ks{0, 1, 2, 3, 5, 8, 9, 17};
+                if (n <= 64) ks.insert(ks.end(), {n - 1, n, n + 3});  // k near and above n
+                compareKnn(t, c, randomQueries(rng, c), ks, what, ties);
+                ++sets;
+                if (HasFailure()) return;
+            }
+        }
+    }
+    EXPECT_EQ(sets, 8u * 7u * 15u);
+    EXPECT_GT(ties, 1000u);  // the integer kinds put many points at equal distances
+}
+
+TEST(KdTree2DKnn, ReusedOutputAndRebuiltTree) {
+    std::mt19937 rng(5);
+    KdTree2D t;
+    Indices idx;
+    std::vector<float> d2;
+    const Cloud big = randomCloud(rng, 0, 500);
+    t.build(big.x.data(), big.y.data(), big.size());
+    t.knn(0.0f, 0.0f, 40, idx, d2);
+    EXPECT_EQ(idx.size(), 40u);
+    // Fewer points of the same arrays: no index >= n may come back, and the long previous
+    // answer must not leak into the new one.
+    t.build(big.x.data(), big.y.data(), 6);
+    t.knn(0.0f, 0.0f, 40, idx, d2);
+    Cloud prefix;
+    for (std::size_t i = 0; i < 6; ++i) prefix.add(big.x[i], big.y[i]);
+    const Knn want = bruteKnn(prefix, 0.0f, 0.0f, 40);
+    EXPECT_EQ(idx, want.idx);
+    EXPECT_EQ(d2, want.dist2);
+    // The radius query still answers as before on the same tree.
+    EXPECT_EQ(query(t, 0.0f, 0.0f, 100.0f), (Indices{0, 1, 2, 3, 4, 5}));
 }
 
 }  // namespace

@@ -333,3 +333,36 @@ TEST(KfdFilterCli, FiltersAndPrintsASummary) {
     EXPECT_NE(text.find("scans    in 225"), std::string::npos) << text;
     EXPECT_TRUE(fs::exists(dir / "out.rawlog"));
 }
+
+TEST(RawlogFilter, BaselineDenoisersCountTheirNoise) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    for (const char* stage : {"radius", "sor", "dbscan"}) {
+        SCOPED_TRACE(stage);
+        auto o = optionsFor(kSena, dir / (std::string(stage) + ".rawlog"));
+        o.pipeline.stages = {"distance", stage};
+        const auto s = kfd::RawlogFilter().run(o);
+        EXPECT_EQ(s.scans_kept, s.scans_in);  // denoisers never drop scans
+        EXPECT_GT(s.points_removed_noise, 0u);
+        checkConservation(kSena, o.output, s);  // every cleared flag is accounted for
+    }
+}
+
+TEST(KfdFilterCli, RadiusAndSorFromAConfigFile) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    std::ofstream(dir / "radius.ini") << "[KFD]\npipeline = distance, radius\nradius_m = 0.2\n"
+                                         "radius_min_neighbors = 2\n";
+    std::ofstream(dir / "sor.yaml") << "kfd:\n  pipeline: [distance, sor]\n  sor_k: 6\n"
+                                       "  sor_std_mul: 1.5\n";
+    for (const char* cfg : {"radius.ini", "sor.yaml"}) {
+        std::string text;
+        ASSERT_EQ(run(quoted(KFD_FILTER_EXE) + " -c " + quoted(dir / cfg) + " -i " + quoted(kSena) +
+                          " -o " + quoted(dir / "out.rawlog"),
+                      &text),
+                  0)
+            << text;
+        EXPECT_NE(text.find("kept 225"), std::string::npos) << text;
+        EXPECT_EQ(text.find(" 0 noise"), std::string::npos) << text;  // some noise removed
+    }
+}

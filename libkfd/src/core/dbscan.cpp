@@ -16,25 +16,19 @@ DbscanFilter::Result DbscanFilter::filter(Scan& scan) {
     constexpr std::int32_t kUnvisited = -2, kNoise = -1;
     Result res;
     const std::size_t n = scan.range.size();
-    x_.clear();
-    y_.clear();
-    beam_.clear();
-    for (std::size_t i = 0; i < n; ++i) {
-        if (!scan.valid[i]) continue;
-        const double a = scan.geometry.angle(i);
-        x_.push_back(static_cast<float>(scan.range[i] * std::cos(a)));
-        y_.push_back(static_cast<float>(scan.range[i] * std::sin(a)));
-        beam_.push_back(static_cast<std::uint32_t>(i));
-    }
-    const std::size_t m = x_.size();
-    res.points_in = m;
-    tree_.build(x_.data(), y_.data(), m);
+    pts_.assign(scan);
+    // A valid beam without a finite range has no position: it is noise.
+    for (const auto b : pts_.nonfinite) scan.valid[b] = 0;
+    const std::size_t m = pts_.size();
+    res.points_in = m + pts_.nonfinite.size();
+    res.points_removed = pts_.nonfinite.size();
+    tree_.build(pts_.x.data(), pts_.y.data(), m);
     point_label_.assign(m, kUnvisited);
     const float eps = static_cast<float>(params_.eps_m);
     std::int32_t cluster = 0;
     for (std::size_t p = 0; p < m; ++p) {
         if (point_label_[p] != kUnvisited) continue;
-        tree_.radius(x_[p], y_[p], eps, neighbours_);
+        tree_.radius(pts_.x[p], pts_.y[p], eps, neighbours_);
         if (neighbours_.size() < params_.min_pts) {
             point_label_[p] = kNoise;  // may still become a border point later
             continue;
@@ -46,7 +40,7 @@ DbscanFilter::Result DbscanFilter::filter(Scan& scan) {
             if (point_label_[q] == kNoise) point_label_[q] = cluster;  // border point
             if (point_label_[q] != kUnvisited) continue;
             point_label_[q] = cluster;
-            tree_.radius(x_[q], y_[q], eps, neighbours_);
+            tree_.radius(pts_.x[q], pts_.y[q], eps, neighbours_);
             if (neighbours_.size() >= params_.min_pts)  // core point: expand
                 queue_.insert(queue_.end(), neighbours_.begin(), neighbours_.end());
         }
@@ -56,9 +50,9 @@ DbscanFilter::Result DbscanFilter::filter(Scan& scan) {
     label_.assign(n, -1);
     for (std::size_t p = 0; p < m; ++p) {
         if (point_label_[p] >= 0) {
-            label_[beam_[p]] = point_label_[p];
+            label_[pts_.beam[p]] = point_label_[p];
         } else {
-            scan.valid[beam_[p]] = 0;
+            scan.valid[pts_.beam[p]] = 0;
             ++res.points_removed;
         }
     }

@@ -32,6 +32,16 @@ bool DbscanStage::filter(Scan& scan, ScanReport& report) {
     return true;
 }
 
+bool RadiusStage::filter(Scan& scan, ScanReport& report) {
+    report.radius = algo_.filter(scan);
+    return true;
+}
+
+bool SorStage::filter(Scan& scan, ScanReport& report) {
+    report.sor = algo_.filter(scan);
+    return true;
+}
+
 void Pipeline::initialize(const Params& p) {
     // Validate every stage's parameters, listed or not, so a bad value in a config file is
     // reported even while its stage is switched off.
@@ -40,6 +50,8 @@ void Pipeline::initialize(const Params& p) {
     Denoiser{p.denoise};
     MotionFilter{p.motion};
     DbscanFilter{p.dbscan};
+    RadiusOutlierFilter{p.radius};
+    StatisticalOutlierFilter{p.sor};
     std::vector<std::unique_ptr<ScanFilter>> stages;
     for (const auto& name : p.stages) {
         for (const auto& s : stages)
@@ -65,9 +77,18 @@ void Pipeline::initialize(const Params& p) {
             auto s = std::make_unique<DbscanStage>();
             s->initialize(p.dbscan);
             stages.push_back(std::move(s));
+        } else if (name == "radius") {
+            auto s = std::make_unique<RadiusStage>();
+            s->initialize(p.radius);
+            stages.push_back(std::move(s));
+        } else if (name == "sor") {
+            auto s = std::make_unique<SorStage>();
+            s->initialize(p.sor);
+            stages.push_back(std::move(s));
         } else {
-            throw std::invalid_argument("pipeline: unknown stage '" + name +
-                                        "' (known: distance, keyframe, denoise, motion, dbscan)");
+            throw std::invalid_argument(
+                "pipeline: unknown stage '" + name +
+                "' (known: distance, keyframe, denoise, motion, dbscan, radius, sor)");
         }
     }
     stages_ = std::move(stages);

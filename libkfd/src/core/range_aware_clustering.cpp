@@ -52,6 +52,15 @@ RangeAwareClustering::Result RangeAwareClustering::cluster(const Scan& scan, Clu
     sets_.clear();
     provisional_.assign(n, -1);
     open_.clear();
+    // jumpDistance() = min(ra, rb) * jump_factor_[gap] + noise_, per beam gap (the angle test
+    // keeps gaps within theta / resolution).
+    const std::size_t max_gap =
+        res_ang > 0 ? static_cast<std::size_t>(theta / res_ang + 1e-6) : std::size_t{0};
+    jump_factor_.resize(max_gap + 1);
+    for (std::size_t gap = 0; gap <= max_gap; ++gap)
+        jump_factor_[gap] =
+            jumpDistance(1.0, 1.0, static_cast<double>(gap) * res_ang) - 3.0 * params_.jump_sigma_m;
+    noise_ = 3.0 * params_.jump_sigma_m;
 
     for (std::size_t i = 0; i < n; ++i) {
         if (!scan.valid[i]) continue;
@@ -64,16 +73,20 @@ RangeAwareClustering::Result RangeAwareClustering::cluster(const Scan& scan, Clu
                                               theta + 1e-12;
                                    }),
                     open_.end());
+        // Which open clusters this point reaches (angle test done above, jump test here), and
+        // the nearest of them. Squared distances; the angle factor comes from jump_factor_.
         int best = -1;
-        double best_d = 0.0;
+        double best_d2 = 0.0;
+        reach_.assign(open_.size(), 0);
         for (std::size_t k = 0; k < open_.size(); ++k) {
             const Open& o = open_[k];
-            const double d = std::hypot(x - o.x, y - o.y);
-            const double dtheta = static_cast<double>(i - o.beam) * res_ang;
-            if (d <= jumpDistance(r, o.r, dtheta)) {
-                if (best < 0 || d < best_d) {
+            const double dx = x - o.x, dy = y - o.y, d2 = dx * dx + dy * dy;
+            const double jump = std::min<double>(r, o.r) * jump_factor_[i - o.beam] + noise_;
+            if (d2 <= jump * jump) {
+                reach_[k] = 1;
+                if (best < 0 || d2 < best_d2) {
                     best = static_cast<int>(k);
-                    best_d = d;
+                    best_d2 = d2;
                 }
             } else {
                 ++res.splits;
@@ -87,13 +100,9 @@ RangeAwareClustering::Result RangeAwareClustering::cluster(const Scan& scan, Clu
         }
         // Join the nearest; clusters that this point also reaches become one.
         const std::uint32_t id = open_[best].id;
-        for (std::size_t k = 0; k < open_.size(); ++k) {
-            if (static_cast<int>(k) == best) continue;
-            const Open& o = open_[k];
-            const double dtheta = static_cast<double>(i - o.beam) * res_ang;
-            if (std::hypot(x - o.x, y - o.y) <= jumpDistance(r, o.r, dtheta))
-                res.merges += sets_.unite(id, o.id) ? 1 : 0;
-        }
+        for (std::size_t k = 0; k < open_.size(); ++k)
+            if (reach_[k] && static_cast<int>(k) != best)
+                res.merges += sets_.unite(id, open_[k].id) ? 1 : 0;
         ++res.links;
         provisional_[i] = static_cast<std::int32_t>(id);
         open_[best] = Open{id, static_cast<std::uint32_t>(i), x, y, r};

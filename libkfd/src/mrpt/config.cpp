@@ -85,7 +85,7 @@ std::vector<Key> buildKeys() {
     using P = Pipeline::Params;
     std::vector<Key> k;
     k.push_back(Key{{"pipeline", "stages in order, comma separated",
-                     "distance, keyframe, denoise, motion, dbscan"},
+                     "distance, keyframe, denoise, motion, dbscan, radius, sor"},
                     [](P& p, const std::string& text) {
                         std::vector<std::string> stages;
                         std::stringstream ss(text);
@@ -94,10 +94,12 @@ std::vector<Key> buildKeys() {
                             item = trim(item);
                             if (item.empty()) continue;
                             if (item != "distance" && item != "keyframe" && item != "denoise" &&
-                                item != "motion" && item != "dbscan")
+                                item != "motion" && item != "dbscan" && item != "radius" &&
+                                item != "sor")
                                 throw ConfigError("pipeline", "unknown stage '" + item +
                                                                   "' (known: distance, keyframe, "
-                                                                  "denoise, motion, dbscan)");
+                                                                  "denoise, motion, dbscan, "
+                                                                  "radius, sor)");
                             for (const auto& s : stages)
                                 if (s == item)
                                     throw ConfigError("pipeline", "stage '" + item + "' repeated");
@@ -176,6 +178,17 @@ std::vector<Key> buildKeys() {
                      [](P& p) -> double& { return p.dbscan.eps_m; }));
     k.push_back(integer("dbscan_min_pts", "dbscan stage: minPts (the point itself included)", 1,
                         1e6, [](P& p) -> std::size_t& { return p.dbscan.min_pts; }));
+    k.push_back(real("radius_m", "radius stage: neighbourhood radius (m)", 0, 100, true,
+                     [](P& p) -> double& { return p.radius.radius_m; }));
+    k.push_back(integer("radius_min_neighbors",
+                        "radius stage: other points needed within radius_m (points)", 1, 1e6,
+                        [](P& p) -> std::size_t& { return p.radius.min_neighbors; }));
+    k.push_back(integer("sor_k", "sor stage: nearest neighbours per point (points)", 1, 1000,
+                        [](P& p) -> std::size_t& { return p.sor.k; }));
+    k.push_back(real("sor_std_mul",
+                     "sor stage: noise above mean + sor_std_mul x stddev of the mean neighbour "
+                     "distance (standard deviations)",
+                     0, 100, false, [](P& p) -> double& { return p.sor.std_mul; }));
     return k;
 }
 

@@ -71,7 +71,7 @@ class CsvWriter {
             s.keyframe_evaluated ? toString(s.keyframe.reason) : "none", s.keyframe.p_common,
             s.keyframe.p_threshold, s.keyframe.references, s.points_in,
             s.distance.removed_non_finite + s.distance.removed_out_of_range, s.denoise.clusters,
-            s.denoise.noise_clusters, s.denoise.points_removed, s.points_out, s.microseconds);
+            s.denoise.noise_clusters, s.noiseRemoved(), s.points_out, s.microseconds);
         out_ << buf;
     }
     void close() {
@@ -140,7 +140,7 @@ bool Run::handleScan(CObservation2DRangeScan& scan) {
         ++sum_.scans_kept;
         sum_.points_removed_range +=
             r.report.distance.removed_non_finite + r.report.distance.removed_out_of_range;
-        sum_.points_removed_noise += r.report.denoise.points_removed;
+        sum_.points_removed_noise += r.report.noiseRemoved();
     } else {
         ++sum_.scans_dropped;
     }

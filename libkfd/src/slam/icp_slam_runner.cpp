@@ -123,16 +123,22 @@ const char* toString(PrefilterMode m) {
             return "kfd";
         case PrefilterMode::Dbscan:
             return "dbscan";
+        case PrefilterMode::Radius:
+            return "radius";
+        case PrefilterMode::Sor:
+            return "sor";
     }
     return "unknown";
 }
 
 PrefilterMode parsePrefilterMode(const std::string& s) {
-    for (auto m : {PrefilterMode::None, PrefilterMode::Odometry, PrefilterMode::Keyframe,
-                   PrefilterMode::Kfd, PrefilterMode::Dbscan})
+    for (auto m :
+         {PrefilterMode::None, PrefilterMode::Odometry, PrefilterMode::Keyframe, PrefilterMode::Kfd,
+          PrefilterMode::Dbscan, PrefilterMode::Radius, PrefilterMode::Sor})
         if (s == toString(m)) return m;
-    throw std::invalid_argument("unknown pre-filter mode '" + s +
-                                "' (expected none, odometry, keyframe, kfd or dbscan)");
+    throw std::invalid_argument(
+        "unknown pre-filter mode '" + s +
+        "' (expected none, odometry, keyframe, kfd, dbscan, radius or sor)");
 }
 
 Pipeline::Params pipelineForMode(PrefilterMode mode, const Pipeline::Params& kfd) {
@@ -151,6 +157,12 @@ Pipeline::Params pipelineForMode(PrefilterMode mode, const Pipeline::Params& kfd
             break;
         case PrefilterMode::Dbscan:
             p.stages = {"distance", "dbscan"};
+            break;
+        case PrefilterMode::Radius:
+            p.stages = {"distance", "radius"};
+            break;
+        case PrefilterMode::Sor:
+            p.stages = {"distance", "sor"};
             break;
     }
     return p;

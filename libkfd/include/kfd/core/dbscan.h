@@ -41,8 +41,7 @@ class DbscanFilter {
   private:
     Params params_;
     KdTree2D tree_;
-    std::vector<float> x_, y_;
-    std::vector<std::uint32_t> beam_;  // point -> beam index
+    ScanPoints pts_;  // the valid beams as points
     std::vector<std::int32_t> point_label_;
     std::vector<std::uint32_t> neighbours_, queue_;
     std::vector<std::int32_t> label_;

@@ -10,7 +10,9 @@
 #include "kfd/core/distance_filter.h"
 #include "kfd/core/keyframe_selector.h"
 #include "kfd/core/motion_filter.h"
+#include "kfd/core/radius_outlier.h"
 #include "kfd/core/scan.h"
+#include "kfd/core/statistical_outlier.h"
 
 namespace kfd {
 
@@ -23,10 +25,19 @@ struct ScanReport {
     DistanceFilter::Result distance;
     KeyframeDecision keyframe;
     Denoiser::Result denoise;
-    DbscanFilter::Result dbscan;  // when the dbscan stage ran
-    std::size_t points_in = 0;    // valid beams on input
-    std::size_t points_out = 0;   // valid beams on output
-    double microseconds = 0.0;    // wall time spent in the chain
+    DbscanFilter::Result dbscan;           // when the dbscan stage ran
+    RadiusOutlierFilter::Result radius;    // when the radius stage ran
+    StatisticalOutlierFilter::Result sor;  // when the sor stage ran
+    std::size_t points_in = 0;             // valid beams on input
+    std::size_t points_out = 0;            // valid beams on output
+    double microseconds = 0.0;             // wall time spent in the chain
+
+    /// Points invalidated as noise by whichever denoising stages ran (denoise, dbscan, radius,
+    /// sor); the distance stage's removals are not noise.
+    std::size_t noiseRemoved() const {
+        return denoise.points_removed + dbscan.points_removed + radius.points_removed +
+               sor.points_removed;
+    }
 };
 
 /// One stage of the chain, as in mp2p_icp's filter pipelines: configured once, then called for
@@ -98,17 +109,43 @@ class DbscanStage : public ScanFilter {
     DbscanFilter algo_;
 };
 
+/// Radius outlier removal (baseline) as a stage. Never drops a scan; invalidates noise points.
+class RadiusStage : public ScanFilter {
+  public:
+    void initialize(const RadiusOutlierFilter::Params& p) { algo_.initialize(p); }
+    const char* name() const override { return "radius"; }
+    bool filter(Scan& scan, ScanReport& report) override;
+
+  private:
+    RadiusOutlierFilter algo_;
+};
+
+/// Statistical outlier removal (baseline) as a stage. Never drops a scan; invalidates noise
+/// points.
+class SorStage : public ScanFilter {
+  public:
+    void initialize(const StatisticalOutlierFilter::Params& p) { algo_.initialize(p); }
+    const char* name() const override { return "sor"; }
+    bool filter(Scan& scan, ScanReport& report) override;
+
+  private:
+    StatisticalOutlierFilter algo_;
+};
+
 class Pipeline {
   public:
     struct Params {
         /// Stage names in order, each at most once. kfd's: "distance", "keyframe", "denoise";
-        /// baselines: "motion" (odometry motion filter), "dbscan" (DBSCAN denoise).
+        /// baselines: "motion" (odometry motion filter), "dbscan" (DBSCAN denoise), "radius"
+        /// (radius outlier removal), "sor" (statistical outlier removal).
         std::vector<std::string> stages{"distance", "keyframe", "denoise"};
         DistanceFilter::Params distance;
         KeyframeSelector::Params keyframe;
         Denoiser::Params denoise;
         MotionFilter::Params motion;
         DbscanFilter::Params dbscan;
+        RadiusOutlierFilter::Params radius;
+        StatisticalOutlierFilter::Params sor;
     };
 
     Pipeline() { initialize(Params{}); }

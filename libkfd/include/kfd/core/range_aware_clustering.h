@@ -66,6 +66,9 @@ class RangeAwareClustering {
     ScanGeometry table_geometry_;
     std::vector<float> cos_, sin_;
     std::vector<Open> open_;
+    std::vector<std::uint8_t> reach_;  // per open cluster: reached by the current point
+    std::vector<double> jump_factor_;  // per beam gap: sin(min(gap*res, lambda/2))/sin(lambda)
+    double noise_ = 0.0;               // 3 sigma
     DisjointSets sets_;
     std::vector<std::int32_t> provisional_;
 };

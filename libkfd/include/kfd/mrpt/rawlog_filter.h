@@ -49,7 +49,7 @@ struct RawlogFilterSummary {
     std::size_t sensors = 0;
     std::size_t points_in = 0;             // valid beams in all input scans
     std::size_t points_removed_range = 0;  // by Algorithm 1, in kept scans
-    std::size_t points_removed_noise = 0;  // by the denoiser, in kept scans
+    std::size_t points_removed_noise = 0;  // by the denoising stages, in kept scans
     double filter_seconds = 0.0;           // time inside the pipeline
     double wall_seconds = 0.0;             // whole run, I/O included
     double droppedPercent() const {

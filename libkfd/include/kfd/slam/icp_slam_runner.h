@@ -18,9 +18,12 @@ enum class PrefilterMode {
     Keyframe,  // keyframe extraction only (distance + keyframe stages)
     Kfd,       // the full method: the [KFD] pipeline (distance, keyframe, denoise)
     Dbscan,    // the paper's comparison: DBSCAN denoise of every scan (distance + dbscan)
+    Radius,    // baseline: radius outlier removal of every scan (distance + radius)
+    Sor,       // baseline: statistical outlier removal of every scan (distance + sor)
 };
 const char* toString(PrefilterMode m);
-/// "none", "odometry", "keyframe", "kfd", "dbscan"; std::invalid_argument otherwise.
+/// "none", "odometry", "keyframe", "kfd", "dbscan", "radius", "sor"; std::invalid_argument
+/// otherwise.
 PrefilterMode parsePrefilterMode(const std::string& s);
 
 /// The pipeline a mode runs, built from the [KFD] parameters.

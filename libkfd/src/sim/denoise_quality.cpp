@@ -1,0 +1,102 @@
+#include "kfd/sim/denoise_quality.h"
+
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "kfd/mrpt/stream_filter.h"
+
+namespace kfd {
+namespace {
+
+NoiseKind parseKind(const std::string& s) {
+    for (auto k : {NoiseKind::Isolated, NoiseKind::Clustered, NoiseKind::Edge})
+        if (s == toString(k)) return k;
+    throw std::runtime_error("unknown noise kind '" + s + "' in labels");
+}
+
+// scan index -> (beam, kind) list
+std::map<std::size_t, std::vector<std::pair<std::size_t, NoiseKind>>> readLabels(
+    const std::string& path) {
+    std::ifstream f(path);
+    if (!f) throw std::runtime_error("cannot open labels " + path);
+    std::map<std::size_t, std::vector<std::pair<std::size_t, NoiseKind>>> out;
+    std::string line;
+    std::getline(f, line);
+    if (line != "scan,timestamp,beam,kind")
+        throw std::runtime_error(path + " is not a kfd-simulate label file");
+    std::size_t lineno = 1;
+    while (std::getline(f, line)) {
+        ++lineno;
+        std::stringstream ss(line);
+        std::string scan, stamp, beam, kind;
+        if (!std::getline(ss, scan, ',') || !std::getline(ss, stamp, ',') ||
+            !std::getline(ss, beam, ',') || !std::getline(ss, kind))
+            throw std::runtime_error(path + ":" + std::to_string(lineno) + ": malformed row");
+        out[std::stoul(scan)].emplace_back(std::stoul(beam), parseKind(kind));
+    }
+    return out;
+}
+
+}  // namespace
+
+DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& labels_csv,
+                                 const Pipeline::Params& pipeline) {
+    const auto labels = readLabels(labels_csv);
+    mrpt::io::CFileGZInputStream in;
+    if (!in.open(rawlog)) throw std::runtime_error("cannot open rawlog " + rawlog);
+    auto arch = mrpt::serialization::archiveFrom(in);
+    StreamFilter filter(pipeline);
+    DenoiseQuality q;
+    std::vector<std::uint8_t> before;
+    std::vector<NoiseKind> kind;
+    for (;;) {
+        mrpt::serialization::CSerializable::Ptr obj;
+        try {
+            obj = arch.ReadObject();
+        } catch (const mrpt::serialization::CExceptionEOF&) {
+            break;
+        }
+        auto scan = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(obj);
+        if (!scan) continue;
+        const std::size_t n = scan->getScanSize();
+        before.resize(n);
+        kind.assign(n, NoiseKind::Clean);
+        for (std::size_t i = 0; i < n; ++i) before[i] = scan->getScanRangeValidity(i);
+        if (const auto it = labels.find(q.scans); it != labels.end())
+            for (const auto& [beam, k] : it->second) {
+                if (beam >= n) throw std::runtime_error("labels do not fit the rawlog");
+                kind[beam] = k;
+            }
+        const auto r = filter.process(*scan);
+        q.microseconds += r.report.microseconds;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!before[i]) continue;
+            ++q.points;
+            const bool removed = r.keep && !scan->getScanRangeValidity(i);
+            const auto ki = static_cast<std::size_t>(kind[i]);
+            if (kind[i] == NoiseKind::Clean) {
+                ++q.clean;
+                q.removed_clean += removed;
+            } else {
+                ++q.noise;
+                ++q.noise_by_kind[ki];
+                q.removed_noise += removed;
+                q.removed_by_kind[ki] += removed;
+            }
+        }
+        ++q.scans;
+    }
+    if (q.scans == 0) throw std::runtime_error("no scans in " + rawlog);
+    if (!labels.empty() && labels.rbegin()->first >= q.scans)
+        throw std::runtime_error("labels refer to more scans than the rawlog holds");
+    return q;
+}
+
+}  // namespace kfd

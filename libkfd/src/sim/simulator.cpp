@@ -1,0 +1,201 @@
+#include "kfd/sim/simulator.h"
+
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/poses/CPose2D.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "kfd/eval/trajectory.h"
+#include "kfd/mrpt/scan_adapter.h"
+
+namespace kfd {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDeg = kPi / 180.0;
+
+// The route as a sequence of primitive motions, sampled at a fixed rate.
+struct Motion {
+    enum Kind { Turn, Drive, Stop } kind;
+    double value;  // Turn: target heading change (rad); Drive: target (x, y); Stop: seconds
+    double x = 0, y = 0;
+};
+
+std::vector<Motion> plan(const World& w) {
+    std::vector<Motion> m;
+    for (std::size_t i = 1; i < w.route.size(); ++i) {
+        const auto& a = w.route[i - 1];
+        const auto& b = w.route[i];
+        Motion d{Motion::Drive, 0.0, b.x, b.y};
+        d.value = std::atan2(b.y - a.y, b.x - a.x);  // heading of the leg
+        m.push_back(Motion{Motion::Turn, d.value});
+        m.push_back(d);
+        if (b.stop_s > 0) m.push_back(Motion{Motion::Stop, b.stop_s});
+        if (b.spin_deg != 0) m.push_back(Motion{Motion::Turn, std::nan(""), b.spin_deg * kDeg});
+    }
+    return m;
+}
+
+// Ground-truth poses at `rate` Hz along the plan.
+std::vector<Pose2D> sample(const World& w, double rate, double speed, double turn_rate,
+                           double max_duration) {
+    const auto motions = plan(w);
+    const double dt = 1.0 / rate;
+    Pose2D p{w.route[0].x, w.route[0].y,
+             std::atan2(w.route[1].y - w.route[0].y, w.route[1].x - w.route[0].x)};
+    std::vector<Pose2D> out{p};
+    auto emit = [&]() {
+        out.push_back(p);
+        return max_duration <= 0 || static_cast<double>(out.size()) * dt < max_duration;
+    };
+    for (const auto& m : motions) {
+        if (m.kind == Motion::Turn) {
+            // Absolute heading (leg start) or relative spin (value NaN, amount in x).
+            double remaining = std::isnan(m.value) ? m.x : wrapAngle(m.value - p.phi);
+            while (std::abs(remaining) > 1e-9) {
+                const double step =
+                    std::copysign(std::min(std::abs(remaining), turn_rate * dt), remaining);
+                p.phi = wrapAngle(p.phi + step);
+                remaining -= step;
+                if (!emit()) return out;
+            }
+        } else if (m.kind == Motion::Drive) {
+            for (;;) {
+                const double dx = m.x - p.x, dy = m.y - p.y, d = std::hypot(dx, dy);
+                if (d < 1e-9) break;
+                const double s = std::min(d, speed * dt);
+                p.x += s * dx / d;
+                p.y += s * dy / d;
+                if (!emit()) return out;
+            }
+        } else {
+            for (int k = 0; k < static_cast<int>(std::round(m.value * rate)); ++k)
+                if (!emit()) return out;
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+SensorModel sensorModel(const std::string& name) {
+    if (name == "mit") return SensorModel{40.0, 1081, 270.0, 0.1, 30.0, 0.01};
+    if (name == "gazebo") return SensorModel{10.0, 720, 359.5, 0.1, 12.0, 0.01};
+    throw std::invalid_argument("unknown sensor '" + name + "' (known: mit, gazebo)");
+}
+
+SimulationSummary Simulator::run(const SimulationOptions& o) {
+    SimulationSummary sum;
+    World world;
+    SensorModel sensor;
+    NoiseInjector noise;
+    try {
+        world = o.gridmap.empty() ? makeWorld(o.world) : loadWorld(o.gridmap, o.route);
+        sensor = sensorModel(o.sensor);
+        noise.initialize(o.noise);
+    } catch (const std::exception& e) {  // bad names, unreadable gridmap or route file
+        throw SimulationError(e.what());
+    }
+    if (!(o.speed_mps > 0) || !(o.turn_rate_dps > 0))
+        throw SimulationError("speed and turn rate must be > 0");
+    if (o.output.empty()) throw SimulationError("no output rawlog given");
+
+    const auto gt =
+        sample(world, sensor.rate_hz, o.speed_mps, o.turn_rate_dps * kDeg, o.duration_s);
+    std::mt19937 rng(o.seed);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+
+    const fs::path out(o.output);
+    const std::string stem = (out.parent_path() / out.stem()).string();
+    sum.rawlog = o.output;
+    sum.ground_truth = stem + ".gt.tum";
+    sum.odometry = stem + ".odom.tum";
+    sum.labels = stem + ".labels.csv";
+    std::error_code mk;
+    if (!out.parent_path().empty()) fs::create_directories(out.parent_path(), mk);
+    const std::string tmp = o.output + ".tmp";
+    mrpt::io::CFileGZOutputStream f;
+    if (!f.open(tmp, 1)) throw SimulationError("cannot write " + o.output);
+    auto arch = mrpt::serialization::archiveFrom(f);
+    std::ofstream labels(sum.labels);
+    if (!labels) throw SimulationError("cannot write " + sum.labels);
+    labels << "scan,timestamp,beam,kind\n";
+
+    Trajectory gt_traj, odo_traj;
+    mrpt::poses::CPose2D odo;  // drifting odometry, starts at the origin
+    const double t0 = 1700000000.0;
+    Scan core;
+    std::vector<NoiseKind> kinds;
+    mrpt::obs::CObservation2DRangeScan scan;
+    scan.sensorLabel = "LASER";
+    scan.aperture = static_cast<float>(sensor.fov_deg * kDeg);
+    scan.maxRange = static_cast<float>(sensor.max_range);
+    scan.rightToLeft = true;
+    scan.stdError = static_cast<float>(sensor.range_sigma);
+
+    for (std::size_t k = 0; k < gt.size(); ++k) {
+        const double t = t0 + static_cast<double>(k) / sensor.rate_hz;
+        const auto stamp = mrpt::Clock::fromDouble(t);
+        if (k > 0) {  // odometry: the true increment, corrupted
+            const Pose2D d = between(gt[k - 1], gt[k]);
+            const double len = std::hypot(d.x, d.y);
+            const double f_t = 1.0 + o.odo_trans_sigma * gauss(rng);
+            const double dphi = d.phi + o.odo_rot_sigma * std::abs(d.phi) * gauss(rng) +
+                                o.odo_drift_deg_per_m * kDeg * len;
+            odo = odo + mrpt::poses::CPose2D(d.x * f_t, d.y * f_t, dphi);
+            sum.distance_m += len;
+        }
+        // Ray casting without MRPT's own noise (it draws from MRPT's global, unseeded random
+        // generator); the range noise is added below from our seeded generator.
+        world.grid.laserScanSimulator(scan, mrpt::poses::CPose2D(gt[k].x, gt[k].y, gt[k].phi), 0.5f,
+                                      sensor.beams, 0.0f);
+        scan.timestamp = stamp;
+        toCore(scan, core);
+        for (std::size_t i = 0; i < core.size(); ++i)
+            if (core.valid[i]) core.range[i] += static_cast<float>(sensor.range_sigma * gauss(rng));
+        for (std::size_t i = 0; i < core.size(); ++i)
+            if (core.valid[i] &&
+                (core.range[i] < sensor.min_range || core.range[i] >= sensor.max_range))
+                core.valid[i] = 0;
+        noise.apply(core, kinds, rng);
+        for (std::size_t i = 0; i < core.size(); ++i) {
+            scan.setScanRange(i, core.range[i]);
+            scan.setScanRangeValidity(i, core.valid[i] != 0);
+            if (kinds[i] == NoiseKind::Clean) continue;
+            labels << k << ',' << std::to_string(t) << ',' << i << ',' << toString(kinds[i])
+                   << '\n';
+            sum.noise_isolated += kinds[i] == NoiseKind::Isolated;
+            sum.noise_clustered += kinds[i] == NoiseKind::Clustered;
+            sum.noise_edge += kinds[i] == NoiseKind::Edge;
+        }
+        mrpt::obs::CObservationOdometry odom;
+        odom.sensorLabel = "ODOMETRY";
+        odom.timestamp = stamp;
+        odom.odometry = odo;
+        arch << scan << odom;
+        gt_traj.push_back({t, gt[k]});
+        odo_traj.push_back({t, Pose2D{odo.x(), odo.y(), odo.phi()}});
+        if (o.on_progress && k % 200 == 0) o.on_progress(static_cast<double>(k) / gt.size());
+    }
+    f.close();
+    labels.close();
+    if (!labels) throw SimulationError("failed writing " + sum.labels);
+    writeTum(sum.ground_truth, gt_traj);
+    writeTum(sum.odometry, odo_traj);
+    std::error_code ec;
+    fs::rename(tmp, o.output, ec);
+    if (ec) throw SimulationError("cannot move the rawlog into place: " + ec.message());
+    sum.scans = gt.size();
+    sum.duration_s = static_cast<double>(gt.size()) / sensor.rate_hz;
+    if (o.on_progress) o.on_progress(1.0);
+    return sum;
+}
+
+}  // namespace kfd

@@ -1,0 +1,198 @@
+// kfd_bench_instructions: the per-scan calls of kfd_bench_stages, each behind its own
+// non-inlined extern "C" function kfd_ir_<case>, for instruction counts under callgrind
+// (deterministic, unlike wall time on a shared machine):
+//
+//   valgrind --tool=callgrind --callgrind-out-file=cg.out kfd_bench_instructions 160
+//   callgrind_annotate --inclusive=yes cg.out | grep kfd_ir_
+//
+// Each case first runs one untimed cycle over its scans (buffers sized, window filled), then
+// calls its kfd_ir_ function N times; instructions per scan = inclusive cost / N. Restoring the
+// valid flags between calls happens outside the counted functions. share/scripts/bench.sh does
+// all of this. Without valgrind the program just runs the cases (a smoke test).
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "bench_scans.h"
+#include "kfd/core/correlation.h"
+#include "kfd/core/dbscan.h"
+#include "kfd/core/denoiser.h"
+#include "kfd/core/distance_filter.h"
+#include "kfd/core/histogram.h"
+#include "kfd/core/keyframe_selector.h"
+#include "kfd/core/pipeline.h"
+#include "kfd/core/radius_outlier.h"
+#include "kfd/core/statistical_outlier.h"
+
+namespace kb = kfd::bench;
+
+namespace {
+
+struct Context {
+    kb::Scenario sc = kb::makeScenario();
+    std::vector<kfd::Scan> work = sc.keyframes;        // scratch copies of the keyframe set
+    std::vector<kfd::Scan> work_dropped = sc.dropped;  // ... and of the dropped set
+    std::vector<std::vector<double>> hist;             // histograms of the keyframe set
+    std::vector<double> out;
+    kfd::Histogram histogram{kfd::Histogram::Params{20}};
+    kfd::DistanceFilter distance{kb::paperParams().distance};
+    kfd::KeyframeSelector selector{kb::paperParams().keyframe};
+    kfd::Denoiser reference{kb::paperParams(kfd::DenoiseVariant::Reference).denoise};
+    kfd::Denoiser range_aware{kb::paperParams(kfd::DenoiseVariant::RangeAware).denoise};
+    kfd::DbscanFilter dbscan{kfd::DbscanFilter::Params{0.7, 10}};
+    kfd::RadiusOutlierFilter radius{kfd::RadiusOutlierFilter::Params{}};
+    kfd::StatisticalOutlierFilter sor{kfd::StatisticalOutlierFilter::Params{}};
+    kfd::Pipeline pipe_dropped{kb::paperParams()};
+    kfd::Pipeline pipe_reference{kb::paperParams(kfd::DenoiseVariant::Reference)};
+    kfd::Pipeline pipe_range_aware{kb::paperParams(kfd::DenoiseVariant::RangeAware)};
+    std::size_t sink = 0;       // results feed this so nothing is optimised away
+    std::size_t surprises = 0;  // dropped-set scans kept or keyframe-set scans dropped
+
+    Context() {
+        hist.resize(sc.keyframes.size());
+        for (std::size_t k = 0; k < hist.size(); ++k) histogram.compute(sc.keyframes[k], hist[k]);
+        for (const auto& s : sc.prefix) selector.filter(s);
+        for (kfd::Scan s : sc.prefix) pipe_dropped.process(s);
+    }
+};
+
+}  // namespace
+
+// The counted calls: one scan each.
+extern "C" {
+__attribute__((noinline)) void kfd_ir_histogram(Context& c, std::size_t k) {
+    c.sink += c.histogram.compute(c.sc.keyframes[k], c.out);
+}
+__attribute__((noinline)) void kfd_ir_pearson(Context& c, std::size_t k) {
+    const auto& a = c.hist[k];
+    const auto& b = c.hist[(k + 1) % c.hist.size()];
+    c.sink += kfd::pearson(a.data(), b.data(), a.size()) > 0.5;
+}
+__attribute__((noinline)) void kfd_ir_distance_filter(Context& c, std::size_t k) {
+    c.sink += c.distance.filter(c.work[k]).valid_out;
+}
+__attribute__((noinline)) void kfd_ir_keyframe_decision(Context& c, std::size_t k) {
+    c.surprises += c.selector.filter(c.sc.dropped[k]).keyframe;
+}
+__attribute__((noinline)) void kfd_ir_denoise_reference(Context& c, std::size_t k) {
+    c.sink += c.reference.filter(c.work[k]).points_removed;
+}
+__attribute__((noinline)) void kfd_ir_denoise_range_aware(Context& c, std::size_t k) {
+    c.sink += c.range_aware.filter(c.work[k]).points_removed;
+}
+__attribute__((noinline)) void kfd_ir_dbscan(Context& c, std::size_t k) {
+    c.sink += c.dbscan.filter(c.work[k]).points_removed;
+}
+__attribute__((noinline)) void kfd_ir_radius_outlier(Context& c, std::size_t k) {
+    c.sink += c.radius.filter(c.work[k]).points_removed;
+}
+__attribute__((noinline)) void kfd_ir_statistical_outlier(Context& c, std::size_t k) {
+    c.sink += c.sor.filter(c.work[k]).points_removed;
+}
+__attribute__((noinline)) void kfd_ir_pipeline_dropped(Context& c, std::size_t k) {
+    c.surprises += c.pipe_dropped.process(c.work_dropped[k]).keep;
+}
+__attribute__((noinline)) void kfd_ir_pipeline_keyframe_reference(Context& c, std::size_t k) {
+    c.surprises += !c.pipe_reference.process(c.work[k]).keep;
+}
+__attribute__((noinline)) void kfd_ir_pipeline_keyframe_range_aware(Context& c, std::size_t k) {
+    c.surprises += !c.pipe_range_aware.process(c.work[k]).keep;
+}
+}
+
+namespace {
+
+struct Case {
+    const char* name;
+    void (*call)(Context&, std::size_t);
+    bool dropped_set;  // runs on the dropped set (else on the keyframe set)
+};
+
+const Case kCases[] = {
+    {"histogram", kfd_ir_histogram, false},
+    {"pearson", kfd_ir_pearson, false},
+    {"distance_filter", kfd_ir_distance_filter, false},
+    {"keyframe_decision", kfd_ir_keyframe_decision, true},
+    {"denoise_reference", kfd_ir_denoise_reference, false},
+    {"denoise_range_aware", kfd_ir_denoise_range_aware, false},
+    {"dbscan", kfd_ir_dbscan, false},
+    {"radius_outlier", kfd_ir_radius_outlier, false},
+    {"statistical_outlier", kfd_ir_statistical_outlier, false},
+    {"pipeline_dropped", kfd_ir_pipeline_dropped, true},
+    {"pipeline_keyframe_reference", kfd_ir_pipeline_keyframe_reference, false},
+    {"pipeline_keyframe_range_aware", kfd_ir_pipeline_keyframe_range_aware, false},
+};
+
+// Untimed cycle: the same work as a counted call, without going through kfd_ir_*.
+void warmUp(Context& c, const Case& cs) {
+    const std::size_t n = cs.dropped_set ? c.sc.dropped.size() : c.sc.keyframes.size();
+    const std::string name = cs.name;
+    for (std::size_t k = 0; k < n; ++k) {
+        kfd::Scan& s = cs.dropped_set ? c.work_dropped[k] : c.work[k];
+        kb::restoreValid(cs.dropped_set ? c.sc.dropped[k] : c.sc.keyframes[k], s);
+        if (name == "histogram") c.histogram.compute(c.sc.keyframes[k], c.out);
+        if (name == "distance_filter") c.distance.filter(s);
+        if (name == "keyframe_decision") c.selector.filter(c.sc.dropped[k]);
+        if (name == "denoise_reference") c.reference.filter(s);
+        if (name == "denoise_range_aware") c.range_aware.filter(s);
+        if (name == "dbscan") c.dbscan.filter(s);
+        if (name == "radius_outlier") c.radius.filter(s);
+        if (name == "statistical_outlier") c.sor.filter(s);
+        if (name == "pipeline_dropped") c.pipe_dropped.process(s);
+        if (name == "pipeline_keyframe_reference") c.pipe_reference.process(s);
+        if (name == "pipeline_keyframe_range_aware") c.pipe_range_aware.process(s);
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc >= 2 && (!std::strcmp(argv[1], "-h") || !std::strcmp(argv[1], "--help"))) {
+        std::printf("usage: kfd_bench_instructions [N [CASE...]]\ncases:");
+        for (const auto& cs : kCases) std::printf(" %s", cs.name);
+        std::printf("\n");
+        return 0;
+    }
+    const long n = argc >= 2 ? std::atol(argv[1]) : 160;
+    if (n <= 0) {
+        std::fprintf(stderr, "kfd_bench_instructions: N must be > 0\n");
+        return 2;
+    }
+    std::vector<const Case*> run;
+    for (int a = 2; a < argc; ++a) {
+        const Case* found = nullptr;
+        for (const auto& cs : kCases)
+            if (!std::strcmp(cs.name, argv[a])) found = &cs;
+        if (!found) {
+            std::fprintf(stderr, "kfd_bench_instructions: unknown case '%s'\n", argv[a]);
+            return 2;
+        }
+        run.push_back(found);
+    }
+    if (run.empty())
+        for (const auto& cs : kCases) run.push_back(&cs);
+
+    Context c;
+    for (const Case* cs : run) {
+        warmUp(c, *cs);
+        const std::size_t size = cs->dropped_set ? c.sc.dropped.size() : c.sc.keyframes.size();
+        for (long i = 0; i < n; ++i) {
+            const std::size_t k = static_cast<std::size_t>(i) % size;
+            if (cs->dropped_set)
+                kb::restoreValid(c.sc.dropped[k], c.work_dropped[k]);
+            else
+                kb::restoreValid(c.sc.keyframes[k], c.work[k]);
+            cs->call(c, k);
+        }
+        std::printf("case %s calls %ld\n", cs->name, n);
+    }
+    if (c.surprises) {
+        std::fprintf(stderr, "kfd_bench_instructions: %zu scans took the wrong path\n",
+                     c.surprises);
+        return 1;
+    }
+    std::printf("checksum %zu\n", c.sink);
+    return 0;
+}

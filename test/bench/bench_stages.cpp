@@ -1,0 +1,213 @@
+// kfd_bench_stages: the cost of each per-scan stage on 1081-beam, 270-degree scans (the class
+// of the paper's MIT data), the paper's 0.752 m/s setting (m = 8, n = 20), and the baselines
+// on the same scans. Scans: bench_scans.h (ray-cast office floor, fixed seed).
+//
+// Stages that invalidate points get a fresh copy of the scan's valid flags before each call
+// (1081 bytes, BM_RestoreValid measures it) so every iteration does the same work.
+#include <benchmark/benchmark.h>
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "bench_scans.h"
+#include "kfd/core/correlation.h"
+#include "kfd/core/dbscan.h"
+#include "kfd/core/denoiser.h"
+#include "kfd/core/distance_filter.h"
+#include "kfd/core/histogram.h"
+#include "kfd/core/keyframe_selector.h"
+#include "kfd/core/pipeline.h"
+#include "kfd/core/radius_outlier.h"
+#include "kfd/core/statistical_outlier.h"
+
+namespace {
+
+using kfd::Scan;
+namespace kb = kfd::bench;
+
+const kb::Scenario& scenario() {
+    static const kb::Scenario s = kb::makeScenario();
+    return s;
+}
+
+void perScan(benchmark::State& state) {
+    state.SetItemsProcessed(state.iterations());  // items = scans
+    state.counters["beams"] = static_cast<double>(kb::kBeams);
+}
+
+// Runs `filter(scan)` (returns the points it removed) on the keyframe set in turn, restoring
+// valid flags before each call.
+template <class Filter>
+void runOnKeyframes(benchmark::State& state, Filter&& filter) {
+    const auto& pristine = scenario().keyframes;
+    std::vector<Scan> work = pristine;
+    double removed = 0.0;
+    std::size_t k = 0;
+    for (auto _ : state) {
+        Scan& s = work[k];
+        kb::restoreValid(pristine[k], s);
+        const std::size_t r = filter(s);
+        benchmark::DoNotOptimize(r);
+        removed += static_cast<double>(r);
+        k = (k + 1) % work.size();
+    }
+    perScan(state);
+    state.counters["removed"] = benchmark::Counter(removed, benchmark::Counter::kAvgIterations);
+}
+
+void BM_RestoreValid(benchmark::State& state) {
+    const auto& pristine = scenario().keyframes;
+    std::vector<Scan> work = pristine;
+    std::size_t k = 0;
+    for (auto _ : state) {
+        kb::restoreValid(pristine[k], work[k]);
+        benchmark::DoNotOptimize(work[k].valid.data());
+        benchmark::ClobberMemory();
+        k = (k + 1) % work.size();
+    }
+    perScan(state);
+}
+BENCHMARK(BM_RestoreValid);
+
+// Algorithm 1.
+void BM_DistanceFilter(benchmark::State& state) {
+    const kfd::DistanceFilter f(kb::paperParams().distance);
+    runOnKeyframes(state, [&](Scan& s) {
+        const auto r = f.filter(s);
+        return r.removed_non_finite + r.removed_out_of_range;
+    });
+}
+BENCHMARK(BM_DistanceFilter)->Unit(benchmark::kMicrosecond);
+
+// Sec. 3.1.2: n = 20 bins of mean range.
+void BM_Histogram(benchmark::State& state) {
+    const auto& scans = scenario().keyframes;
+    const kfd::Histogram h(kfd::Histogram::Params{20});
+    std::vector<double> out;
+    std::size_t k = 0;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(h.compute(scans[k], out));
+        benchmark::ClobberMemory();
+        k = (k + 1) % scans.size();
+    }
+    perScan(state);
+}
+BENCHMARK(BM_Histogram)->Unit(benchmark::kMicrosecond);
+
+// Formula 2: one Pearson correlation of two 20-bin histograms (a decision needs m = 8).
+void BM_Pearson(benchmark::State& state) {
+    const auto& scans = scenario().keyframes;
+    const kfd::Histogram h(kfd::Histogram::Params{20});
+    std::vector<std::vector<double>> hist(scans.size());
+    for (std::size_t k = 0; k < scans.size(); ++k) h.compute(scans[k], hist[k]);
+    std::size_t k = 0;
+    for (auto _ : state) {
+        const auto& a = hist[k];
+        const auto& b = hist[(k + 1) % hist.size()];
+        benchmark::DoNotOptimize(kfd::pearson(a.data(), b.data(), a.size()));
+        k = (k + 1) % hist.size();
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Pearson);
+
+// Sec. 3.1.4, Formula 3: histogram + m = 8 correlations + decision, on scans the full window
+// drops (the paper's 0.233 ms per dropped scan).
+void BM_KeyframeDecision(benchmark::State& state) {
+    const auto& sc = scenario();
+    kfd::KeyframeSelector sel(kb::paperParams().keyframe);
+    for (const auto& s : sc.prefix) sel.filter(s);
+    std::size_t k = 0, kept = 0;
+    for (auto _ : state) {
+        const auto d = sel.filter(sc.dropped[k]);
+        kept += d.keyframe ? 1 : 0;
+        k = (k + 1) % sc.dropped.size();
+    }
+    if (kept) state.SkipWithError("a scan of the dropped set was kept: scenario broken");
+    perScan(state);
+    state.counters["references"] = static_cast<double>(sel.windowSize());
+}
+BENCHMARK(BM_KeyframeDecision)->Unit(benchmark::kMicrosecond);
+
+// Algorithm 2 as published (t = 5 rings, theta = 10 x resolution) + the m_threshold = 10
+// cluster filter.
+void BM_DenoiseReference(benchmark::State& state) {
+    kfd::Denoiser d(kb::paperParams(kfd::DenoiseVariant::Reference).denoise);
+    runOnKeyframes(state, [&](Scan& s) { return d.filter(s).points_removed; });
+}
+BENCHMARK(BM_DenoiseReference)->Unit(benchmark::kMicrosecond);
+
+// kfd's range-aware clustering + range-adaptive cluster filter (default.ini's values).
+void BM_DenoiseRangeAware(benchmark::State& state) {
+    kfd::Denoiser d(kb::paperParams(kfd::DenoiseVariant::RangeAware).denoise);
+    runOnKeyframes(state, [&](Scan& s) { return d.filter(s).points_removed; });
+}
+BENCHMARK(BM_DenoiseRangeAware)->Unit(benchmark::kMicrosecond);
+
+// The paper's DBSCAN comparison (Eps 0.7 m, minPts 10), on the same scans as the denoisers.
+void BM_Dbscan(benchmark::State& state) {
+    kfd::DbscanFilter f(kfd::DbscanFilter::Params{0.7, 10});
+    runOnKeyframes(state, [&](Scan& s) { return f.filter(s).points_removed; });
+}
+BENCHMARK(BM_Dbscan)->Unit(benchmark::kMicrosecond);
+
+// Baselines with kfd's default parameters, on the same scans.
+void BM_RadiusOutlier(benchmark::State& state) {
+    kfd::RadiusOutlierFilter f(kfd::RadiusOutlierFilter::Params{});
+    runOnKeyframes(state, [&](Scan& s) { return f.filter(s).points_removed; });
+}
+BENCHMARK(BM_RadiusOutlier)->Unit(benchmark::kMicrosecond);
+
+void BM_StatisticalOutlier(benchmark::State& state) {
+    kfd::StatisticalOutlierFilter f(kfd::StatisticalOutlierFilter::Params{});
+    runOnKeyframes(state, [&](Scan& s) { return f.filter(s).points_removed; });
+}
+BENCHMARK(BM_StatisticalOutlier)->Unit(benchmark::kMicrosecond);
+
+// The whole per-scan call, Pipeline::process (distance -> keyframe -> denoise), when the
+// keyframe stage drops the scan.
+void BM_PipelineDropped(benchmark::State& state) {
+    const auto& sc = scenario();
+    kfd::Pipeline p(kb::paperParams());
+    for (Scan s : sc.prefix) p.process(s);
+    std::vector<Scan> work = sc.dropped;
+    std::size_t k = 0, kept = 0;
+    for (auto _ : state) {
+        Scan& s = work[k];
+        kb::restoreValid(sc.dropped[k], s);
+        const auto r = p.process(s);
+        kept += r.keep ? 1 : 0;
+        k = (k + 1) % work.size();
+    }
+    if (kept) state.SkipWithError("a scan of the dropped set was kept: scenario broken");
+    perScan(state);
+}
+BENCHMARK(BM_PipelineDropped)->Unit(benchmark::kMicrosecond);
+
+// The whole per-scan call when the scan is a keyframe and gets denoised (arg: 0 = reference
+// variant as in the paper, 1 = range-aware).
+void BM_PipelineKeyframe(benchmark::State& state) {
+    const auto variant =
+        state.range(0) == 0 ? kfd::DenoiseVariant::Reference : kfd::DenoiseVariant::RangeAware;
+    state.SetLabel(kfd::toString(variant));
+    const auto& pristine = scenario().keyframes;
+    kfd::Pipeline p(kb::paperParams(variant));
+    std::vector<Scan> work = pristine;
+    for (Scan s : pristine) p.process(s);  // fill the window, size the buffers
+    std::size_t k = 0, dropped = 0;
+    for (auto _ : state) {
+        Scan& s = work[k];
+        kb::restoreValid(pristine[k], s);
+        const auto r = p.process(s);
+        dropped += r.keep ? 0 : 1;
+        k = (k + 1) % work.size();
+    }
+    if (dropped) state.SkipWithError("a scan of the keyframe set was dropped: scenario broken");
+    perScan(state);
+}
+BENCHMARK(BM_PipelineKeyframe)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
