@@ -1,0 +1,142 @@
+#include "kfd/render/cluster_figure.h"
+
+#include <GL/osmesa.h>
+#include <mrpt/opengl/CFBORender.h>
+#include <mrpt/opengl/CGridPlaneXY.h>
+#include <mrpt/opengl/COpenGLScene.h>
+#include <mrpt/opengl/CPointCloudColoured.h>
+#include <mrpt/opengl/CSetOfLines.h>
+
+#include <cmath>
+#include <vector>
+
+namespace kfd {
+
+struct ClusterFigure::Impl {
+    OSMesaContext ctx = nullptr;
+    std::vector<unsigned char> buffer;
+    std::unique_ptr<mrpt::opengl::CFBORender> fbo;
+};
+
+ClusterFigure::ClusterFigure(const ClusterFigureOptions& opts)
+    : impl_(std::make_unique<Impl>()), opts_(opts) {
+    if (opts.width < 16 || opts.height < 16) throw RenderError("figure size too small");
+    // OSMesa core-profile context (see ../shared/notes/platform.md), then MRPT's FBO renderer.
+    const int attribs[] = {OSMESA_FORMAT,
+                           OSMESA_RGBA,
+                           OSMESA_DEPTH_BITS,
+                           24,
+                           OSMESA_PROFILE,
+                           OSMESA_CORE_PROFILE,
+                           OSMESA_CONTEXT_MAJOR_VERSION,
+                           3,
+                           OSMESA_CONTEXT_MINOR_VERSION,
+                           3,
+                           0};
+    impl_->ctx = OSMesaCreateContextAttribs(attribs, nullptr);
+    if (!impl_->ctx) throw RenderError("cannot create an OSMesa OpenGL 3.3 context");
+    impl_->buffer.resize(static_cast<std::size_t>(opts.width) * opts.height * 4);
+    if (!OSMesaMakeCurrent(impl_->ctx, impl_->buffer.data(), GL_UNSIGNED_BYTE, opts.width,
+                           opts.height))
+        throw RenderError("cannot make the OSMesa context current");
+    mrpt::opengl::CFBORender::Parameters p(opts.width, opts.height);
+    p.create_EGL_context = false;
+    impl_->fbo = std::make_unique<mrpt::opengl::CFBORender>(p);
+}
+
+ClusterFigure::~ClusterFigure() {
+    impl_->fbo.reset();
+    if (impl_->ctx) OSMesaDestroyContext(impl_->ctx);
+}
+
+std::array<std::uint8_t, 3> ClusterFigure::colourOf(std::int32_t label, bool noise) {
+    if (noise) return {230, 20, 20};
+    static const std::array<std::uint8_t, 3> palette[] = {
+        {31, 119, 180}, {44, 160, 44},   {148, 103, 189}, {140, 86, 75}, {23, 190, 207},
+        {188, 189, 34}, {227, 119, 194}, {255, 127, 14},  {80, 80, 80},  {0, 90, 50}};
+    return palette[static_cast<std::size_t>(label < 0 ? 0 : label) % 10];
+}
+
+std::pair<int, int> ClusterFigure::pixelOf(double x, double y) const {
+    // Orthographic top view: the visible height is 2 * half_extent_ metres.
+    const double s = 0.5 * opts_.height / half_extent_;
+    return {static_cast<int>(std::lround(0.5 * opts_.width + x * s)),
+            static_cast<int>(std::lround(0.5 * opts_.height - y * s))};
+}
+
+mrpt::img::CImage ClusterFigure::render(const Scan& scan, const Clusters& c) {
+    using namespace mrpt::opengl;
+    if (!OSMesaMakeCurrent(impl_->ctx, impl_->buffer.data(), GL_UNSIGNED_BYTE, opts_.width,
+                           opts_.height))
+        throw RenderError("cannot make the OSMesa context current");
+    COpenGLScene scene;
+    double extent = opts_.half_extent_m;
+    auto pts = CPointCloudColoured::Create();
+    auto noise = CPointCloudColoured::Create();
+    pts->setPointSize(opts_.point_size);
+    noise->setPointSize(2.0f * opts_.point_size);
+    for (std::size_t i = 0; i < scan.size() && i < c.label.size(); ++i) {
+        if (!scan.valid[i] || c.label[i] < 0) continue;
+        const double a = scan.geometry.angle(i), r = scan.range[i];
+        const float x = static_cast<float>(r * std::cos(a)),
+                    y = static_cast<float>(r * std::sin(a));
+        const bool is_noise = c.noise[static_cast<std::size_t>(c.label[i])] != 0;
+        const auto col = colourOf(c.label[i], is_noise);
+        (is_noise ? noise : pts)
+            ->insertPoint({x, y, is_noise ? 0.02f : 0.0f, col[0], col[1], col[2]});
+        if (opts_.half_extent_m <= 0)
+            extent = std::max({extent, std::abs(double(x)), std::abs(double(y))});
+    }
+    half_extent_ = opts_.half_extent_m > 0 ? opts_.half_extent_m : std::max(1.0, 1.05 * extent);
+    const double he = half_extent_ * std::max(1.0, double(opts_.width) / opts_.height);
+
+    auto grid =
+        CGridPlaneXY::Create(static_cast<float>(-std::ceil(he)), static_cast<float>(std::ceil(he)),
+                             static_cast<float>(-std::ceil(half_extent_)),
+                             static_cast<float>(std::ceil(half_extent_)), -0.01f, 1.0f);
+    grid->setColor_u8(220, 220, 220);
+    scene.insert(grid);
+    if (opts_.ring_r_max > 0 && opts_.rings > 0) {  // Formulas 6-8: r_i = sqrt(i) r_max / sqrt(t)
+        auto rings = CSetOfLines::Create();
+        rings->setColor_u8(200, 200, 235);
+        for (std::size_t i = 1; i <= opts_.rings; ++i) {
+            const double ri = std::sqrt(double(i) / double(opts_.rings)) * opts_.ring_r_max;
+            for (int k = 0; k < 180; ++k) {
+                const double a0 = 2 * kPi * k / 180, a1 = 2 * kPi * (k + 1) / 180;
+                rings->appendLine(ri * std::cos(a0), ri * std::sin(a0), -0.005, ri * std::cos(a1),
+                                  ri * std::sin(a1), -0.005);
+            }
+        }
+        scene.insert(rings);
+    }
+    auto marks = CSetOfLines::Create();  // sensor at the origin and a 1 m scale bar
+    marks->setColor_u8(0, 0, 0);
+    marks->setLineWidth(2.0f);
+    marks->appendLine(-0.15, -0.1, 0.01, 0.25, 0.0, 0.01);
+    marks->appendLine(0.25, 0.0, 0.01, -0.15, 0.1, 0.01);
+    marks->appendLine(-0.15, 0.1, 0.01, -0.15, -0.1, 0.01);
+    const double bx = -he * 0.9, by = -half_extent_ * 0.9;
+    marks->appendLine(bx, by, 0.01, bx + 1.0, by, 0.01);
+    marks->appendLine(bx, by - 0.05, 0.01, bx, by + 0.05, 0.01);
+    marks->appendLine(bx + 1.0, by - 0.05, 0.01, bx + 1.0, by + 0.05, 0.01);
+    scene.insert(marks);
+    scene.insert(pts);
+    scene.insert(noise);
+    scene.getViewport()->setCustomBackgroundColor({1.0f, 1.0f, 1.0f, 1.0f});
+
+    auto& cam = impl_->fbo->getCamera(scene);
+    cam.setOrthogonal(true);
+    cam.setAzimuthDegrees(-90.0f);
+    cam.setElevationDegrees(90.0f);
+    cam.setPointingAt(0.0f, 0.0f, 0.0f);
+    cam.setZoomDistance(static_cast<float>(4.0 * half_extent_));  // visible height = zoom / 2
+    mrpt::img::CImage img;
+    try {
+        impl_->fbo->render_RGB(scene, img);
+    } catch (const std::exception& e) {
+        throw RenderError(std::string("rendering failed: ") + e.what());
+    }
+    return img;
+}
+
+}  // namespace kfd

@@ -1,0 +1,119 @@
+// kfd/render/cluster_figure.h: render off-screen, read the pixels back.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <memory>
+
+#include "kfd/core/denoiser.h"
+#include "kfd/render/cluster_figure.h"
+
+namespace {
+
+// A wall at x = +2 m in front of the sensor, |y| <= 1.5 m.
+kfd::Scan wallAhead() {
+    kfd::Scan s;
+    s.geometry = kfd::ScanGeometry{721, kfd::kPi, true};
+    s.range.assign(721, 0.0f);
+    s.valid.assign(721, 0);
+    for (std::size_t i = 0; i < 721; ++i) {
+        const double c = std::cos(s.geometry.angle(i));
+        if (c < 0.8) continue;
+        s.range[i] = static_cast<float>(2.0 / c);
+        s.valid[i] = 1;
+    }
+    return s;
+}
+
+// CImage stores 3-channel images as BGR.
+std::array<std::uint8_t, 3> rgbAt(const mrpt::img::CImage& img, int x, int y) {
+    const auto* p = img.ptr<std::uint8_t>(x, y);
+    return {p[2], p[1], p[0]};
+}
+
+bool colourNear(const mrpt::img::CImage& img, int cx, int cy, std::array<std::uint8_t, 3> rgb) {
+    for (int dy = -2; dy <= 2; ++dy)
+        for (int dx = -2; dx <= 2; ++dx)
+            if (rgbAt(img, cx + dx, cy + dy) == rgb) return true;
+    return false;
+}
+
+std::size_t beamAt(const kfd::Scan& s, double angle) {
+    std::size_t best = 0;
+    for (std::size_t i = 0; i < s.size(); ++i)
+        if (std::abs(s.geometry.angle(i) - angle) < std::abs(s.geometry.angle(best) - angle))
+            best = i;
+    return best;
+}
+
+}  // namespace
+
+TEST(ClusterFigure, ClusterPointsHaveTheirColourPlusXIsRightAndPlusYIsUp) {
+    std::unique_ptr<kfd::ClusterFigure> fig;
+    try {
+        kfd::ClusterFigureOptions o;
+        o.width = o.height = 400;
+        o.half_extent_m = 3.0;
+        fig = std::make_unique<kfd::ClusterFigure>(o);
+    } catch (const kfd::RenderError& e) {
+        GTEST_SKIP() << "no off-screen OpenGL here: " << e.what();
+    }
+    const kfd::Scan s = wallAhead();
+    kfd::Denoiser den;  // reference variant: the wall is one cluster
+    kfd::Scan work = s;
+    den.filter(work);
+    const auto img = fig->render(s, den.clusters());
+    ASSERT_EQ(img.getWidth(), 400u);
+    ASSERT_EQ(img.getHeight(), 400u);
+
+    // A wall point on the +y side: (2, 2 tan 0.5) = (2, 1.09) m.
+    const std::size_t i = beamAt(s, 0.5);
+    ASSERT_TRUE(s.valid[i]);
+    const auto label = den.clusters().label[i];
+    ASSERT_GE(label, 0);
+    const double x = s.range[i] * std::cos(s.geometry.angle(i));
+    const double y = s.range[i] * std::sin(s.geometry.angle(i));
+    const auto [px, py] = fig->pixelOf(x, y);
+    EXPECT_GT(px, 200);  // +x right of the centre
+    EXPECT_LT(py, 200);  // +y above the centre
+    EXPECT_TRUE(colourNear(img, px, py, kfd::ClusterFigure::colourOf(label, false)))
+        << "no cluster colour near (" << px << ", " << py << ")";
+    // The mirrored place (-x, same y) is empty: background or grid, light grey at most.
+    const auto [mx, my] = fig->pixelOf(-x, y);
+    const auto bg = rgbAt(img, mx, my);
+    EXPECT_GE(int(bg[0]) + bg[1] + bg[2], 3 * 200);
+    // Not blank: many coloured pixels.
+    std::size_t coloured = 0;
+    for (unsigned r = 0; r < img.getHeight(); ++r)
+        for (unsigned c = 0; c < img.getWidth(); ++c) {
+            const auto v = rgbAt(img, int(c), int(r));
+            coloured +=
+                std::abs(int(v[0]) - int(v[1])) > 40 || std::abs(int(v[2]) - int(v[1])) > 40;
+        }
+    EXPECT_GT(coloured, 100u);
+}
+
+TEST(ClusterFigure, NoisePointsAreRed) {
+    std::unique_ptr<kfd::ClusterFigure> fig;
+    try {
+        kfd::ClusterFigureOptions o;
+        o.width = o.height = 300;
+        o.half_extent_m = 3.0;
+        fig = std::make_unique<kfd::ClusterFigure>(o);
+    } catch (const kfd::RenderError& e) {
+        GTEST_SKIP() << "no off-screen OpenGL here: " << e.what();
+    }
+    kfd::Scan s = wallAhead();
+    const std::size_t lone = beamAt(s, -1.2);  // an isolated return far from the wall
+    s.range[lone] = 1.5f;
+    s.valid[lone] = 1;
+    kfd::Denoiser den;
+    kfd::Scan work = s;
+    den.filter(work);
+    ASSERT_FALSE(work.valid[lone]);  // removed as noise
+    const auto img = fig->render(s, den.clusters());
+    const auto [px, py] = fig->pixelOf(1.5 * std::cos(s.geometry.angle(lone)),
+                                       1.5 * std::sin(s.geometry.angle(lone)));
+    EXPECT_GT(py, 150);  // -y below the centre
+    EXPECT_TRUE(colourNear(img, px, py, kfd::ClusterFigure::colourOf(0, true)));
+}
