@@ -8,6 +8,7 @@
 
 #include "kfd/eval/trajectory.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/sim/simulator.h"
 #include "kfd/slam/icp_slam_runner.h"
 
 namespace fs = std::filesystem;
@@ -101,8 +102,8 @@ TEST(IcpSlamRunner, KfdOnMitCsailHasBoundedErrorAndAPoseForEveryScan) {
     const auto traj = kfd::readTum(dir / "out/trajectory.tum");
     EXPECT_EQ(traj.size(), s.scans_in);
     EXPECT_EQ(lines(dir / "out/scans.csv"), s.scans_in + 1);
-    for (const char* f :
-         {"summary.json", "final_map.simplemap", "map.png", "log_estimated_path.txt"})
+    for (const char* f : {"summary.json", "final_map.simplemap", "map.png", "map_figure.png",
+                          "report.md", "log_estimated_path.txt"})
         EXPECT_TRUE(fs::exists(dir / (std::string("out/") + f))) << f;
     const std::string json = text(dir / "out/summary.json");
     for (const char* key : {"\"scans_in\"", "\"scans_kept\"", "\"dropped_pct\"",
@@ -262,4 +263,22 @@ TEST(IcpSlamRunner, RadiusAndSorModesRunAndKeepEveryScan) {
         EXPECT_NE(json.find(std::string("\"mode\": \"") + kfd::toString(mode) + "\""),
                   std::string::npos);
     }
+}
+
+TEST(IcpSlamRunner, GroundTruthTrajectoryGivesAteAndAReport) {
+    TempDir dir;
+    kfd::SimulationOptions so;
+    so.duration_s = 8.0;
+    so.output = dir / "sim.rawlog";
+    const auto sim = kfd::Simulator().run(so);
+    auto o = options(sim.rawlog, dir / "out", kfd::PrefilterMode::None);
+    o.ground_truth_tum = sim.ground_truth;
+    const auto s = kfd::IcpSlamRunner().run(o);
+    ASSERT_TRUE(s.ate_rmse.has_value());
+    EXPECT_LT(*s.ate_rmse, 0.1);  // ICP-SLAM on clean simulated scans: centimetres
+    EXPECT_NE(text(dir / "out/summary.json").find("\"ate_rmse_m\""), std::string::npos);
+    const std::string report = text(dir / "out/report.md");
+    EXPECT_NE(report.find("ATE RMSE"), std::string::npos);
+    EXPECT_NE(report.find("map_figure.png"), std::string::npos);
+    EXPECT_TRUE(fs::exists(dir / "out/map_figure.png"));
 }

@@ -25,13 +25,15 @@ const char* kUsage =
     "      --match-drop PCT    odometry mode: pick the motion thresholds that drop PCT %% of\n"
     "                          the scans (e.g. kfd's drop rate on the same log)\n"
     "  -g, --relations FILE    ground-truth .relations: report the relations error\n"
-    "      --max-dt S          stamp matching tolerance for the relations (default 0.001)\n"
+    "      --gt FILE           ground-truth trajectory (TUM): ATE RMSE, drawn in the figure\n"
+    "      --max-dt S          stamp matching tolerance (default 0.001)\n"
     "      --no-map            skip final_map.simplemap and map.png\n"
     "  -q, --quiet             no progress on stderr\n"
     "  -h, --help              this text\n"
     "\n"
     "Writes trajectory.tum (a pose for every input scan), log_estimated_path.txt (icp-slam's\n"
-    "format), scans.csv, summary.json, final_map.simplemap and map.png into the output folder.\n"
+    "format), scans.csv, summary.json, final_map.simplemap, map.png, map_figure.png and\n"
+    "report.md into the output folder.\n"
     "Exit status: 0 on success, 1 on bad input or configuration, 2 on bad usage.\n";
 
 int usageError(const std::string& msg) {
@@ -53,7 +55,7 @@ int main(int argc, char** argv) {
             return 0;
         } else if (a == "-i" || a == "--rawlog" || a == "-o" || a == "--out" || a == "-m" ||
                    a == "--mode" || a == "-g" || a == "--relations" || a == "--max-dt" ||
-                   a == "--match-drop") {
+                   a == "--match-drop" || a == "--gt") {
             const char* v = next();
             if (!v) return usageError(a + " needs a value");
             try {
@@ -67,6 +69,8 @@ int main(int argc, char** argv) {
                     o.relations = v;
                 else if (a == "--max-dt")
                     o.relations_max_dt = std::stod(v);
+                else if (a == "--gt")
+                    o.ground_truth_tum = v;
                 else
                     o.odometry_target_drop_pct = std::stod(v);
             } catch (const std::exception& e) {
@@ -109,6 +113,7 @@ int main(int argc, char** argv) {
             "  time       pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s, "
             "wall %.2f s\n",
             s.prefilter_us_per_scan, s.icp_ms_per_scan, s.cpu_s_total, s.wall_s_total);
+        if (s.ate_rmse) std::printf("  ATE        RMSE %.4f m\n", *s.ate_rmse);
         if (s.relations) {
             const auto& r = *s.relations;
             std::printf(

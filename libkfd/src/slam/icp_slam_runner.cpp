@@ -21,8 +21,10 @@
 #include <filesystem>
 #include <fstream>
 
+#include "kfd/eval/ate.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/stream_filter.h"
+#include "kfd/render/map_figure.h"
 
 namespace kfd {
 namespace {
@@ -229,7 +231,8 @@ IcpSlamSummary IcpSlamRunner::run(const IcpSlamOptions& opts) {
         static_cast<double>(std::max<std::uintmax_t>(1, fs::file_size(sum.rawlog, ec)));
     auto arch = mrpt::serialization::archiveFrom(in);
 
-    Trajectory traj;
+    Trajectory traj, odo_traj;
+    std::vector<std::size_t> keyframes;
     OdometryTracker odo;
     double prefilter_us = 0.0, builder_s = 0.0;
     std::size_t entry = 0, step = 0;
@@ -298,6 +301,8 @@ IcpSlamSummary IcpSlamRunner::run(const IcpSlamOptions& opts) {
                       pose.yaw());
         f_path << buf;
         for (const auto& s : entry_scans) {
+            if (s.r.keep) keyframes.push_back(traj.size());
+            if (odo.current) odo_traj.push_back(StampedPose{s.t, *odo.current});
             traj.push_back(StampedPose{s.t, Pose2D{pose.x(), pose.y(), pose.yaw()}});
             const auto& rep = s.r.report;
             std::snprintf(buf, sizeof(buf), "%zu,%.6f,%s,%d,%s,%.6f,%zu,%zu,%.2f,%.6f,%.6f,%.6f\n",
@@ -320,6 +325,14 @@ IcpSlamSummary IcpSlamRunner::run(const IcpSlamOptions& opts) {
     f_csv.close();
     writeTum((out / "trajectory.tum").string(), traj);
 
+    Trajectory gt;
+    if (!opts.ground_truth_tum.empty()) {
+        gt = readTum(opts.ground_truth_tum);  // EvalError
+        sortByTime(gt);
+        Trajectory sorted = traj;
+        sortByTime(sorted);
+        sum.ate_rmse = computeAte(sorted, gt, opts.relations_max_dt).rmse;
+    }
     if (opts.write_map) {
         builder.saveCurrentMapToFile((out / "final_map.simplemap").string());
         mrpt::maps::CSimpleMap sm;
@@ -327,6 +340,14 @@ IcpSlamSummary IcpSlamRunner::run(const IcpSlamOptions& opts) {
         mrpt::maps::COccupancyGridMap2D grid(-10, 10, -10, 10, 0.05f);
         grid.loadFromSimpleMap(sm);
         grid.saveAsBitmapFile((out / "map.png").string());
+        MapFigureInput fig;
+        fig.grid = &grid;
+        fig.estimate = traj;
+        fig.ground_truth = gt;
+        fig.odometry = odo_traj;
+        fig.keyframes = keyframes;
+        fig.title = fs::path(sum.rawlog).filename().string() + "  mode " + toString(opts.mode);
+        renderMapFigure(fig).saveToFile((out / "map_figure.png").string());
     }
 
     sum.dropped_pct = sum.scans_in ? 100.0 * static_cast<double>(sum.scans_in - sum.scans_kept) /
@@ -346,6 +367,33 @@ IcpSlamSummary IcpSlamRunner::run(const IcpSlamOptions& opts) {
     sum.wall_s_total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     std::ofstream((out / "summary.json").string()) << toJson(sum);
+    if (opts.write_map) {  // a human-readable report tying the figure to the numbers
+        std::ofstream r((out / "report.md").string());
+        char line[512];
+        r << "# kfd-icp-slam report\n\n";
+        r << "- rawlog: `" << sum.rawlog << "`\n- pre-filter mode: **" << toString(sum.mode)
+          << "**\n";
+        std::snprintf(line, sizeof(line),
+                      "- scans: %zu in, %zu kept (%.1f %% dropped); points removed: %zu of %zu\n"
+                      "- time: pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s\n",
+                      sum.scans_in, sum.scans_kept, sum.dropped_pct, sum.points_removed,
+                      sum.points_in, sum.prefilter_us_per_scan, sum.icp_ms_per_scan,
+                      sum.cpu_s_total);
+        r << line;
+        if (sum.relations) {
+            std::snprintf(line, sizeof(line),
+                          "- relations error (%zu used, %zu unmatched): %.4f +- %.4f m, %.3f +- "
+                          "%.3f deg\n",
+                          sum.relations->used, sum.relations->unmatched, sum.relations->trans_mean,
+                          sum.relations->trans_std, sum.relations->rot_mean_deg,
+                          sum.relations->rot_std_deg);
+            r << line;
+        }
+        if (sum.ate_rmse) r << "- ATE RMSE after SE(2) alignment: " << *sum.ate_rmse << " m\n";
+        r << "\n![map, estimate (blue, dots = keyframes), ground truth (green), odometry (grey)]"
+             "(map_figure.png)\n\nAll numbers: `summary.json`; per scan: `scans.csv`; "
+             "trajectory: `trajectory.tum`.\n";
+    }
     return sum;
 }
 
@@ -375,6 +423,10 @@ std::string toJson(const IcpSlamSummary& s) {
                   s.wall_s_total, s.pipeline.motion.max_distance_m,
                   s.pipeline.motion.max_angle_deg);
     std::string j = buf;
+    if (s.ate_rmse) {
+        std::snprintf(buf, sizeof(buf), ",\n  \"ate_rmse_m\": %.6f", *s.ate_rmse);
+        j += buf;
+    }
     if (s.relations) {
         const auto& r = *s.relations;
         std::snprintf(buf, sizeof(buf),

@@ -44,7 +44,8 @@ struct IcpSlamOptions {
     std::optional<double> odometry_target_drop_pct;
     std::string relations;           // ground truth (.relations), optional
     double relations_max_dt = 1e-3;  // s, stamp matching tolerance
-    bool write_map = true;           // .simplemap and occupancy-grid PNG
+    std::string ground_truth_tum;    // ground-truth trajectory (TUM), optional: ATE and figure
+    bool write_map = true;           // .simplemap, occupancy-grid PNG, map_figure.png and report.md
     std::function<void(const IcpSlamProgress&)> on_progress;
 };
 
@@ -62,6 +63,7 @@ struct IcpSlamSummary {
     double wall_s_total = 0.0;
     Pipeline::Params pipeline;  // what ran
     std::optional<RelationsError> relations;
+    std::optional<double> ate_rmse;  // m, against ground_truth_tum after SE(2) alignment
     std::string relations_file;
 };
 
@@ -80,7 +82,8 @@ class SlamError : public std::runtime_error {
 ///
 /// Writes into the output folder: trajectory.tum (one pose per input scan, TUM format),
 /// log_estimated_path.txt (icp-slam's "step x y phi", one per rawlog entry), scans.csv,
-/// summary.json, and with write_map final_map.simplemap and map.png (occupancy grid).
+/// summary.json, and with write_map final_map.simplemap, map.png (occupancy grid),
+/// map_figure.png (grid + estimate, keyframes, odometry and ground truth) and report.md.
 class IcpSlamRunner {
   public:
     IcpSlamSummary run(const IcpSlamOptions& opts);

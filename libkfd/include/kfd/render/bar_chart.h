@@ -1,0 +1,30 @@
+// Grouped bar charts with error bars, drawn with MRPT's 2D canvas (no OpenGL, no display).
+#pragma once
+
+#include <mrpt/img/CImage.h>
+
+#include <string>
+#include <vector>
+
+namespace kfd {
+
+struct BarChart {
+    std::string title, y_label;
+    std::vector<std::string> groups;          // x categories (e.g. datasets)
+    std::vector<std::string> series;          // bars per group (e.g. modes)
+    std::vector<std::vector<double>> values;  // [group][series]; NaN = no bar
+    std::vector<std::vector<double>> errors;  // same shape, optional (+- error bar)
+    bool log_y = false;
+    int width = 1000, height = 500;
+
+    /// Throws std::invalid_argument when the shapes do not match or a log axis has a value <= 0.
+    mrpt::img::CImage render() const;
+    /// The colour of series s (R, G, B), shared by bars and legend.
+    static mrpt::img::TColor seriesColour(std::size_t s);
+};
+
+/// Reads "group,series,value[,error]" rows (header line first) into a chart, keeping first-seen
+/// order of groups and series. Throws std::runtime_error on malformed input.
+BarChart readBarChartCsv(const std::string& path);
+
+}  // namespace kfd
