@@ -42,6 +42,20 @@ def main():
         chart(time, "time-per-scan.png",
               "Pre-filter + ICP-SLAM time per input scan", "ms per scan")
         chart(drop, "dropped.png", "Scans dropped by the pre-filter", "% of scans")
+    bench = os.path.join(ROOT, "out", "bench", "stages.json")  # from share/scripts/bench.sh
+    if os.path.exists(bench):
+        names = {"BM_DistanceFilter": "distance", "BM_Histogram": "histogram",
+                 "BM_KeyframeDecision": "keyframe decision", "BM_DenoiseReference": "denoise ref",
+                 "BM_DenoiseRangeAware": "denoise r-aware", "BM_PipelineDropped": "scan dropped",
+                 "BM_PipelineKeyframe/1": "keyframe kept", "BM_Dbscan": "DBSCAN",
+                 "BM_RadiusOutlier": "radius", "BM_StatisticalOutlier": "SOR"}
+        rows = []
+        for b in json.load(open(bench))["benchmarks"]:
+            if b.get("aggregate_name") == "median" and b["run_name"] in names:
+                us = b["cpu_time"] / (1000.0 if b["time_unit"] == "ns" else 1.0)
+                rows.append((names[b["run_name"]], "median CPU time", us, 0))
+        chart(rows, "time-per-stage.png",
+              "Time per 1081-beam scan by stage (Google Benchmark medians)", "us, log", True)
     sim = os.path.join(ROOT, "out", "sim-slam", "results.json")
     if os.path.exists(sim):
         res = json.load(open(sim))

@@ -14,6 +14,7 @@ import json
 import os
 import re
 import subprocess
+import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BIN = os.path.join(ROOT, "build", "apps")
@@ -80,3 +81,6 @@ def main():
 
 if __name__ == "__main__":
     main()
+    # Render the charts of docs/RESULTS.md from the results just written.
+    subprocess.run([sys.executable, os.path.join(ROOT, "share", "scripts", "charts.py")],
+                   check=True, stdout=sys.stderr)

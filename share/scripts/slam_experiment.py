@@ -80,3 +80,6 @@ def main():
 
 if __name__ == "__main__":
     main()
+    # Render the charts of docs/RESULTS.md from the results just written.
+    subprocess.run([sys.executable, os.path.join(ROOT, "share", "scripts", "charts.py")],
+                   check=True, stdout=sys.stderr)

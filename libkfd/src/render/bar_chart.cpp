@@ -76,7 +76,9 @@ mrpt::img::CImage BarChart::render() const {
     const double bw = gw * 0.8 / std::max<std::size_t>(1, series.size());
     for (std::size_t g = 0; g < groups.size(); ++g) {
         const int gx = left + static_cast<int>(g * gw + 0.1 * gw);
-        img.textOut(gx, bottom + 6, groups[g], black);
+        // 6x13 font: 6 px per character; cut labels to the group's width.
+        const std::size_t fit = static_cast<std::size_t>(std::max(1.0, 0.95 * gw / 6.0));
+        img.textOut(gx, bottom + 6, groups[g].substr(0, fit), black);
         for (std::size_t s = 0; s < series.size(); ++s) {
             const double v = values[g][s];
             if (std::isnan(v)) continue;

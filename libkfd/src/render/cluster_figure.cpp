@@ -136,6 +136,14 @@ mrpt::img::CImage ClusterFigure::render(const Scan& scan, const Clusters& c) {
     } catch (const std::exception& e) {
         throw RenderError(std::string("rendering failed: ") + e.what());
     }
+    // Legend (bitmap font, drawn on the rendered image).
+    const mrpt::img::TColor black(0, 0, 0), red(230, 20, 20);
+    img.selectTextFont("6x13");
+    img.textOut(8, 6, "clusters: one colour each", black);
+    img.filledRectangle(8, 24, 16, 32, red);
+    img.textOut(22, 22, "removed as noise", black);
+    img.textOut(8, 38, "1 m grid; bar (bottom left) = 1 m; sensor at centre", black);
+    if (opts_.ring_r_max > 0) img.textOut(8, 54, "rings: equal-area boundaries", black);
     return img;
 }
 
