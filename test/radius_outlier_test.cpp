@@ -33,17 +33,8 @@ RadiusOutlierFilter::Params params(double radius_m, std::size_t min_neighbors) {
 /// points exactly at the radius.
 Scan line(const std::vector<float>& ranges) { return test::makeScan(ranges, 0.0); }
 
-std::vector<std::uint8_t> flags(std::initializer_list<int> v) {
-    return std::vector<std::uint8_t>(v.begin(), v.end());
-}
-
 std::string whatOf(const RadiusOutlierFilter::Params& p) {
-    try {
-        RadiusOutlierFilter f(p);
-    } catch (const std::invalid_argument& e) {
-        return e.what();
-    }
-    return "<no error>";
+    return test::constructionError<RadiusOutlierFilter>(p);
 }
 
 // --- Parameters -----------------------------------------------------------------------------
@@ -116,17 +107,17 @@ TEST(RadiusOutlierFilter, ExactlyAtTheRadiusAndExactlyMinNeighbors) {
         return s.valid;
     };
     // Neighbours exactly 1 m away are within a 1 m radius.
-    EXPECT_EQ(run(1.0, 1), flags({1, 1, 1, 1, 0}));
-    EXPECT_EQ(run(0.999, 1), flags({0, 0, 0, 0, 0}));
+    EXPECT_EQ(run(1.0, 1), test::flags({1, 1, 1, 1, 0}));
+    EXPECT_EQ(run(0.999, 1), test::flags({0, 0, 0, 0, 0}));
     // 11 and 12 have exactly 2 others within 1 m: enough for 2, not for 3.
-    EXPECT_EQ(run(1.0, 2), flags({0, 1, 1, 0, 0}));
-    EXPECT_EQ(run(1.0, 3), flags({0, 0, 0, 0, 0}));
+    EXPECT_EQ(run(1.0, 2), test::flags({0, 1, 1, 0, 0}));
+    EXPECT_EQ(run(1.0, 3), test::flags({0, 0, 0, 0, 0}));
     // Within 2 m: 10 and 13 have 2 others, 11 and 12 have 3.
-    EXPECT_EQ(run(2.0, 2), flags({1, 1, 1, 1, 0}));
-    EXPECT_EQ(run(2.0, 3), flags({0, 1, 1, 0, 0}));
+    EXPECT_EQ(run(2.0, 2), test::flags({1, 1, 1, 1, 0}));
+    EXPECT_EQ(run(2.0, 3), test::flags({0, 1, 1, 0, 0}));
     // 20 is 7 m from 13.
-    EXPECT_EQ(run(7.0, 1), flags({1, 1, 1, 1, 1}));
-    EXPECT_EQ(run(6.5, 1), flags({1, 1, 1, 1, 0}));
+    EXPECT_EQ(run(7.0, 1), test::flags({1, 1, 1, 1, 1}));
+    EXPECT_EQ(run(6.5, 1), test::flags({1, 1, 1, 1, 0}));
 }
 
 TEST(RadiusOutlierFilter, ThePointItselfIsNotCountedButDuplicatesAre) {
@@ -136,7 +127,7 @@ TEST(RadiusOutlierFilter, ThePointItselfIsNotCountedButDuplicatesAre) {
     Scan pair = line({4.0f, 4.0f, 9.0f});          // two points at the same place
     const auto r = f.filter(pair);
     EXPECT_EQ(r.points_removed, 1u);
-    EXPECT_EQ(pair.valid, flags({1, 1, 0}));
+    EXPECT_EQ(pair.valid, test::flags({1, 1, 0}));
 }
 
 TEST(RadiusOutlierFilter, EveryPointIsJudgedOnTheInputScan) {
@@ -145,28 +136,28 @@ TEST(RadiusOutlierFilter, EveryPointIsJudgedOnTheInputScan) {
     RadiusOutlierFilter f(params(0.5, 2));
     Scan s = line({5.0f, 5.5f, 6.0f});
     EXPECT_EQ(f.filter(s).points_removed, 2u);
-    EXPECT_EQ(s.valid, flags({0, 1, 0}));
+    EXPECT_EQ(s.valid, test::flags({0, 1, 0}));
 }
 
 TEST(RadiusOutlierFilter, InvalidBeamsAreIgnored) {
     RadiusOutlierFilter f(params(0.5, 1));
     Scan s = line({4.0f, 4.2f, 7.0f, 7.1f});
-    s.valid = flags({1, 0, 0, 1});  // each valid point's only neighbour is invalid
+    s.valid = test::flags({1, 0, 0, 1});  // each valid point's only neighbour is invalid
     const auto r = f.filter(s);
     EXPECT_EQ(r.points_in, 2u);
     EXPECT_EQ(r.points_removed, 2u);
-    EXPECT_EQ(s.valid, flags({0, 0, 0, 0}));
+    EXPECT_EQ(s.valid, test::flags({0, 0, 0, 0}));
 }
 
 TEST(RadiusOutlierFilter, NonFiniteRangesAreRemoved) {
     RadiusOutlierFilter f(params(0.5, 1));
     Scan s = line({4.0f, 4.2f, std::numeric_limits<float>::quiet_NaN(),
                    std::numeric_limits<float>::infinity(), 4.1f});
-    s.valid = flags({1, 1, 1, 1, 0});
+    s.valid = test::flags({1, 1, 1, 1, 0});
     const auto r = f.filter(s);
     EXPECT_EQ(r.points_in, 4u);
     EXPECT_EQ(r.points_removed, 2u);
-    EXPECT_EQ(s.valid, flags({1, 1, 0, 0, 0}));
+    EXPECT_EQ(s.valid, test::flags({1, 1, 0, 0, 0}));
 }
 
 TEST(RadiusOutlierFilter, EmptyScans) {
@@ -303,8 +294,8 @@ std::vector<std::uint8_t> plainRadiusOutlier(const Scan& s, double radius_m,
 TEST(RadiusOutlierFilter, ReferenceAgreesWithHandMadeCase) {
     // Guards the reference the random comparison relies on.
     const Scan s = line({10.0f, 11.0f, 12.0f, 13.0f, 20.0f});
-    EXPECT_EQ(plainRadiusOutlier(s, 1.0, 2), flags({0, 1, 1, 0, 0}));
-    EXPECT_EQ(plainRadiusOutlier(s, 2.0, 2), flags({1, 1, 1, 1, 0}));
+    EXPECT_EQ(plainRadiusOutlier(s, 1.0, 2), test::flags({0, 1, 1, 0, 0}));
+    EXPECT_EQ(plainRadiusOutlier(s, 2.0, 2), test::flags({1, 1, 1, 1, 0}));
 }
 
 TEST(RadiusOutlierFilter, MatchesPlainImplementationOnRandomScans) {

@@ -34,17 +34,8 @@ StatisticalOutlierFilter::Params params(std::size_t k, double std_mul) {
 /// exactly, so distances, their means and the statistics below are exact in binary.
 Scan line(const std::vector<float>& ranges) { return test::makeScan(ranges, 0.0); }
 
-std::vector<std::uint8_t> flags(std::initializer_list<int> v) {
-    return std::vector<std::uint8_t>(v.begin(), v.end());
-}
-
 std::string whatOf(const StatisticalOutlierFilter::Params& p) {
-    try {
-        StatisticalOutlierFilter f(p);
-    } catch (const std::invalid_argument& e) {
-        return e.what();
-    }
-    return "<no error>";
+    return test::constructionError<StatisticalOutlierFilter>(p);
 }
 
 // --- Parameters -----------------------------------------------------------------------------
@@ -145,13 +136,13 @@ TEST(StatisticalOutlierFilter, FewerPointsThanKUsesAllOthers) {
     f.initialize(params(8, 0.99));
     r = f.filter(s);
     EXPECT_EQ(r.points_removed, 1u);
-    EXPECT_EQ(s.valid, flags({1, 1, 0}));
+    EXPECT_EQ(s.valid, test::flags({1, 1, 0}));
     // k = 1: d = 1, 1, 2; mu = 4/3, sigma = sqrt(1/3): 13 is above mu + 0.5 sigma.
     s = input;
     f.initialize(params(1, 0.5));
     r = f.filter(s);
     EXPECT_EQ(f.meanDistances(), (std::vector<double>{1.0, 1.0, 2.0}));
-    EXPECT_EQ(s.valid, flags({1, 1, 0}));
+    EXPECT_EQ(s.valid, test::flags({1, 1, 0}));
 }
 
 TEST(StatisticalOutlierFilter, TwoPointsAreAlwaysKept) {
@@ -207,11 +198,11 @@ TEST(StatisticalOutlierFilter, InvalidAndNonFiniteBeams) {
     // out of the statistics.
     const Scan clean = line({10.0f, 11.0f, 13.0f, 50.0f, 12.0f});
     Scan a = clean;
-    a.valid = flags({1, 1, 1, 0, 0});
+    a.valid = test::flags({1, 1, 1, 0, 0});
     Scan b = clean;
     b.range[3] = std::numeric_limits<float>::quiet_NaN();
     b.range[4] = -std::numeric_limits<float>::infinity();
-    b.valid = flags({1, 1, 1, 1, 1});
+    b.valid = test::flags({1, 1, 1, 1, 1});
     StatisticalOutlierFilter f(params(8, 1.0));
     const auto ra = f.filter(a);
     const auto da = f.meanDistances();
@@ -220,7 +211,7 @@ TEST(StatisticalOutlierFilter, InvalidAndNonFiniteBeams) {
     EXPECT_EQ(ra.points_removed, 0u);
     EXPECT_EQ(rb.points_in, 5u);
     EXPECT_EQ(rb.points_removed, 2u);
-    EXPECT_EQ(b.valid, flags({1, 1, 1, 0, 0}));
+    EXPECT_EQ(b.valid, test::flags({1, 1, 1, 0, 0}));
     EXPECT_EQ(rb.mean_distance, ra.mean_distance);
     EXPECT_EQ(rb.threshold, ra.threshold);
     EXPECT_EQ(ra.threshold, 2.5);
@@ -385,7 +376,7 @@ TEST(StatisticalOutlierFilter, ReferenceAgreesWithHandMadeCase) {
     EXPECT_EQ(e.mean, (std::vector<double>{2.0, 1.5, 2.5}));
     EXPECT_EQ(e.mu, 2.0);
     EXPECT_EQ(e.sigma, 0.5);
-    EXPECT_EQ(e.valid, flags({1, 1, 0}));
+    EXPECT_EQ(e.valid, test::flags({1, 1, 0}));
 }
 
 TEST(StatisticalOutlierFilter, MatchesPlainImplementationOnRandomScans) {

@@ -8,6 +8,8 @@
 #include <initializer_list>
 #include <map>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "kfd/core/scan.h"
@@ -16,6 +18,22 @@ namespace kfd {
 namespace test {
 
 inline double deg2rad(double deg) { return deg * kPi / 180.0; }
+
+/// A valid-flag vector written inline: flags({1, 0, 1}).
+inline std::vector<std::uint8_t> flags(std::initializer_list<int> v) {
+    return std::vector<std::uint8_t>(v.begin(), v.end());
+}
+
+/// The std::invalid_argument text a Filter's constructor gives for `p`, or "<no error>".
+template <class Filter>
+std::string constructionError(const typename Filter::Params& p) {
+    try {
+        Filter f(p);
+    } catch (const std::invalid_argument& e) {
+        return e.what();
+    }
+    return "<no error>";
+}
 
 /// Geometry of `beams` beams over `aperture` rad (MRPT convention, see ScanGeometry).
 inline ScanGeometry geometry(std::size_t beams, double aperture, bool right_to_left = true) {

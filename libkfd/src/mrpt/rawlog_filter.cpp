@@ -204,7 +204,7 @@ void Run::flushPendingAction(bool frame_kept) {
 }
 
 void Run::handleFrame(const std::shared_ptr<CSensoryFrame>& sf) {
-    std::size_t scans = 0, dropped = 0;
+    std::size_t scans = 0;
     for (auto it = sf->begin(); it != sf->end();) {
         auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(*it);
         if (!scan) {
@@ -216,7 +216,6 @@ void Run::handleFrame(const std::shared_ptr<CSensoryFrame>& sf) {
             ++it;
         } else {
             it = sf->erase(it);
-            ++dropped;
         }
     }
     const bool frame_kept = !(scans > 0 && sf->size() == 0);

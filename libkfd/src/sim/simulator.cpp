@@ -23,9 +23,9 @@ constexpr double kDeg = kPi / 180.0;
 
 // The route as a sequence of primitive motions, sampled at a fixed rate.
 struct Motion {
-    enum Kind { Turn, Drive, Stop } kind;
-    double value;  // Turn: target heading change (rad); Drive: target (x, y); Stop: seconds
-    double x = 0, y = 0;
+    enum Kind { TurnTo, Spin, Drive, Stop } kind;
+    double value = 0;     // TurnTo: heading (rad); Spin: angle (rad); Stop: seconds
+    double x = 0, y = 0;  // Drive: target (m)
 };
 
 std::vector<Motion> plan(const World& w) {
@@ -33,12 +33,10 @@ std::vector<Motion> plan(const World& w) {
     for (std::size_t i = 1; i < w.route.size(); ++i) {
         const auto& a = w.route[i - 1];
         const auto& b = w.route[i];
-        Motion d{Motion::Drive, 0.0, b.x, b.y};
-        d.value = std::atan2(b.y - a.y, b.x - a.x);  // heading of the leg
-        m.push_back(Motion{Motion::Turn, d.value});
-        m.push_back(d);
+        m.push_back(Motion{Motion::TurnTo, std::atan2(b.y - a.y, b.x - a.x)});  // face the leg
+        m.push_back(Motion{Motion::Drive, 0.0, b.x, b.y});
         if (b.stop_s > 0) m.push_back(Motion{Motion::Stop, b.stop_s});
-        if (b.spin_deg != 0) m.push_back(Motion{Motion::Turn, std::nan(""), b.spin_deg * kDeg});
+        if (b.spin_deg != 0) m.push_back(Motion{Motion::Spin, b.spin_deg * kDeg});
     }
     return m;
 }
@@ -56,9 +54,8 @@ std::vector<Pose2D> sample(const World& w, double rate, double speed, double tur
         return max_duration <= 0 || static_cast<double>(out.size()) * dt < max_duration;
     };
     for (const auto& m : motions) {
-        if (m.kind == Motion::Turn) {
-            // Absolute heading (leg start) or relative spin (value NaN, amount in x).
-            double remaining = std::isnan(m.value) ? m.x : wrapAngle(m.value - p.phi);
+        if (m.kind == Motion::TurnTo || m.kind == Motion::Spin) {
+            double remaining = m.kind == Motion::Spin ? m.value : wrapAngle(m.value - p.phi);
             while (std::abs(remaining) > 1e-9) {
                 const double step =
                     std::copysign(std::min(std::abs(remaining), turn_rate * dt), remaining);
