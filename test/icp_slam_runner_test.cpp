@@ -8,6 +8,7 @@
 
 #include "kfd/eval/trajectory.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/report/slam_report.h"
 #include "kfd/sim/simulator.h"
 #include "kfd/slam/icp_slam_runner.h"
 
@@ -49,6 +50,13 @@ std::size_t lines(const std::string& path) {
     return n;
 }
 
+// A run and its report, as kfd-icp-slam does.
+kfd::IcpSlamSummary runAndReport(const kfd::IcpSlamOptions& o) {
+    const auto result = kfd::IcpSlamRunner().run(o);
+    kfd::writeIcpSlamReport(result);
+    return result.summary;
+}
+
 kfd::IcpSlamOptions options(const std::string& rawlog, const std::string& out,
                             kfd::PrefilterMode mode) {
     kfd::IcpSlamOptions o;
@@ -76,7 +84,7 @@ TEST(IcpSlamRunner, ModeNoneMatchesMrptIcpSlam) {
         "icp-slam '" + (dir / "icp.ini") + "' '" + kSena + "' > '" + (dir / "icp.log") + "' 2>&1";
     ASSERT_EQ(std::system(cmd.c_str()), 0) << text(dir / "icp.log");
 
-    const auto s = kfd::IcpSlamRunner().run(options(kSena, dir / "kfd", kfd::PrefilterMode::None));
+    const auto s = runAndReport(options(kSena, dir / "kfd", kfd::PrefilterMode::None));
     EXPECT_EQ(s.scans_kept, s.scans_in);
     const std::string mine = text(dir / "kfd/log_estimated_path.txt");
     const std::string theirs = text(dir / "mrpt/log_estimated_path.txt");
@@ -89,7 +97,7 @@ TEST(IcpSlamRunner, KfdOnMitCsailHasBoundedErrorAndAPoseForEveryScan) {
     TempDir dir;
     auto o = options(kMitCsail, dir / "out", kfd::PrefilterMode::Kfd);
     o.relations = kMitCsailRel;
-    const auto s = kfd::IcpSlamRunner().run(o);
+    const auto s = runAndReport(o);
     EXPECT_EQ(s.scans_in, 1988u);
     EXPECT_GT(s.dropped_pct, 5.0);
     ASSERT_TRUE(s.relations.has_value());
@@ -121,7 +129,7 @@ TEST(IcpSlamRunner, EveryModeRunsAndAccountsForEveryScan) {
         SCOPED_TRACE(kfd::toString(mode));
         auto o = options(kSena, dir / kfd::toString(mode), mode);
         o.write_map = false;
-        const auto s = kfd::IcpSlamRunner().run(o);
+        const auto s = runAndReport(o);
         // MRPT's action/frame reader (as in icp-slam, which also logs 224 poses) yields 224 of
         // the file's 225 scans.
         EXPECT_EQ(s.scans_in, 224u);
@@ -151,7 +159,7 @@ TEST(IcpSlamRunner, OdometryModeMatchesATargetDropRate) {
         auto o = options(kSena, dir / "odo", kfd::PrefilterMode::Odometry);
         o.write_map = false;
         o.odometry_target_drop_pct = target;
-        const auto s = kfd::IcpSlamRunner().run(o);
+        const auto s = runAndReport(o);
         EXPECT_NEAR(s.dropped_pct, target, 3.0);  // 225 scans: steps of 0.44 %
         EXPECT_GT(s.pipeline.motion.max_distance_m, 0.0);
     }
@@ -160,16 +168,16 @@ TEST(IcpSlamRunner, OdometryModeMatchesATargetDropRate) {
 TEST(IcpSlamRunner, BadInputIsAClearError) {
     TempDir dir;
     auto o = options(dir / "missing.rawlog", dir / "out", kfd::PrefilterMode::Kfd);
-    EXPECT_THROW(kfd::IcpSlamRunner().run(o), kfd::SlamError);
+    EXPECT_THROW(runAndReport(o), kfd::SlamError);
     o.config_file = dir / "missing.ini";
-    EXPECT_THROW(kfd::IcpSlamRunner().run(o), kfd::SlamError);
+    EXPECT_THROW(runAndReport(o), kfd::SlamError);
     std::ofstream(dir / "text.rawlog") << "not a rawlog\n";
     o = options(dir / "text.rawlog", dir / "out", kfd::PrefilterMode::Kfd);
-    EXPECT_THROW(kfd::IcpSlamRunner().run(o), kfd::SlamError);
+    EXPECT_THROW(runAndReport(o), kfd::SlamError);
     std::ofstream(dir / "bad.ini") << text(kConfig) << "\n[KFD]\nwindw = 2\n";
     o = options(kSena, dir / "out", kfd::PrefilterMode::Kfd);
     o.config_file = dir / "bad.ini";
-    EXPECT_THROW(kfd::IcpSlamRunner().run(o), kfd::ConfigError);
+    EXPECT_THROW(runAndReport(o), kfd::ConfigError);
 }
 
 TEST(IcpSlamRunner, ModesParseAndMapToPipelines) {
@@ -251,7 +259,7 @@ TEST(IcpSlamRunner, RadiusAndSorModesRunAndKeepEveryScan) {
         SCOPED_TRACE(kfd::toString(mode));
         auto o = options(kSena, dir / kfd::toString(mode), mode);
         o.write_map = false;
-        const auto s = kfd::IcpSlamRunner().run(o);
+        const auto s = runAndReport(o);
         EXPECT_EQ(s.scans_in, 224u);
         EXPECT_EQ(s.scans_kept, s.scans_in);  // denoisers never drop scans
         // Out-of-range and noise removals together (the noise alone is checked in
@@ -273,7 +281,7 @@ TEST(IcpSlamRunner, GroundTruthTrajectoryGivesAteAndAReport) {
     const auto sim = kfd::Simulator().run(so);
     auto o = options(sim.rawlog, dir / "out", kfd::PrefilterMode::None);
     o.ground_truth_tum = sim.ground_truth;
-    const auto s = kfd::IcpSlamRunner().run(o);
+    const auto s = runAndReport(o);
     ASSERT_TRUE(s.ate_rmse.has_value());
     EXPECT_LT(*s.ate_rmse, 0.1);  // ICP-SLAM on clean simulated scans: centimetres
     EXPECT_NE(text(dir / "out/summary.json").find("\"ate_rmse_m\""), std::string::npos);

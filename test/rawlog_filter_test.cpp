@@ -1,6 +1,5 @@
 // kfd-filter end to end: RawlogFilter on real rawlogs, error handling, and the CLI.
 #include <gtest/gtest.h>
-#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
@@ -28,16 +27,10 @@ const std::string kSena =
 const std::string kMitCsail = std::string(KFD_DATASETS_DIR) + "/mit-csail/mit-csail.rawlog";
 
 std::vector<mrpt::serialization::CSerializable::Ptr> readAll(const std::string& path) {
-    mrpt::io::CFileGZInputStream in(path);
-    auto arch = mrpt::serialization::archiveFrom(in);
+    kfd::RawlogSource source(path);
     std::vector<mrpt::serialization::CSerializable::Ptr> v;
-    for (;;) {
-        try {
-            v.push_back(arch.ReadObject());
-        } catch (const mrpt::serialization::CExceptionEOF&) {
-            break;
-        }
-    }
+    kfd::SourceEntry e;
+    while (source.next(e)) e.forEachObject([&](const auto& obj) { v.push_back(obj); });
     return v;
 }
 

@@ -1,15 +1,14 @@
 // kfd-simulate's logic: deterministic logs with consistent ground truth and labels, and the
 // denoising-quality scorer on them.
 #include <gtest/gtest.h>
-#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
-#include <mrpt/serialization/CArchive.h>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "kfd/eval/trajectory.h"
+#include "kfd/mrpt/rawlog_source.h"
 #include "kfd/sim/denoise_quality.h"
 #include "kfd/sim/simulator.h"
 
@@ -68,21 +67,17 @@ TEST(Simulator, MitSensorAtFortyHertzWithConsistentFiles) {
     EXPECT_EQ(kfd::readTum(s.ground_truth).size(), s.scans);
     EXPECT_EQ(kfd::readTum(s.odometry).size(), s.scans);
     // The rawlog: a 1081-beam, 270-degree scan and an odometry observation per step.
-    mrpt::io::CFileGZInputStream in(s.rawlog);
-    auto arch = mrpt::serialization::archiveFrom(in);
+    kfd::RawlogSource source(s.rawlog);
     std::size_t scans = 0, objects = 0;
-    for (;;) {
-        try {
-            auto obj = arch.ReadObject();
-            ++objects;
-            if (auto sc = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(obj)) {
-                ++scans;
-                EXPECT_EQ(sc->getScanSize(), 1081u);
-                EXPECT_NEAR(sc->aperture, 270.0 * M_PI / 180.0, 1e-5);
-            }
-        } catch (const mrpt::serialization::CExceptionEOF&) {
-            break;
-        }
+    kfd::SourceEntry e;
+    while (source.next(e)) {
+        objects = e.objects_read;
+        EXPECT_EQ(e.kind, kfd::SourceEntry::Kind::Observation);
+        e.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& sc) {
+            ++scans;
+            EXPECT_EQ(sc->getScanSize(), 1081u);
+            EXPECT_NEAR(sc->aperture, 270.0 * M_PI / 180.0, 1e-5);
+        });
     }
     EXPECT_EQ(scans, s.scans);
     EXPECT_EQ(objects, 2 * s.scans);

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "common/progress.h"
+#include "kfd/report/slam_report.h"
 #include "kfd/slam/icp_slam_runner.h"
 
 namespace {
@@ -103,7 +104,9 @@ int main(int argc, char** argv) {
         };
     }
     try {
-        const auto s = kfd::IcpSlamRunner().run(o);
+        const auto result = kfd::IcpSlamRunner().run(o);
+        kfd::writeIcpSlamReport(result);
+        const auto& s = result.summary;
         std::printf("kfd-icp-slam summary (mode %s)\n", kfd::toString(s.mode));
         std::printf("  rawlog     %s\n  output     %s\n", s.rawlog.c_str(), s.output_dir.c_str());
         std::printf("  scans      in %zu, kept %zu, dropped %.1f %%\n", s.scans_in, s.scans_kept,

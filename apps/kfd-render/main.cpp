@@ -1,8 +1,5 @@
 // kfd-render: renders the clusters of one scan of a rawlog to PNG (off-screen, OSMesa).
-#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
-#include <mrpt/obs/CSensoryFrame.h>
-#include <mrpt/serialization/CArchive.h>
 
 #include <cmath>
 #include <cstdio>
@@ -12,6 +9,7 @@
 #include "kfd/core/distance_filter.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/scan_adapter.h"
+#include "kfd/mrpt/source.h"
 #include "kfd/render/cluster_figure.h"
 
 namespace {
@@ -75,38 +73,22 @@ int main(int argc, char** argv) {
     try {
         const kfd::Pipeline::Params p =
             cfg.empty() ? kfd::Pipeline::Params{} : kfd::loadConfigFile(cfg);
-        mrpt::io::CFileGZInputStream f;
-        if (!f.open(in)) throw std::runtime_error("cannot open " + in);
-        auto arch = mrpt::serialization::archiveFrom(f);
+        const auto source = kfd::openSource(in);
         mrpt::obs::CObservation2DRangeScan::Ptr chosen;
         double best = 1e300;
         long n = 0;
-        for (;;) {
-            mrpt::serialization::CSerializable::Ptr obj;
-            try {
-                obj = arch.ReadObject();
-            } catch (const mrpt::serialization::CExceptionEOF&) {
-                break;
-            }
-            // Scans stand alone (observations layout) or inside sensory frames.
-            std::vector<mrpt::obs::CObservation2DRangeScan::Ptr> scans;
-            if (auto s = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(obj))
-                scans.push_back(s);
-            if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj))
-                for (const auto& o : *sf)
-                    if (auto s = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(o))
-                        scans.push_back(s);
-            for (const auto& s : scans) {
+        kfd::SourceEntry entry;
+        while (!(index >= 0 && chosen) && source->next(entry)) {
+            entry.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
                 if (index >= 0 && n++ == index) chosen = s;
                 if (index < 0) {
-                    const double d = std::abs(mrpt::Clock::toDouble(s->timestamp) - stamp);
+                    const double d = std::abs(kfd::stampOf(*s) - stamp);
                     if (d < best) {
                         best = d;
                         chosen = s;
                     }
                 }
-            }
-            if (index >= 0 && chosen) break;
+            });
         }
         if (!chosen) throw std::runtime_error("no such scan in " + in);
         kfd::Scan scan;
@@ -124,8 +106,7 @@ int main(int argc, char** argv) {
         auto img = fig.render(scan, den.clusters());
         if (!img.saveToFile(out)) throw std::runtime_error("cannot write " + out);
         std::printf("kfd-render: scan at %.6f, %zu clusters, %zu noise points -> %s\n",
-                    mrpt::Clock::toDouble(chosen->timestamp), r.clusters, r.points_removed,
-                    out.c_str());
+                    kfd::stampOf(*chosen), r.clusters, r.points_removed, out.c_str());
     } catch (const std::exception& e) {
         std::fprintf(stderr, "kfd-render: %s\n", e.what());
         return 1;

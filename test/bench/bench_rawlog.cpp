@@ -1,7 +1,7 @@
 // kfd_bench_rawlog: kfd-filter's throughput on a large rawlog against the I/O limit.
 //
-//   BM_ParseRawlog   reads every object (mrpt::serialization::archiveFrom on a
-//                    CFileGZInputStream) and does nothing else: the I/O limit;
+//   BM_ParseRawlog   reads every object (kfd::RawlogSource: MRPT's CArchive over zlib) and
+//                    does nothing else: the I/O limit;
 //   BM_CopyRawlog    reads every object and writes it unchanged (gzip level 1, as kfd-filter);
 //   BM_FilterRawlog  kfd::RawlogFilter::run, the whole of kfd-filter (read, filter, write),
 //                    arg 0: built-in defaults (= kfd-filter without -c), 1: share/kfd/default.ini,
@@ -10,7 +10,6 @@
 // Input: $KFD_BENCH_RAWLOG, or KFD_DATASETS_DIR/mit-killian/mit-killian.rawlog (17480 scans).
 // When it is missing every benchmark is skipped with a message.
 #include <benchmark/benchmark.h>
-#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/registerAllClasses.h>
 #include <mrpt/serialization/CArchive.h>
@@ -26,6 +25,7 @@
 
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/rawlog_filter.h"
+#include "kfd/mrpt/rawlog_source.h"
 
 #ifndef KFD_DATASETS_DIR
 #define KFD_DATASETS_DIR "../shared/datasets"
@@ -67,17 +67,12 @@ void BM_ParseRawlog(benchmark::State& state) {
     mrpt::obs::registerAllClasses_mrpt_obs();  // what kfd's own classes would load anyway
     std::size_t objects = 0;
     for (auto _ : state) {
-        mrpt::io::CFileGZInputStream in(inputPath());
-        auto arch = mrpt::serialization::archiveFrom(in);
+        kfd::RawlogSource source(inputPath());
+        kfd::SourceEntry e;
         objects = 0;
-        for (;;) {
-            try {
-                auto obj = arch.ReadObject();
-                benchmark::DoNotOptimize(obj.get());
-            } catch (const mrpt::serialization::CExceptionEOF&) {
-                break;
-            }
-            ++objects;
+        while (source.next(e)) {
+            benchmark::DoNotOptimize(e.kind);
+            objects = e.objects_read;
         }
     }
     state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(objects));
@@ -90,8 +85,7 @@ void BM_CopyRawlog(benchmark::State& state) {
     TempOutput tmp;
     std::size_t objects = 0;
     for (auto _ : state) {
-        mrpt::io::CFileGZInputStream in(inputPath());
-        auto arch = mrpt::serialization::archiveFrom(in);
+        kfd::RawlogSource source(inputPath());
         mrpt::io::CFileGZOutputStream out;
         if (!out.open(tmp.path.string(), 1)) {
             state.SkipWithError("cannot write the scratch output");
@@ -99,15 +93,10 @@ void BM_CopyRawlog(benchmark::State& state) {
         }
         auto out_arch = mrpt::serialization::archiveFrom(out);
         objects = 0;
-        for (;;) {
-            mrpt::serialization::CSerializable::Ptr obj;
-            try {
-                obj = arch.ReadObject();
-            } catch (const mrpt::serialization::CExceptionEOF&) {
-                break;
-            }
-            out_arch << *obj;
-            ++objects;
+        kfd::SourceEntry e;
+        while (source.next(e)) {
+            e.forEachObject([&](const auto& obj) { out_arch << *obj; });
+            objects = e.objects_read;
         }
     }
     state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(objects));

@@ -1,7 +1,6 @@
 // kfd_bench_rawlog_prefix IN OUT PERCENT: writes the first PERCENT % of IN's top-level objects
 // to OUT (gzip), so kfd-filter's peak memory can be measured on logs of growing size that are
 // cut at object boundaries. Used by share/scripts/bench.sh.
-#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/registerAllClasses.h>
 #include <mrpt/serialization/CArchive.h>
@@ -13,20 +12,16 @@
 #include <stdexcept>
 #include <string>
 
+#include "kfd/mrpt/rawlog_source.h"
+
 namespace {
 
 std::size_t countObjects(const std::string& path) {
-    mrpt::io::CFileGZInputStream in(path);
-    auto arch = mrpt::serialization::archiveFrom(in);
+    kfd::RawlogSource source(path);
+    kfd::SourceEntry e;
     std::size_t n = 0;
-    for (;;) {
-        try {
-            arch.ReadObject();
-        } catch (const mrpt::serialization::CExceptionEOF&) {
-            return n;
-        }
-        ++n;
-    }
+    while (source.next(e)) n = e.objects_read;
+    return n;
 }
 
 }  // namespace
@@ -47,12 +42,17 @@ int main(int argc, char** argv) {
     try {
         const std::size_t total = countObjects(input);
         const auto keep = static_cast<std::size_t>(std::ceil(total * percent / 100.0));
-        mrpt::io::CFileGZInputStream in(input);
-        auto arch = mrpt::serialization::archiveFrom(in);
+        kfd::RawlogSource source(input);
         mrpt::io::CFileGZOutputStream out;
         if (!out.open(output, 1)) throw std::runtime_error("cannot write " + output);
         auto out_arch = mrpt::serialization::archiveFrom(out);
-        for (std::size_t i = 0; i < keep; ++i) out_arch << *arch.ReadObject();
+        std::size_t written = 0;
+        kfd::SourceEntry e;
+        while (written < keep && source.next(e))
+            e.forEachObject([&](const auto& obj) {
+                if (written < keep) out_arch << *obj;
+                ++written;
+            });
         std::printf("%s: %zu of %zu objects\n", output.c_str(), keep, total);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "kfd_bench_rawlog_prefix: %s\n", e.what());

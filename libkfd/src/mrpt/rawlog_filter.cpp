@@ -1,11 +1,9 @@
 #include "kfd/mrpt/rawlog_filter.h"
 
-#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
-#include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose2D.h>
 #include <mrpt/serialization/CArchive.h>
@@ -24,21 +22,8 @@ namespace fs = std::filesystem;
 using mrpt::obs::CActionCollection;
 using mrpt::obs::CActionRobotMovement2D;
 using mrpt::obs::CObservation2DRangeScan;
-using mrpt::obs::CObservationOdometry;
 using mrpt::obs::CSensoryFrame;
 using mrpt::poses::CPose2D;
-
-Pose2D toPose(const CPose2D& p) { return Pose2D{p.x(), p.y(), p.phi()}; }
-
-// MRPT nests exception texts ("==== MRPT exception ==== Message: ..."); keep the innermost
-// message line, which says what actually failed.
-std::string lastMessage(const std::string& what) {
-    const auto pos = what.rfind("Message:");
-    if (pos == std::string::npos) return what.substr(0, what.find('\n'));
-    std::string line = what.substr(pos + 8, what.find('\n', pos) - pos - 8);
-    const auto b = line.find_first_not_of(' ');
-    return b == std::string::npos ? line : line.substr(b);
-}
 
 // Removes the temporary output unless released.
 struct TempFile {
@@ -109,7 +94,6 @@ class Run {
     CPose2D carry_;                               // odometry of dropped frames, not yet written
     bool have_carry_ = false;
     std::optional<Pose2D> odometry_;  // absolute odometry, for the motion guards
-    CPose2D odo_accum_;               // integrated action increments (actions layout)
     bool saw_frames_ = false, saw_observations_ = false;
     std::size_t scan_index_ = 0;
 };
@@ -125,8 +109,7 @@ void Run::write(const mrpt::serialization::CSerializable& obj) {
 
 bool Run::handleScan(CObservation2DRangeScan& scan) {
     ++sum_.scans_in;
-    const double stamp =
-        scan.timestamp == mrpt::Clock::time_point() ? 0.0 : mrpt::Clock::toDouble(scan.timestamp);
+    const double stamp = stampForOutput(stampOf(scan));
     StreamResult r;
     try {
         r = filter_.process(scan, odometry_);
@@ -153,10 +136,6 @@ void Run::handleActions(const std::shared_ptr<CActionCollection>& acts) {
     // Two actions in a row (no frame between): the first stands on its own.
     if (pending_) flushPendingAction(true);
     pending_ = acts;
-    if (auto mv = acts->getBestMovementEstimation()) {
-        odo_accum_ = odo_accum_ + mv->rawOdometryIncrementReading;
-        odometry_ = toPose(odo_accum_);
-    }
 }
 
 // Writes the pending action (with any carried odometry composed in) or, when its frame was
@@ -235,10 +214,8 @@ void Run::execute() {
     if (fs::exists(opts_.output, ec) && fs::equivalent(opts_.input, opts_.output, ec))
         throw RawlogError("the output must not be the input file: " + opts_.output);
 
-    mrpt::io::CFileGZInputStream in;
-    if (!in.open(opts_.input)) throw RawlogError("cannot open the input rawlog: " + opts_.input);
-    const std::uint64_t total = fs::file_size(opts_.input, ec);
-    if (total == 0) throw RawlogError("the input is empty: " + opts_.input);
+    RawlogSource source(opts_.input);
+    const std::uint64_t total = source.bytesTotal();
 
     TempFile tmp;
     {
@@ -252,48 +229,43 @@ void Run::execute() {
     arch_.emplace(out_);
     if (!opts_.stats_csv.empty()) csv_.open(opts_.stats_csv);
 
-    auto in_arch = mrpt::serialization::archiveFrom(in);
     RawlogProgress progress;
     progress.bytes_total = total;
-    for (;;) {
-        mrpt::serialization::CSerializable::Ptr obj;
-        try {
-            obj = in_arch.ReadObject();
-        } catch (const mrpt::serialization::CExceptionEOF&) {
-            break;
-        } catch (const std::exception& e) {
-            const std::string what = lastMessage(e.what());
-            throw RawlogError("cannot read object #" + std::to_string(sum_.objects_in) + " of " +
-                              opts_.input +
-                              (sum_.objects_in == 0 ? " (is it an MRPT rawlog?): "
-                                                    : " (truncated or corrupt file?): ") +
-                              what);
+    const std::size_t every = std::max<std::size_t>(1, opts_.progress_every);
+    SourceEntry e;
+    while (source.next(e)) {
+        const std::size_t before = sum_.objects_in;
+        sum_.objects_in = e.objects_read;
+        odometry_ = e.odometry;
+        switch (e.kind) {
+            case SourceEntry::Kind::Frame:
+                saw_frames_ = true;
+                if (e.action) handleActions(e.action);
+                handleFrame(e.frame);
+                break;
+            case SourceEntry::Kind::Action:
+                saw_frames_ = true;
+                handleActions(e.action);
+                break;
+            case SourceEntry::Kind::Observation: {
+                saw_observations_ = true;
+                flushPendingAction(true);
+                auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(e.observation);
+                if (!scan)
+                    write(*e.observation);
+                else if (handleScan(*scan))
+                    write(*scan);
+                else
+                    ++sum_.objects_dropped;
+                break;
+            }
+            case SourceEntry::Kind::Other:
+                flushPendingAction(true);
+                write(*e.other);
+                break;
         }
-        if (!obj) continue;
-        ++sum_.objects_in;
-        if (auto acts = std::dynamic_pointer_cast<CActionCollection>(obj)) {
-            saw_frames_ = true;
-            handleActions(acts);
-        } else if (auto sf = std::dynamic_pointer_cast<CSensoryFrame>(obj)) {
-            saw_frames_ = true;
-            handleFrame(sf);
-        } else if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(obj)) {
-            saw_observations_ = true;
-            flushPendingAction(true);
-            if (handleScan(*scan))
-                write(*scan);
-            else
-                ++sum_.objects_dropped;
-        } else {
-            if (auto odo = std::dynamic_pointer_cast<CObservationOdometry>(obj))
-                odometry_ = toPose(odo->odometry);
-            if (std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj)) saw_observations_ = true;
-            flushPendingAction(true);
-            write(*obj);
-        }
-        if (opts_.on_progress &&
-            sum_.objects_in % std::max<std::size_t>(1, opts_.progress_every) == 0) {
-            progress.bytes_read = in.getPosition();
+        if (opts_.on_progress && before / every != sum_.objects_in / every) {
+            progress.bytes_read = source.bytesRead();
             progress.objects = sum_.objects_in;
             progress.scans_in = sum_.scans_in;
             progress.scans_kept = sum_.scans_kept;

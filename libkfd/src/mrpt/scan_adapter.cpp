@@ -1,8 +1,8 @@
 #include "kfd/mrpt/scan_adapter.h"
 
-#include <mrpt/core/Clock.h>
-
 #include <stdexcept>
+
+#include "kfd/mrpt/source.h"
 
 namespace kfd {
 
@@ -23,9 +23,7 @@ void toCore(const mrpt::obs::CObservation2DRangeScan& obs, Scan& out) {
         out.range[i] = obs.getScanRange(i);
         out.valid[i] = obs.getScanRangeValidity(i) ? 1 : 0;
     }
-    out.timestamp = obs.timestamp == mrpt::Clock::time_point()
-                        ? std::numeric_limits<double>::quiet_NaN()
-                        : mrpt::Clock::toDouble(obs.timestamp);
+    out.timestamp = stampOf(obs);
 }
 
 std::size_t applyValidity(const Scan& scan, mrpt::obs::CObservation2DRangeScan& obs) {

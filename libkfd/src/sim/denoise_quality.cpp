@@ -1,8 +1,6 @@
 #include "kfd/sim/denoise_quality.h"
 
-#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
-#include <mrpt/serialization/CArchive.h>
 
 #include <fstream>
 #include <map>
@@ -10,6 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "kfd/mrpt/source.h"
 #include "kfd/mrpt/stream_filter.h"
 
 namespace kfd {
@@ -49,22 +48,13 @@ std::map<std::size_t, std::vector<std::pair<std::size_t, NoiseKind>>> readLabels
 DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& labels_csv,
                                  const Pipeline::Params& pipeline) {
     const auto labels = readLabels(labels_csv);
-    mrpt::io::CFileGZInputStream in;
-    if (!in.open(rawlog)) throw std::runtime_error("cannot open rawlog " + rawlog);
-    auto arch = mrpt::serialization::archiveFrom(in);
+    const auto source = openSource(rawlog);
     StreamFilter filter(pipeline);
     DenoiseQuality q;
     std::vector<std::uint8_t> before;
     std::vector<NoiseKind> kind;
-    for (;;) {
-        mrpt::serialization::CSerializable::Ptr obj;
-        try {
-            obj = arch.ReadObject();
-        } catch (const mrpt::serialization::CExceptionEOF&) {
-            break;
-        }
-        auto scan = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(obj);
-        if (!scan) continue;
+    SourceEntry e;
+    auto score = [&](const mrpt::obs::CObservation2DRangeScan::Ptr& scan) {
         const std::size_t n = scan->getScanSize();
         before.resize(n);
         kind.assign(n, NoiseKind::Clean);
@@ -92,7 +82,8 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
             }
         }
         ++q.scans;
-    }
+    };
+    while (source->next(e)) e.forEachScan(score);
     if (q.scans == 0) throw std::runtime_error("no scans in " + rawlog);
     if (!labels.empty() && labels.rbegin()->first >= q.scans)
         throw std::runtime_error("labels refer to more scans than the rawlog holds");

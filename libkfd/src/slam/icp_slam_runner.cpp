@@ -1,17 +1,10 @@
 #include "kfd/slam/icp_slam_runner.h"
 
 #include <mrpt/config/CConfigFile.h>
-#include <mrpt/io/CFileGZInputStream.h>
-#include <mrpt/maps/COccupancyGridMap2D.h>
-#include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CActionCollection.h>
-#include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
-#include <mrpt/obs/CObservationOdometry.h>
-#include <mrpt/obs/CRawlog.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose3DPDF.h>
-#include <mrpt/serialization/CArchive.h>
 #include <mrpt/slam/CMetricMapBuilderICP.h>
 
 #include <chrono>
@@ -23,8 +16,8 @@
 
 #include "kfd/eval/ate.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/mrpt/source.h"
 #include "kfd/mrpt/stream_filter.h"
-#include "kfd/render/map_figure.h"
 
 namespace kfd {
 namespace {
@@ -33,25 +26,62 @@ namespace fs = std::filesystem;
 using mrpt::obs::CObservation2DRangeScan;
 constexpr const char* kSect = "MappingApplication";
 
-double stampOf(const mrpt::obs::CObservation& o) {
-    return o.timestamp == mrpt::Clock::time_point() ? 0.0 : mrpt::Clock::toDouble(o.timestamp);
+// One step of MRPT's icp-slam: an observation on its own, or an odometry action with a sensory
+// frame.
+struct IcpSlamStep {
+    mrpt::obs::CObservation::Ptr observation;
+    mrpt::obs::CActionCollection::Ptr action;
+    mrpt::obs::CSensoryFrame::Ptr frame;
+};
+
+// MRPT's icp-slam reads the log with CRawlog::getActionObservationPairOrObservation: an
+// observation on its own is one step; an action is paired with the next sensory frame, and
+// whatever lies between them (even another action or observation) is skipped, as is a frame
+// without an action. This reproduces that grouping over a source's entries.
+class IcpSlamSteps {
+  public:
+    /// True when `e` completes a step, written to `step`.
+    bool feed(const SourceEntry& e, IcpSlamStep& step) {
+        using Kind = SourceEntry::Kind;
+        step = IcpSlamStep();
+        if (pending_) {  // an action waiting for its frame
+            if (e.kind != Kind::Frame) return false;
+            step.action = std::move(pending_);
+            step.frame = e.frame;
+            return true;
+        }
+        if (e.kind == Kind::Observation) {
+            step.observation = e.observation;
+            return true;
+        }
+        if (e.kind == Kind::Frame && e.action) {
+            step.action = e.action;
+            step.frame = e.frame;
+            return true;
+        }
+        if (e.kind == Kind::Action) pending_ = e.action;
+        return false;
+    }
+
+  private:
+    mrpt::obs::CActionCollection::Ptr pending_;
+};
+
+std::unique_ptr<Source> openLog(const std::string& path) {
+    try {
+        return openSource(path);
+    } catch (const SourceError& e) {
+        throw SlamError(e.what(), path);
+    }
 }
 
-// Odometry of a scan stream, from either rawlog layout, for the motion-based stages.
-struct OdometryTracker {
-    mrpt::poses::CPose2D accum;
-    std::optional<Pose2D> current;
-    void onAction(const mrpt::obs::CActionCollection& a) {
-        if (auto mv = a.getBestMovementEstimation()) {
-            accum = accum + mv->rawOdometryIncrementReading;
-            current = Pose2D{accum.x(), accum.y(), accum.phi()};
-        }
+bool nextEntry(Source& source, SourceEntry& e) {
+    try {
+        return source.next(e);
+    } catch (const SourceError& err) {
+        throw SlamError(err.what(), source.path());
     }
-    void onObservation(const mrpt::obs::CObservation& o) {
-        if (const auto* odo = dynamic_cast<const mrpt::obs::CObservationOdometry*>(&o))
-            current = Pose2D{odo->odometry.x(), odo->odometry.y(), odo->odometry.phi()};
-    }
-};
+}
 
 struct ScanStamp {
     double t;
@@ -61,26 +91,20 @@ struct ScanStamp {
 // Reads only timestamps and odometry of every scan (for matching the odometry baseline's drop
 // rate to a target before the real run).
 std::vector<ScanStamp> scanOdometry(const std::string& rawlog) {
-    mrpt::io::CFileGZInputStream in(rawlog);
-    auto arch = mrpt::serialization::archiveFrom(in);
+    auto source = openLog(rawlog);
     std::vector<ScanStamp> out;
-    OdometryTracker odo;
-    mrpt::obs::CActionCollection::Ptr action;
-    mrpt::obs::CSensoryFrame::Ptr sf;
-    mrpt::obs::CObservation::Ptr obs;
-    std::size_t entry = 0;
-    while (
-        mrpt::obs::CRawlog::getActionObservationPairOrObservation(arch, action, sf, obs, entry)) {
-        if (obs) {
-            odo.onObservation(*obs);
-            if (IS_CLASS(*obs, CObservation2DRangeScan))
-                out.push_back({stampOf(*obs), odo.current});
-        } else if (sf) {
-            if (action) odo.onAction(*action);
-            for (const auto& o : *sf)
-                if (IS_CLASS(*o, CObservation2DRangeScan))
-                    out.push_back({stampOf(*o), odo.current});
-        }
+    IcpSlamSteps steps;
+    IcpSlamStep step;
+    SourceEntry e;
+    while (nextEntry(*source, e)) {
+        if (!steps.feed(e, step)) continue;
+        auto add = [&](const mrpt::obs::CObservation& o) {
+            if (IS_CLASS(o, CObservation2DRangeScan)) out.push_back({stampOf(o), e.odometry});
+        };
+        if (step.observation)
+            add(*step.observation);
+        else
+            for (const auto& o : *step.frame) add(*o);
     }
     return out;
 }
@@ -170,10 +194,11 @@ Pipeline::Params pipelineForMode(PrefilterMode mode, const Pipeline::Params& kfd
     return p;
 }
 
-IcpSlamSummary IcpSlamRunner::run(const IcpSlamOptions& opts) {
+IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
     const auto wall0 = std::chrono::steady_clock::now();
     const std::clock_t cpu0 = std::clock();
-    IcpSlamSummary sum;
+    IcpSlamResult res;
+    IcpSlamSummary& sum = res.summary;
     sum.mode = opts.mode;
 
     std::error_code ec;
@@ -195,11 +220,7 @@ IcpSlamSummary IcpSlamRunner::run(const IcpSlamOptions& opts) {
         const double target = *opts.odometry_target_drop_pct;
         if (!(target >= 0.0 && target < 100.0))
             throw SlamError("the target drop rate must be in [0, 100)");
-        try {
-            sum.pipeline.motion = matchDropRate(scanOdometry(sum.rawlog), target);
-        } catch (const std::exception& e) {
-            throw SlamError(std::string("cannot read the rawlog: ") + e.what());
-        }
+        sum.pipeline.motion = matchDropRate(scanOdometry(sum.rawlog), target);
     }
     StreamFilter prefilter(sum.pipeline);
 
@@ -225,17 +246,13 @@ IcpSlamSummary IcpSlamRunner::run(const IcpSlamOptions& opts) {
     f_csv << "index,timestamp,sensor,kept,reason,p_common,points_in,points_removed,prefilter_us,"
              "x,y,phi\n";
 
-    mrpt::io::CFileGZInputStream in;
-    if (!in.open(sum.rawlog)) throw SlamError("cannot open the rawlog " + sum.rawlog);
+    auto source = openLog(sum.rawlog);
     const double total_bytes =
-        static_cast<double>(std::max<std::uintmax_t>(1, fs::file_size(sum.rawlog, ec)));
-    auto arch = mrpt::serialization::archiveFrom(in);
+        static_cast<double>(std::max<std::uint64_t>(1, source->bytesTotal()));
 
-    Trajectory traj, odo_traj;
-    std::vector<std::size_t> keyframes;
-    OdometryTracker odo;
+    Trajectory& traj = res.trajectory;
     double prefilter_us = 0.0, builder_s = 0.0;
-    std::size_t entry = 0, step = 0;
+    std::size_t step_no = 0;
     char buf[256];
     struct Pending {
         double t;
@@ -243,66 +260,52 @@ IcpSlamSummary IcpSlamRunner::run(const IcpSlamOptions& opts) {
         StreamResult r;
     };
     std::vector<Pending> entry_scans;
+    SourceEntry e;
+    IcpSlamSteps steps;
+    IcpSlamStep step;
 
     auto prefilterScan = [&](CObservation2DRangeScan& scan) {
-        StreamResult r = prefilter.process(scan, odo.current);
+        StreamResult r = prefilter.process(scan, e.odometry);
         ++sum.scans_in;
         sum.scans_kept += r.keep;
         sum.points_in += r.report.points_in;
         if (r.keep) sum.points_removed += r.report.points_in - r.report.points_out;
         prefilter_us += r.report.microseconds;
-        entry_scans.push_back({stampOf(scan), scan.sensorLabel, std::move(r)});
+        entry_scans.push_back({stampForOutput(stampOf(scan)), scan.sensorLabel, std::move(r)});
         return entry_scans.back().r.keep;
     };
+    auto timed = [&](auto&& process) {
+        const auto t0 = std::chrono::steady_clock::now();
+        process();
+        builder_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    };
 
-    for (;;) {
-        mrpt::obs::CActionCollection::Ptr action;
-        mrpt::obs::CSensoryFrame::Ptr sf;
-        mrpt::obs::CObservation::Ptr obs;
-        try {
-            if (!mrpt::obs::CRawlog::getActionObservationPairOrObservation(arch, action, sf, obs,
-                                                                           entry))
-                break;
-        } catch (const std::exception& e) {
-            throw SlamError("cannot read rawlog entry " + std::to_string(entry) + " of " +
-                            sum.rawlog + " (truncated or not a rawlog?)");
-        }
-        if (entry < rawlog_offset) continue;
+    while (nextEntry(*source, e)) {
+        if (!steps.feed(e, step) || e.objects_read < rawlog_offset) continue;
         entry_scans.clear();
-        if (obs) {
-            odo.onObservation(*obs);
+        if (step.observation) {
             bool process = true;
-            if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(obs))
+            if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(step.observation))
                 process = prefilterScan(*scan);
-            if (process) {
-                const auto t0 = std::chrono::steady_clock::now();
-                builder.processObservation(obs);
-                builder_s +=
-                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-            }
-        } else if (sf && action) {
-            odo.onAction(*action);
-            for (auto it = sf->begin(); it != sf->end();) {
+            if (process) timed([&] { builder.processObservation(step.observation); });
+        } else {
+            for (auto it = step.frame->begin(); it != step.frame->end();) {
                 auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(*it);
                 if (scan && !prefilterScan(*scan))
-                    it = sf->erase(it);
+                    it = step.frame->erase(it);
                 else
                     ++it;
             }
-            const auto t0 = std::chrono::steady_clock::now();
-            builder.processActionObservation(*action, *sf);  // odometry kept even if sf is empty
-            builder_s +=
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        } else {
-            continue;
+            // odometry kept even if the frame is empty
+            timed([&] { builder.processActionObservation(*step.action, *step.frame); });
         }
         const auto pose = builder.getCurrentPoseEstimation()->getMeanVal();
-        std::snprintf(buf, sizeof(buf), "%i %f %f %f\n", static_cast<int>(step), pose.x(), pose.y(),
-                      pose.yaw());
+        std::snprintf(buf, sizeof(buf), "%i %f %f %f\n", static_cast<int>(step_no), pose.x(),
+                      pose.y(), pose.yaw());
         f_path << buf;
         for (const auto& s : entry_scans) {
-            if (s.r.keep) keyframes.push_back(traj.size());
-            if (odo.current) odo_traj.push_back(StampedPose{s.t, *odo.current});
+            if (s.r.keep) res.keyframes.push_back(traj.size());
+            if (e.odometry) res.odometry.push_back(StampedPose{s.t, *e.odometry});
             traj.push_back(StampedPose{s.t, Pose2D{pose.x(), pose.y(), pose.yaw()}});
             const auto& rep = s.r.report;
             std::snprintf(buf, sizeof(buf), "%zu,%.6f,%s,%d,%s,%.6f,%zu,%zu,%.2f,%.6f,%.6f,%.6f\n",
@@ -313,11 +316,11 @@ IcpSlamSummary IcpSlamRunner::run(const IcpSlamOptions& opts) {
                           rep.microseconds, pose.x(), pose.y(), pose.yaw());
             f_csv << buf;
         }
-        ++step;
+        ++step_no;
         ++sum.entries;
-        if (opts.on_progress && step % 500 == 0)
+        if (opts.on_progress && step_no % 500 == 0)
             opts.on_progress({sum.entries, sum.scans_in, sum.scans_kept,
-                              static_cast<double>(in.getPosition()) / total_bytes});
+                              static_cast<double>(source->bytesRead()) / total_bytes});
     }
     if (sum.entries == 0) throw SlamError("no entries in " + sum.rawlog + ": not a rawlog?");
     if (opts.on_progress) opts.on_progress({sum.entries, sum.scans_in, sum.scans_kept, 1.0});
@@ -325,29 +328,16 @@ IcpSlamSummary IcpSlamRunner::run(const IcpSlamOptions& opts) {
     f_csv.close();
     writeTum((out / "trajectory.tum").string(), traj);
 
-    Trajectory gt;
     if (!opts.ground_truth_tum.empty()) {
-        gt = readTum(opts.ground_truth_tum);  // EvalError
-        sortByTime(gt);
+        res.ground_truth = readTum(opts.ground_truth_tum);  // EvalError
+        sortByTime(res.ground_truth);
         Trajectory sorted = traj;
         sortByTime(sorted);
-        sum.ate_rmse = computeAte(sorted, gt, opts.relations_max_dt).rmse;
+        sum.ate_rmse = computeAte(sorted, res.ground_truth, opts.relations_max_dt).rmse;
     }
     if (opts.write_map) {
-        builder.saveCurrentMapToFile((out / "final_map.simplemap").string());
-        mrpt::maps::CSimpleMap sm;
-        builder.getCurrentlyBuiltMap(sm);
-        mrpt::maps::COccupancyGridMap2D grid(-10, 10, -10, 10, 0.05f);
-        grid.loadFromSimpleMap(sm);
-        grid.saveAsBitmapFile((out / "map.png").string());
-        MapFigureInput fig;
-        fig.grid = &grid;
-        fig.estimate = traj;
-        fig.ground_truth = gt;
-        fig.odometry = odo_traj;
-        fig.keyframes = keyframes;
-        fig.title = fs::path(sum.rawlog).filename().string() + "  mode " + toString(opts.mode);
-        renderMapFigure(fig).saveToFile((out / "map_figure.png").string());
+        res.map.emplace();
+        builder.getCurrentlyBuiltMap(*res.map);
     }
 
     sum.dropped_pct = sum.scans_in ? 100.0 * static_cast<double>(sum.scans_in - sum.scans_kept) /
@@ -366,82 +356,7 @@ IcpSlamSummary IcpSlamRunner::run(const IcpSlamOptions& opts) {
     sum.cpu_s_total = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
     sum.wall_s_total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    std::ofstream((out / "summary.json").string()) << toJson(sum);
-    if (opts.write_map) {  // a human-readable report tying the figure to the numbers
-        std::ofstream r((out / "report.md").string());
-        char line[512];
-        r << "# kfd-icp-slam report\n\n";
-        r << "- rawlog: `" << sum.rawlog << "`\n- pre-filter mode: **" << toString(sum.mode)
-          << "**\n";
-        std::snprintf(line, sizeof(line),
-                      "- scans: %zu in, %zu kept (%.1f %% dropped); points removed: %zu of %zu\n"
-                      "- time: pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s\n",
-                      sum.scans_in, sum.scans_kept, sum.dropped_pct, sum.points_removed,
-                      sum.points_in, sum.prefilter_us_per_scan, sum.icp_ms_per_scan,
-                      sum.cpu_s_total);
-        r << line;
-        if (sum.relations) {
-            std::snprintf(line, sizeof(line),
-                          "- relations error (%zu used, %zu unmatched): %.4f +- %.4f m, %.3f +- "
-                          "%.3f deg\n",
-                          sum.relations->used, sum.relations->unmatched, sum.relations->trans_mean,
-                          sum.relations->trans_std, sum.relations->rot_mean_deg,
-                          sum.relations->rot_std_deg);
-            r << line;
-        }
-        if (sum.ate_rmse) r << "- ATE RMSE after SE(2) alignment: " << *sum.ate_rmse << " m\n";
-        r << "\n![map, estimate (blue, dots = keyframes), ground truth (green), odometry (grey)]"
-             "(map_figure.png)\n\nAll numbers: `summary.json`; per scan: `scans.csv`; "
-             "trajectory: `trajectory.tum`.\n";
-    }
-    return sum;
-}
-
-std::string toJson(const IcpSlamSummary& s) {
-    auto esc = [](const std::string& v) {
-        std::string o;
-        for (char c : v) {
-            if (c == '"' || c == '\\') o += '\\';
-            o += c;
-        }
-        return o;
-    };
-    char buf[4096];
-    std::string stages;
-    for (const auto& st : s.pipeline.stages) stages += (stages.empty() ? "\"" : ", \"") + st + "\"";
-    std::snprintf(buf, sizeof(buf),
-                  "{\n  \"mode\": \"%s\",\n  \"rawlog\": \"%s\",\n  \"stages\": [%s],\n"
-                  "  \"entries\": %zu,\n  \"scans_in\": %zu,\n  \"scans_kept\": %zu,\n"
-                  "  \"dropped_pct\": %.3f,\n  \"points_in\": %zu,\n  \"points_removed\": %zu,\n"
-                  "  \"prefilter_us_per_scan\": %.3f,\n  \"icp_ms_per_scan\": %.4f,\n"
-                  "  \"icp_ms_per_kept_scan\": %.4f,\n  \"cpu_s_total\": %.3f,\n"
-                  "  \"wall_s_total\": %.3f,\n  \"motion_distance_m\": %.6f,\n"
-                  "  \"motion_angle_deg\": %.6f",
-                  toString(s.mode), esc(s.rawlog).c_str(), stages.c_str(), s.entries, s.scans_in,
-                  s.scans_kept, s.dropped_pct, s.points_in, s.points_removed,
-                  s.prefilter_us_per_scan, s.icp_ms_per_scan, s.icp_ms_per_kept_scan, s.cpu_s_total,
-                  s.wall_s_total, s.pipeline.motion.max_distance_m,
-                  s.pipeline.motion.max_angle_deg);
-    std::string j = buf;
-    if (s.ate_rmse) {
-        std::snprintf(buf, sizeof(buf), ",\n  \"ate_rmse_m\": %.6f", *s.ate_rmse);
-        j += buf;
-    }
-    if (s.relations) {
-        const auto& r = *s.relations;
-        std::snprintf(buf, sizeof(buf),
-                      ",\n  \"relations\": {\n    \"file\": \"%s\",\n    \"used\": %zu,\n"
-                      "    \"unmatched\": %zu,\n    \"trans_mean_m\": %.6f,\n"
-                      "    \"trans_std_m\": %.6f,\n    \"rot_mean_deg\": %.6f,\n"
-                      "    \"rot_std_deg\": %.6f,\n    \"trans2_mean_m2\": %.6f,\n"
-                      "    \"trans2_std_m2\": %.6f,\n    \"rot2_mean_deg2\": %.6f,\n"
-                      "    \"rot2_std_deg2\": %.6f\n  }",
-                      esc(s.relations_file).c_str(), r.used, r.unmatched, r.trans_mean, r.trans_std,
-                      r.rot_mean_deg, r.rot_std_deg, r.trans2_mean, r.trans2_std, r.rot2_mean,
-                      r.rot2_std);
-        j += buf;
-    }
-    return j + "\n}\n";
+    return res;
 }
 
 }  // namespace kfd

@@ -3,19 +3,13 @@
 
 #include <cstdint>
 #include <functional>
-#include <stdexcept>
 #include <string>
 
 #include "kfd/core/pipeline.h"
+#include "kfd/mrpt/rawlog_source.h"
 #include "kfd/mrpt/stream_filter.h"
 
 namespace kfd {
-
-/// Bad input or output: missing/unreadable file, not a rawlog, truncated rawlog, write failure.
-class RawlogError : public std::runtime_error {
-  public:
-    using std::runtime_error::runtime_error;
-};
 
 struct RawlogProgress {
     std::uint64_t bytes_read = 0;   // compressed bytes consumed

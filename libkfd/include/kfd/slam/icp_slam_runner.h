@@ -1,13 +1,18 @@
 // ICP-SLAM over a rawlog with a kfd pre-filter in front (the paper's Figure 1).
 #pragma once
 
+#include <mrpt/maps/CSimpleMap.h>
+
 #include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "kfd/core/error.h"
 #include "kfd/core/pipeline.h"
 #include "kfd/eval/relations.h"
+#include "kfd/eval/trajectory.h"
 
 namespace kfd {
 
@@ -45,7 +50,8 @@ struct IcpSlamOptions {
     std::string relations;           // ground truth (.relations), optional
     double relations_max_dt = 1e-3;  // s, stamp matching tolerance
     std::string ground_truth_tum;    // ground-truth trajectory (TUM), optional: ATE and figure
-    bool write_map = true;           // .simplemap, occupancy-grid PNG, map_figure.png and report.md
+    bool write_map = true;           // keep the built map in the result (for .simplemap, map.png,
+                            // map_figure.png and report.md, written by kfd/report/slam_report.h)
     std::function<void(const IcpSlamProgress&)> on_progress;
 };
 
@@ -67,10 +73,20 @@ struct IcpSlamSummary {
     std::string relations_file;
 };
 
+/// Everything a run produced, for the report (kfd/report/slam_report.h) and other callers.
+struct IcpSlamResult {
+    IcpSlamSummary summary;
+    Trajectory trajectory;               // one pose per input scan (time order of the log)
+    Trajectory odometry;                 // the odometry of every input scan that had one
+    std::vector<std::size_t> keyframes;  // indices into `trajectory` of the kept scans
+    Trajectory ground_truth;             // ground_truth_tum, sorted by time (empty without it)
+    std::optional<mrpt::maps::CSimpleMap> map;  // the built map, with write_map
+};
+
 /// Bad input, configuration or output (message says which).
-class SlamError : public std::runtime_error {
+class SlamError : public Error {
   public:
-    using std::runtime_error::runtime_error;
+    using Error::Error;
 };
 
 /// Runs CMetricMapBuilderICP over a rawlog exactly like MRPT's icp-slam (same config sections,
@@ -81,15 +97,12 @@ class SlamError : public std::runtime_error {
 /// propagated with odometry for dropped scans).
 ///
 /// Writes into the output folder: trajectory.tum (one pose per input scan, TUM format),
-/// log_estimated_path.txt (icp-slam's "step x y phi", one per rawlog entry), scans.csv,
-/// summary.json, and with write_map final_map.simplemap, map.png (occupancy grid),
-/// map_figure.png (grid + estimate, keyframes, odometry and ground truth) and report.md.
+/// log_estimated_path.txt (icp-slam's "step x y phi", one per rawlog entry) and scans.csv.
+/// summary.json, final_map.simplemap, map.png, map_figure.png and report.md are written from
+/// the result by writeIcpSlamReport() (kfd/report/slam_report.h).
 class IcpSlamRunner {
   public:
-    IcpSlamSummary run(const IcpSlamOptions& opts);
+    IcpSlamResult run(const IcpSlamOptions& opts);
 };
-
-/// summary.json's text.
-std::string toJson(const IcpSlamSummary& s);
 
 }  // namespace kfd

@@ -1,0 +1,23 @@
+// The files of a kfd-icp-slam run written from its result: summary.json, the map and its
+// figure, report.md.
+#pragma once
+
+#include <string>
+
+#include "kfd/slam/icp_slam_runner.h"
+
+namespace kfd {
+
+/// summary.json's text: every number of the summary, keys in a fixed order (mode, rawlog,
+/// stages, entries, scans_in, scans_kept, dropped_pct, points_in, points_removed,
+/// prefilter_us_per_scan, icp_ms_per_scan, icp_ms_per_kept_scan, cpu_s_total, wall_s_total,
+/// motion_distance_m, motion_angle_deg, then ate_rmse_m and relations when present).
+std::string toJson(const IcpSlamSummary& s);
+
+/// Writes into result.summary.output_dir: summary.json and, when the result holds the built
+/// map (IcpSlamOptions::write_map), final_map.simplemap, map.png (occupancy grid, 5 cm),
+/// map_figure.png (grid + estimate, keyframes, odometry and ground truth) and report.md.
+/// Throws SlamError when a file cannot be written.
+void writeIcpSlamReport(const IcpSlamResult& result);
+
+}  // namespace kfd

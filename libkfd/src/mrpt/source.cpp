@@ -1,0 +1,34 @@
+#include "kfd/mrpt/source.h"
+
+#include <mrpt/core/Clock.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CObservationOdometry.h>
+
+#include <limits>
+
+#include "kfd/mrpt/rawlog_source.h"
+
+namespace kfd {
+
+double stampOf(const mrpt::obs::CObservation& obs) {
+    return obs.timestamp == mrpt::Clock::time_point() ? std::numeric_limits<double>::quiet_NaN()
+                                                      : mrpt::Clock::toDouble(obs.timestamp);
+}
+
+void OdometryTracker::onAction(const mrpt::obs::CActionCollection& actions) {
+    if (auto mv = actions.getBestMovementEstimation()) {
+        accum_ = accum_ + mv->rawOdometryIncrementReading;
+        current_ = Pose2D{accum_.x(), accum_.y(), accum_.phi()};
+    }
+}
+
+void OdometryTracker::onObservation(const mrpt::obs::CObservation& obs) {
+    if (const auto* odo = dynamic_cast<const mrpt::obs::CObservationOdometry*>(&obs))
+        current_ = Pose2D{odo->odometry.x(), odo->odometry.y(), odo->odometry.phi()};
+}
+
+std::unique_ptr<Source> openSource(const std::string& path) {
+    return std::make_unique<RawlogSource>(path);
+}
+
+}  // namespace kfd

@@ -1,0 +1,125 @@
+#include "kfd/report/slam_report.h"
+
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/maps/COccupancyGridMap2D.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "kfd/render/map_figure.h"
+
+namespace kfd {
+namespace {
+
+namespace fs = std::filesystem;
+
+void writeText(const fs::path& path, const std::string& text) {
+    std::ofstream f(path);
+    f << text;
+    f.close();
+    if (f.fail()) throw SlamError("cannot write " + path.string(), path.string());
+}
+
+std::string reportMarkdown(const IcpSlamSummary& sum) {
+    std::string r = "# kfd-icp-slam report\n\n";
+    r += "- rawlog: `" + sum.rawlog + "`\n- pre-filter mode: **" + toString(sum.mode) + "**\n";
+    char line[512];
+    std::snprintf(line, sizeof(line),
+                  "- scans: %zu in, %zu kept (%.1f %% dropped); points removed: %zu of %zu\n"
+                  "- time: pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s\n",
+                  sum.scans_in, sum.scans_kept, sum.dropped_pct, sum.points_removed, sum.points_in,
+                  sum.prefilter_us_per_scan, sum.icp_ms_per_scan, sum.cpu_s_total);
+    r += line;
+    if (sum.relations) {
+        std::snprintf(line, sizeof(line),
+                      "- relations error (%zu used, %zu unmatched): %.4f +- %.4f m, %.3f +- "
+                      "%.3f deg\n",
+                      sum.relations->used, sum.relations->unmatched, sum.relations->trans_mean,
+                      sum.relations->trans_std, sum.relations->rot_mean_deg,
+                      sum.relations->rot_std_deg);
+        r += line;
+    }
+    if (sum.ate_rmse) {
+        std::ostringstream ate;  // as the stream prints it (6 significant digits)
+        ate << *sum.ate_rmse;
+        r += "- ATE RMSE after SE(2) alignment: " + ate.str() + " m\n";
+    }
+    r += "\n![map, estimate (blue, dots = keyframes), ground truth (green), odometry (grey)]"
+         "(map_figure.png)\n\nAll numbers: `summary.json`; per scan: `scans.csv`; "
+         "trajectory: `trajectory.tum`.\n";
+    return r;
+}
+
+void writeMap(const IcpSlamResult& res, const fs::path& out) {
+    const auto& sum = res.summary;
+    {  // as CMetricMapBuilder::saveCurrentMapToFile
+        mrpt::io::CFileGZOutputStream f;
+        if (!f.open((out / "final_map.simplemap").string()))
+            throw SlamError("cannot write " + (out / "final_map.simplemap").string());
+        mrpt::serialization::archiveFrom(f) << *res.map;
+    }
+    mrpt::maps::COccupancyGridMap2D grid(-10, 10, -10, 10, 0.05f);
+    grid.loadFromSimpleMap(*res.map);
+    grid.saveAsBitmapFile((out / "map.png").string());
+    MapFigureInput fig;
+    fig.grid = &grid;
+    fig.estimate = res.trajectory;
+    fig.ground_truth = res.ground_truth;
+    fig.odometry = res.odometry;
+    fig.keyframes = res.keyframes;
+    fig.title = fs::path(sum.rawlog).filename().string() + "  mode " + toString(sum.mode);
+    renderMapFigure(fig).saveToFile((out / "map_figure.png").string());
+}
+
+}  // namespace
+
+std::string toJson(const IcpSlamSummary& s) {
+    nlohmann::ordered_json j;
+    j["mode"] = toString(s.mode);
+    j["rawlog"] = s.rawlog;
+    j["stages"] = s.pipeline.stages;
+    j["entries"] = s.entries;
+    j["scans_in"] = s.scans_in;
+    j["scans_kept"] = s.scans_kept;
+    j["dropped_pct"] = s.dropped_pct;
+    j["points_in"] = s.points_in;
+    j["points_removed"] = s.points_removed;
+    j["prefilter_us_per_scan"] = s.prefilter_us_per_scan;
+    j["icp_ms_per_scan"] = s.icp_ms_per_scan;
+    j["icp_ms_per_kept_scan"] = s.icp_ms_per_kept_scan;
+    j["cpu_s_total"] = s.cpu_s_total;
+    j["wall_s_total"] = s.wall_s_total;
+    j["motion_distance_m"] = s.pipeline.motion.max_distance_m;
+    j["motion_angle_deg"] = s.pipeline.motion.max_angle_deg;
+    if (s.ate_rmse) j["ate_rmse_m"] = *s.ate_rmse;
+    if (s.relations) {
+        const auto& r = *s.relations;
+        nlohmann::ordered_json rel;
+        rel["file"] = s.relations_file;
+        rel["used"] = r.used;
+        rel["unmatched"] = r.unmatched;
+        rel["trans_mean_m"] = r.trans_mean;
+        rel["trans_std_m"] = r.trans_std;
+        rel["rot_mean_deg"] = r.rot_mean_deg;
+        rel["rot_std_deg"] = r.rot_std_deg;
+        rel["trans2_mean_m2"] = r.trans2_mean;
+        rel["trans2_std_m2"] = r.trans2_std;
+        rel["rot2_mean_deg2"] = r.rot2_mean;
+        rel["rot2_std_deg2"] = r.rot2_std;
+        j["relations"] = std::move(rel);
+    }
+    return j.dump(2) + "\n";
+}
+
+void writeIcpSlamReport(const IcpSlamResult& result) {
+    const fs::path out(result.summary.output_dir);
+    if (result.map) writeMap(result, out);
+    writeText(out / "summary.json", toJson(result.summary));
+    if (result.map) writeText(out / "report.md", reportMarkdown(result.summary));
+}
+
+}  // namespace kfd
