@@ -50,8 +50,9 @@ struct IcpSlamOptions {
     std::string relations;           // ground truth (.relations), optional
     double relations_max_dt = 1e-3;  // s, stamp matching tolerance
     std::string ground_truth_tum;    // ground-truth trajectory (TUM), optional: ATE and figure
-    bool write_map = true;           // keep the built map in the result (for .simplemap, map.png,
-                            // map_figure.png and report.md, written by kfd/report/slam_report.h)
+    /// Keep the built map in the result, for writeIcpSlamReport's final_map.simplemap, map.png,
+    /// map_figure.png and report.md (kfd/report/slam_report.h).
+    bool write_map = true;
     std::function<void(const IcpSlamProgress&)> on_progress;
 };
 
