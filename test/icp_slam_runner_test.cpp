@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "kfd/eval/trajectory.h"
@@ -289,4 +290,79 @@ TEST(IcpSlamRunner, GroundTruthTrajectoryGivesAteAndAReport) {
     EXPECT_NE(report.find("ATE RMSE"), std::string::npos);
     EXPECT_NE(report.find("map_figure.png"), std::string::npos);
     EXPECT_TRUE(fs::exists(dir / "out/map_figure.png"));
+}
+
+TEST(IcpSlamRunner, TruncatedRawlogIsAnErrorNotAShortRun) {
+    const std::string real = std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog";
+    if (!fs::exists(real)) GTEST_SKIP() << "missing " << real;
+    TempDir dir;
+    {
+        std::ifstream in(real, std::ios::binary);
+        std::string data((std::istreambuf_iterator<char>(in)), {});
+        std::ofstream(dir / "cut.rawlog", std::ios::binary) << data.substr(0, data.size() / 2);
+    }
+    auto o = options(dir / "cut.rawlog", dir / "out", kfd::PrefilterMode::None);
+    o.write_map = false;
+    try {
+        kfd::IcpSlamRunner().run(o);
+        ADD_FAILURE() << "a truncated rawlog ran to its end";
+    } catch (const kfd::SlamError& e) {
+        EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
+    }
+}
+
+TEST(IcpSlamRunner, SummaryJsonKeepsEveryKeyInOrder) {
+    kfd::IcpSlamSummary s;
+    s.mode = kfd::PrefilterMode::Odometry;
+    s.rawlog = "a \"quoted\" \\ path.rawlog";
+    s.pipeline.stages = {"motion"};
+    s.scans_in = 10;
+    s.scans_kept = 4;
+    s.dropped_pct = 60.0;
+    s.ate_rmse = 0.125;
+    s.relations = kfd::RelationsError{};
+    s.relations->used = 7;
+    s.relations_file = "gt.relations";
+    const std::string json = kfd::toJson(s);
+    std::size_t last = 0;
+    for (const char* key : {"\"mode\": \"odometry\"",
+                            "\"rawlog\": \"a \\\"quoted\\\" \\\\ path.rawlog\"",
+                            "\"stages\"",
+                            "\"motion\"",
+                            "\"entries\"",
+                            "\"scans_in\": 10",
+                            "\"scans_kept\": 4",
+                            "\"dropped_pct\": 60.0",
+                            "\"points_in\"",
+                            "\"points_removed\"",
+                            "\"prefilter_us_per_scan\"",
+                            "\"icp_ms_per_scan\"",
+                            "\"icp_ms_per_kept_scan\"",
+                            "\"cpu_s_total\"",
+                            "\"wall_s_total\"",
+                            "\"motion_distance_m\"",
+                            "\"motion_angle_deg\"",
+                            "\"ate_rmse_m\": 0.125",
+                            "\"relations\"",
+                            "\"file\": \"gt.relations\"",
+                            "\"used\": 7",
+                            "\"unmatched\"",
+                            "\"trans_mean_m\"",
+                            "\"trans_std_m\"",
+                            "\"rot_mean_deg\"",
+                            "\"rot_std_deg\"",
+                            "\"trans2_mean_m2\"",
+                            "\"trans2_std_m2\"",
+                            "\"rot2_mean_deg2\"",
+                            "\"rot2_std_deg2\""}) {
+        const auto at = json.find(key, last);
+        ASSERT_NE(at, std::string::npos) << key << " in\n" << json;
+        last = at;
+    }
+    EXPECT_EQ(json.back(), '\n');
+    s.ate_rmse.reset();
+    s.relations.reset();
+    const std::string bare = kfd::toJson(s);
+    EXPECT_EQ(bare.find("ate_rmse_m"), std::string::npos);
+    EXPECT_EQ(bare.find("relations"), std::string::npos);
 }

@@ -214,8 +214,8 @@ void Run::execute() {
     if (fs::exists(opts_.output, ec) && fs::equivalent(opts_.input, opts_.output, ec))
         throw RawlogError("the output must not be the input file: " + opts_.output);
 
-    RawlogSource source(opts_.input);
-    const std::uint64_t total = source.bytesTotal();
+    const auto source = openSource(opts_.input);
+    const std::uint64_t total = source->bytesTotal();
 
     TempFile tmp;
     {
@@ -233,7 +233,7 @@ void Run::execute() {
     progress.bytes_total = total;
     const std::size_t every = std::max<std::size_t>(1, opts_.progress_every);
     SourceEntry e;
-    while (source.next(e)) {
+    while (source->next(e)) {
         const std::size_t before = sum_.objects_in;
         sum_.objects_in = e.objects_read;
         odometry_ = e.odometry;
@@ -265,7 +265,7 @@ void Run::execute() {
                 break;
         }
         if (opts_.on_progress && before / every != sum_.objects_in / every) {
-            progress.bytes_read = source.bytesRead();
+            progress.bytes_read = source->bytesRead();
             progress.objects = sum_.objects_in;
             progress.scans_in = sum_.scans_in;
             progress.scans_kept = sum_.scans_kept;
