@@ -69,6 +69,21 @@ ProgressPrinter* Cli::progress() {
     return &*progress_;
 }
 
+std::string Cli::unexpected(int argc, char** argv) const {
+    // CLI11's message, with the arguments in command-line order (2.1 prints them reversed).
+    std::vector<std::string> left = app_.remaining(), ordered;
+    for (int i = 1; i < argc; ++i) {
+        const auto it = std::find(left.begin(), left.end(), argv[i]);
+        if (it == left.end()) continue;
+        ordered.push_back(*it);
+        left.erase(it);
+    }
+    ordered.insert(ordered.end(), left.begin(), left.end());
+    return (ordered.size() > 1 ? "The following arguments were not expected: "
+                               : "The following argument was not expected: ") +
+           CLI::detail::join(ordered, " ");
+}
+
 int Cli::usageError(const std::string& message) const {
     std::fprintf(stderr, "%s: %s\nTry '%s --help'.\n", name_.c_str(), message.c_str(),
                  name_.c_str());
@@ -84,6 +99,11 @@ int Cli::run(int argc, char** argv, const std::function<void()>& body) {
     } catch (const CLI::CallForVersion& e) {
         std::printf("%s\n", e.what());
         return 0;
+    } catch (const CLI::ExtrasError&) {
+        return usageError(unexpected(argc, argv));
+    } catch (const CLI::RequiredError& e) {
+        // An unknown argument explains a missing one ("--ouput x"): name it first.
+        return usageError(app_.remaining().empty() ? e.what() : unexpected(argc, argv));
     } catch (const CLI::ParseError& e) {
         return usageError(e.what());
     }

@@ -11,6 +11,7 @@
 #include <system_error>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "kfd/core/error.h"
 
@@ -39,8 +40,8 @@ class ProgressPrinter {
 };
 
 /// Reads `text` as a number of type T into `value`. Returns the message of a text that is not
-/// one as a whole ("'abc' is not an integer", "'1e999' is out of
-/// range"), or empty. A leading '+' is accepted.
+/// one as a whole, in base 10 ("'abc' is not an integer", "'1e999' is out of range"), or
+/// empty. A leading '+' is accepted.
 template <class T>
 std::string parseNumber(const std::string& text, T& value) {
     static_assert(std::is_arithmetic_v<T>);
@@ -65,6 +66,19 @@ T toNumber(const std::string& text) {
     return value;
 }
 
+/// A validator for option(): a number in [lo, hi] ("'12' is outside [0, 9]").
+template <class T>
+CLI::Validator inRange(T lo, T hi) {
+    auto check = [lo, hi](std::string& text) -> std::string {
+        T value{};
+        if (std::string e = parseNumber(text, value); !e.empty()) return e;
+        if (value >= lo && value <= hi) return {};
+        return "'" + text + "' is outside [" + CLI::detail::to_string(lo) + ", " +
+               CLI::detail::to_string(hi) + "]";
+    };
+    return CLI::Validator(check, "");
+}
+
 /// One app's command line. The app declares its options, then hands its body to run().
 class Cli {
   public:
@@ -76,20 +90,29 @@ class Cli {
     const std::string& name() const { return name_; }
 
     /// A typed option ("-i,--input"), or a positional argument when `names` has no dash. A
-    /// number must parse as a whole: "--flag: 'abc' is not a number".
+    /// number must parse as a whole, in base 10: "--flag: 'abc' is not a number".
     template <class T>
     CLI::Option* option(const std::string& names, T& value, const std::string& help) {
-        CLI::Option* opt = app_.add_option(names, value, help);
-        if constexpr (std::is_arithmetic_v<T>) opt->check(numberCheck<T>());
-        return opt;
+        if constexpr (std::is_arithmetic_v<T>) {
+            return option(names, value, help, toNumber<T>)
+                ->type_name(CLI::detail::type_name<T>())
+                ->default_function([&value] { return CLI::detail::to_string(value); });
+        } else {
+            return app_.add_option(names, value, help);
+        }
     }
-    /// An option of `n_min` to `n_max` values (e.g. "--size W H"), given once.
+    /// An option of `n_min` to `n_max` numbers (e.g. "--size W H"), given once.
     template <class T>
     CLI::Option* option(const std::string& names, std::vector<T>& values, const std::string& help,
                         int n_min, int n_max) {
-        CLI::Option* opt = app_.add_option(names, values, help)->expected(n_min, n_max);
-        if constexpr (std::is_arithmetic_v<T>) opt->check(numberCheck<T>());
-        return opt->multi_option_policy(CLI::MultiOptionPolicy::Throw);
+        auto set = [&values](const std::vector<std::string>& texts) {
+            values.clear();
+            for (const auto& t : texts) values.push_back(toNumber<T>(t));
+        };
+        return app_.add_option_function<std::vector<std::string>>(names, set, help)
+            ->expected(n_min, n_max)
+            ->check(numberCheck<T>())
+            ->multi_option_policy(CLI::MultiOptionPolicy::Throw);
     }
     /// An option whose text `parse` turns into the value; what `parse` throws for a bad text
     /// becomes the usage error "--flag: what".
@@ -133,6 +156,7 @@ class Cli {
             },
             "");
     }
+    std::string unexpected(int argc, char** argv) const;
     int usageError(const std::string& message) const;
 
     std::string name_;

@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
         ->type_name("FILE");
     cli.option("--compress", opts.compress_level, "gzip level of the output, 0-9")
         ->type_name("N")
-        ->check(CLI::Range(0, 9).description(""))
+        ->check(kfd::app::inRange(0, 9))
         ->capture_default_str();
     cli.addQuiet();
     cli.flag("--print-config", print_config, "print the effective configuration and exit");
