@@ -86,8 +86,8 @@ class Cli {
     /// list of options.
     Cli(std::string name, const std::string& synopsis, std::string about, std::string footer = {});
 
+    /// The CLI11 app, for what the helpers below do not cover.
     CLI::App& app() { return app_; }
-    const std::string& name() const { return name_; }
 
     /// A typed option ("-i,--input"), or a positional argument when `names` has no dash. A
     /// number must parse as a whole, in base 10: "--flag: 'abc' is not a number".
