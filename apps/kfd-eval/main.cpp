@@ -2,66 +2,34 @@
 #include <cstdio>
 #include <string>
 
+#include "common/cli.h"
 #include "kfd/eval/ate.h"
 #include "kfd/eval/relations.h"
 
-namespace {
-
-const char* kUsage =
-    "Usage: kfd-eval EST.tum [--relations GT.relations] [--gt GT.tum] [options]\n"
-    "\n"
-    "  -r, --relations FILE  Kuemmerle et al. 2009 relations metric (mean +- std of the\n"
-    "                        translation error in m and rotation error in deg, absolute and\n"
-    "                        squared)\n"
-    "  -g, --gt FILE         ground-truth TUM trajectory: ATE RMSE after SE(2) alignment, RPE\n"
-    "      --max-dt S        stamp matching tolerance (default 0.001 s)\n"
-    "      --rpe-delta S     RPE time step (default 1.0 s)\n"
-    "  -h, --help            this text\n"
-    "Stamps that do not match are counted and reported. Exit 1 on unreadable input.\n";
-
-int usageError(const std::string& m) {
-    std::fprintf(stderr, "kfd-eval: %s\nTry 'kfd-eval --help'.\n", m.c_str());
-    return 2;
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
+    kfd::app::Cli cli("kfd-eval", "EST.tum [--relations GT.relations] [--gt GT.tum] [options]",
+                      "Trajectory error of EST.tum (TUM format) against ground truth.",
+                      "Stamps that do not match are counted and reported. Exit 1 on unreadable "
+                      "input, 2 on bad usage.");
     std::string est_file, rel_file, gt_file;
     double max_dt = 1e-3, rpe_delta = 1.0;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
-        if (a == "-h" || a == "--help") {
-            std::fputs(kUsage, stdout);
-            return 0;
-        } else if (a == "-r" || a == "--relations" || a == "-g" || a == "--gt" || a == "--max-dt" ||
-                   a == "--rpe-delta") {
-            const char* v = next();
-            if (!v) return usageError(a + " needs a value");
-            try {
-                if (a == "-r" || a == "--relations")
-                    rel_file = v;
-                else if (a == "-g" || a == "--gt")
-                    gt_file = v;
-                else if (a == "--max-dt")
-                    max_dt = std::stod(v);
-                else
-                    rpe_delta = std::stod(v);
-            } catch (const std::exception& e) {
-                return usageError(a + ": " + e.what());
-            }
-        } else if (!a.empty() && a[0] == '-') {
-            return usageError("unknown option '" + a + "'");
-        } else if (est_file.empty()) {
-            est_file = a;
-        } else {
-            return usageError("too many arguments");
-        }
-    }
-    if (est_file.empty()) return usageError("no estimated trajectory");
-    if (rel_file.empty() && gt_file.empty()) return usageError("give --relations and/or --gt");
-    try {
+    cli.option("EST.tum", est_file, "estimated trajectory (TUM)")->required();
+    cli.option("-r,--relations", rel_file,
+               "Kuemmerle et al. 2009 relations metric (mean +- std of the\n"
+               "translation error in m and rotation error in deg, absolute and\nsquared)")
+        ->type_name("FILE");
+    cli.option("-g,--gt", gt_file,
+               "ground-truth TUM trajectory: ATE RMSE after SE(2) alignment, RPE")
+        ->type_name("FILE");
+    cli.option("--max-dt", max_dt, "stamp matching tolerance (s)")
+        ->type_name("S")
+        ->capture_default_str();
+    cli.option("--rpe-delta", rpe_delta, "RPE time step (s)")
+        ->type_name("S")
+        ->capture_default_str();
+    return cli.run(argc, argv, [&] {
+        if (rel_file.empty() && gt_file.empty())
+            throw kfd::app::UsageError("give --relations and/or --gt");
         auto est = kfd::readTum(est_file);
         kfd::sortByTime(est);
         std::printf("estimate   %s (%zu poses)\n", est_file.c_str(), est.size());
@@ -88,9 +56,5 @@ int main(int argc, char** argv) {
                 "%.3f deg\n",
                 rpe_delta, p.pairs, p.unmatched, p.trans_rmse, p.rot_rmse_deg);
         }
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "kfd-eval: %s\n", e.what());
-        return 1;
-    }
-    return 0;
+    });
 }

@@ -1,49 +1,15 @@
 // kfd-filter: keyframe extraction + clustering denoise of every 2D scan of a rawlog.
 // All logic lives in kfd::RawlogFilter; this file parses arguments and reports.
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <iostream>
 #include <string>
+#include <vector>
 
-#include "common/progress.h"
+#include "common/cli.h"
 #include "kfd/core/window_helper.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/rawlog_filter.h"
 
 namespace {
-
-const char* kUsage =
-    "Usage: kfd-filter -i IN.rawlog -o OUT.rawlog [options]\n"
-    "\n"
-    "Drops 2D range scans that carry no new information (keyframe extraction, Hu et al. 2023)\n"
-    "and removes noise points from the kept scans (clustering denoise). Every other object is\n"
-    "copied unchanged and in order; odometry of dropped frames is composed into the next kept\n"
-    "action. Removed points are marked invalid (beam count and angles are kept).\n"
-    "\n"
-    "Options:\n"
-    "  -i, --input FILE        input rawlog (either MRPT layout, plain or gzip)\n"
-    "  -o, --output FILE       output rawlog (written to a temporary file, then renamed)\n"
-    "  -c, --config FILE       .ini ([KFD] section) or .yaml configuration;\n"
-    "                          default: built-in defaults (= share/kfd/paper-mit-0.752.ini)\n"
-    "      --stats FILE        per-scan CSV (timestamp, sensor, keyframe, reason, P_common,\n"
-    "                          clusters, points removed, microseconds)\n"
-    "      --compress N        gzip level of the output, 0-9 (default 1)\n"
-    "  -q, --quiet             no progress on stderr\n"
-    "      --print-config      print the effective configuration and exit\n"
-    "      --list-keys         list every configuration key with its range and exit\n"
-    "      --suggest-window V F [P_PAIR]\n"
-    "                          Formulas 4-5: suggest the window m for speed V (m/s) and scan\n"
-    "                          rate F (Hz), then exit\n"
-    "  -h, --help              this text\n"
-    "      --version           version\n"
-    "\n"
-    "Exit status: 0 on success, 1 on bad input or configuration, 2 on bad usage.\n";
-
-int usageError(const std::string& msg) {
-    std::fprintf(stderr, "kfd-filter: %s\nTry 'kfd-filter --help'.\n", msg.c_str());
-    return 2;
-}
 
 void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSummary& s) {
     const double removed = static_cast<double>(s.points_removed_noise);
@@ -64,104 +30,81 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
                 s.filter_seconds, s.scans_in ? 1e6 * s.filter_seconds / s.scans_in : 0.0);
 }
 
+void printWindowSuggestion(const std::vector<double>& a) {
+    const double pp = a.size() > 2 ? a[2] : 0.985;
+    kfd::WindowSuggestion s;
+    try {
+        s = kfd::suggestWindow(a[0], a[1], pp);
+    } catch (const std::exception& e) {
+        throw kfd::app::UsageError(std::string("--suggest-window: ") + e.what());
+    }
+    std::printf("dx = %.3f cm per scan (Formula 4)\n", s.dx_cm);
+    if (s.m_min) std::printf("Formula 5 allows m = %zu..%zu\n", s.m_min, s.m_max);
+    std::printf("window = %zu\np_pair = %g (P_threshold = %.4f)\n", s.m, pp, s.p_threshold);
+    if (!s.note.empty()) std::printf("note: %s\n", s.note.c_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+    kfd::app::Cli cli(
+        "kfd-filter", "-i IN.rawlog -o OUT.rawlog [options]",
+        "Drops 2D range scans that carry no new information (keyframe extraction, Hu et al. 2023)\n"
+        "and removes noise points from the kept scans (clustering denoise). Every other object is\n"
+        "copied unchanged and in order; odometry of dropped frames is composed into the next kept\n"
+        "action. Removed points are marked invalid (beam count and angles are kept).",
+        "Exit status: 0 on success, 1 on bad input or configuration, 2 on bad usage.");
     kfd::RawlogFilterOptions opts;
     std::string config;
-    bool quiet = false, print_config = false;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto value = [&](const char* name) -> const char* {
-            if (i + 1 >= argc) return nullptr;
-            (void)name;
-            return argv[++i];
-        };
-        if (a == "-h" || a == "--help") {
-            std::fputs(kUsage, stdout);
-            return 0;
-        } else if (a == "--version") {
-            std::printf("kfd-filter %s\n", KFD_VERSION);
-            return 0;
-        } else if (a == "-i" || a == "--input") {
-            const char* v = value("input");
-            if (!v) return usageError(a + " needs a file name");
-            opts.input = v;
-        } else if (a == "-o" || a == "--output") {
-            const char* v = value("output");
-            if (!v) return usageError(a + " needs a file name");
-            opts.output = v;
-        } else if (a == "-c" || a == "--config") {
-            const char* v = value("config");
-            if (!v) return usageError(a + " needs a file name");
-            config = v;
-        } else if (a == "--stats") {
-            const char* v = value("stats");
-            if (!v) return usageError(a + " needs a file name");
-            opts.stats_csv = v;
-        } else if (a == "--compress") {
-            const char* v = value("compress");
-            char* end = nullptr;
-            const long lvl = v ? std::strtol(v, &end, 10) : -1;
-            if (!v || *end || lvl < 0 || lvl > 9) return usageError("--compress needs 0-9");
-            opts.compress_level = static_cast<int>(lvl);
-        } else if (a == "-q" || a == "--quiet") {
-            quiet = true;
-        } else if (a == "--print-config") {
-            print_config = true;
-        } else if (a == "--list-keys") {
+    bool print_config = false, list_keys = false;
+    std::vector<double> window;
+    cli.option("-i,--input", opts.input, "input rawlog (either MRPT layout, plain or gzip)")
+        ->type_name("FILE");
+    cli.option("-o,--output", opts.output,
+               "output rawlog (written to a temporary file, then renamed)")
+        ->type_name("FILE");
+    cli.option("-c,--config", config,
+               ".ini ([KFD] section) or .yaml configuration;\n"
+               "default: built-in defaults (= share/kfd/paper-mit-0.752.ini)")
+        ->type_name("FILE");
+    cli.option("--stats", opts.stats_csv,
+               "per-scan CSV (timestamp, sensor, keyframe, reason, P_common,\n"
+               "clusters, points removed, microseconds)")
+        ->type_name("FILE");
+    cli.option("--compress", opts.compress_level, "gzip level of the output, 0-9")
+        ->type_name("N")
+        ->check(kfd::app::inRange(0, 9))
+        ->capture_default_str();
+    cli.addQuiet();
+    cli.flag("--print-config", print_config, "print the effective configuration and exit");
+    cli.flag("--list-keys", list_keys, "list every configuration key with its range and exit");
+    cli.option("--suggest-window", window,
+               "Formulas 4-5: suggest the window m for speed V (m/s) and\n"
+               "scan rate F (Hz), then exit",
+               2, 3)
+        ->option_text("V F [P_PAIR]");
+    cli.addVersion(KFD_VERSION);
+    return cli.run(argc, argv, [&] {
+        if (list_keys) {
             for (const auto& k : kfd::configKeys())
                 std::printf("%-22s %-28s %s\n", k.name.c_str(), k.range.c_str(), k.help.c_str());
-            return 0;
-        } else if (a == "--suggest-window") {
-            if (i + 2 >= argc) return usageError("--suggest-window needs SPEED RATE [P_PAIR]");
-            try {
-                const double v = std::stod(argv[++i]);
-                const double f = std::stod(argv[++i]);
-                double pp = 0.985;
-                if (i + 1 < argc && argv[i + 1][0] != '-') pp = std::stod(argv[++i]);
-                const auto s = kfd::suggestWindow(v, f, pp);
-                std::printf("dx = %.3f cm per scan (Formula 4)\n", s.dx_cm);
-                if (s.m_min) std::printf("Formula 5 allows m = %zu..%zu\n", s.m_min, s.m_max);
-                std::printf("window = %zu\np_pair = %g (P_threshold = %.4f)\n", s.m, pp,
-                            s.p_threshold);
-                if (!s.note.empty()) std::printf("note: %s\n", s.note.c_str());
-                return 0;
-            } catch (const std::exception& e) {
-                return usageError(std::string("--suggest-window: ") + e.what());
-            }
-        } else {
-            return usageError("unknown argument '" + a + "'");
+            return;
         }
-    }
-
-    try {
+        if (!window.empty()) return printWindowSuggestion(window);
         if (!config.empty()) opts.pipeline = kfd::loadConfigFile(config);
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "kfd-filter: %s\n", e.what());
-        return 1;
-    }
-    if (print_config) {
-        std::fputs(kfd::toIni(opts.pipeline).c_str(), stdout);
-        return 0;
-    }
-    if (opts.input.empty()) return usageError("no input rawlog (-i)");
-    if (opts.output.empty()) return usageError("no output rawlog (-o)");
-
-    kfd::app::ProgressPrinter progress("kfd-filter");
-    if (!quiet) {
-        opts.on_progress = [&](const kfd::RawlogProgress& p) {
-            progress.update(p.bytes_total ? static_cast<double>(p.bytes_read) / p.bytes_total : 0.0,
-                            p.scans_in, p.scans_kept);
-        };
-    }
-    try {
+        if (print_config) {
+            std::fputs(kfd::toIni(opts.pipeline).c_str(), stdout);
+            return;
+        }
+        if (opts.input.empty()) throw kfd::app::UsageError("no input rawlog (-i)");
+        if (opts.output.empty()) throw kfd::app::UsageError("no output rawlog (-o)");
+        if (auto* progress = cli.progress())
+            opts.on_progress = [progress](const kfd::RawlogProgress& p) {
+                progress->update(
+                    p.bytes_total ? static_cast<double>(p.bytes_read) / p.bytes_total : 0.0,
+                    p.scans_in, p.scans_kept);
+            };
         const auto summary = kfd::RawlogFilter().run(opts);
         printSummary(opts, summary);
-    } catch (const std::exception& e) {
-        if (!quiet) progress.abort();
-        std::fprintf(stderr, "kfd-filter: %s\n", e.what());
-        return 1;
-    }
-    return 0;
+    });
 }

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <string>
 
+#include "common/cli.h"
 #include "kfd/core/denoiser.h"
 #include "kfd/core/distance_filter.h"
 #include "kfd/mrpt/config.h"
@@ -12,65 +13,29 @@
 #include "kfd/mrpt/source.h"
 #include "kfd/render/cluster_figure.h"
 
-namespace {
-const char* kUsage =
-    "Usage: kfd-render -i IN.rawlog (--index N | --time T) -o OUT.png [options]\n"
-    "\n"
-    "Runs the distance filter and the denoiser of CONFIG on one scan and draws its clusters\n"
-    "(each in its own colour), the removed noise points (red), the ring boundaries, the sensor\n"
-    "and a 1 m grid and scale bar, top-down with +x right and +y up. No display needed.\n"
-    "\n"
-    "  -i FILE        rawlog\n"
-    "  --index N      the N-th 2D scan (0-based)\n"
-    "  --time T       the scan nearest to timestamp T (s)\n"
-    "  -c FILE        configuration (.ini [KFD] or .yaml); default: built-in defaults\n"
-    "  -o FILE        output PNG\n"
-    "  --size PX      image width and height (default 800)\n"
-    "  --extent M     half the visible height in metres (default: fit the scan)\n";
-
-int usage(const std::string& m) {
-    std::fprintf(stderr, "kfd-render: %s\nTry 'kfd-render --help'.\n", m.c_str());
-    return 2;
-}
-}  // namespace
-
 int main(int argc, char** argv) {
+    kfd::app::Cli cli(
+        "kfd-render", "-i IN.rawlog (--index N | --time T) -o OUT.png [options]",
+        "Runs the distance filter and the denoiser of CONFIG on one scan and draws its clusters\n"
+        "(each in its own colour), the removed noise points (red), the ring boundaries, the "
+        "sensor\n"
+        "and a 1 m grid and scale bar, top-down with +x right and +y up. No display needed.");
     std::string in, out, cfg;
     long index = -1;
     double stamp = std::nan(""), extent = 0.0;
     int size = 800;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        if (a == "-h" || a == "--help") {
-            std::fputs(kUsage, stdout);
-            return 0;
-        }
-        if (i + 1 >= argc) return usage(a + " needs a value");
-        const std::string v = argv[++i];
-        try {
-            if (a == "-i")
-                in = v;
-            else if (a == "-o")
-                out = v;
-            else if (a == "-c")
-                cfg = v;
-            else if (a == "--index")
-                index = std::stol(v);
-            else if (a == "--time")
-                stamp = std::stod(v);
-            else if (a == "--size")
-                size = std::stoi(v);
-            else if (a == "--extent")
-                extent = std::stod(v);
-            else
-                return usage("unknown option '" + a + "'");
-        } catch (const std::exception& e) {
-            return usage(a + ": " + e.what());
-        }
-    }
-    if (in.empty() || out.empty()) return usage("-i and -o are required");
-    if ((index < 0) == std::isnan(stamp)) return usage("give exactly one of --index and --time");
-    try {
+    cli.option("-i", in, "rawlog")->type_name("FILE")->required();
+    cli.option("--index", index, "the N-th 2D scan (0-based)")->type_name("N");
+    cli.option("--time", stamp, "the scan nearest to timestamp T (s)")->type_name("T");
+    cli.option("-c", cfg, "configuration (.ini [KFD] or .yaml); default: built-in defaults")
+        ->type_name("FILE");
+    cli.option("-o", out, "output PNG")->type_name("FILE")->required();
+    cli.option("--size", size, "image width and height")->type_name("PX")->capture_default_str();
+    cli.option("--extent", extent, "half the visible height in metres (default: fit the scan)")
+        ->type_name("M");
+    return cli.run(argc, argv, [&] {
+        if ((index < 0) == std::isnan(stamp))
+            throw kfd::app::UsageError("give exactly one of --index and --time");
         const kfd::Pipeline::Params p =
             cfg.empty() ? kfd::Pipeline::Params{} : kfd::loadConfigFile(cfg);
         const auto source = kfd::openSource(in);
@@ -107,9 +72,5 @@ int main(int argc, char** argv) {
         if (!img.saveToFile(out)) throw std::runtime_error("cannot write " + out);
         std::printf("kfd-render: scan at %.6f, %zu clusters, %zu noise points -> %s\n",
                     kfd::stampOf(*chosen), r.clusters, r.points_removed, out.c_str());
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "kfd-render: %s\n", e.what());
-        return 1;
-    }
-    return 0;
+    });
 }

@@ -1,0 +1,123 @@
+#include "common/cli.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+
+namespace kfd::app {
+
+ProgressPrinter::ProgressPrinter(std::string app)
+    : app_(std::move(app)), tty_(isatty(fileno(stderr))) {}
+
+void ProgressPrinter::update(double fraction, std::size_t scans, std::size_t kept) {
+    const int pct = static_cast<int>(100.0 * std::clamp(fraction, 0.0, 1.0));
+    if (tty_) {
+        std::fprintf(stderr, "\r[%s] %3d%%  %zu scans, %zu kept", app_.c_str(), pct, scans, kept);
+        open_line_ = pct < 100;
+        if (!open_line_) std::fputc('\n', stderr);
+    } else if (pct / 10 != last_decile_) {
+        last_decile_ = pct / 10;
+        std::fprintf(stderr, "[%s] %3d%%  %zu scans, %zu kept\n", app_.c_str(), pct, scans, kept);
+    }
+}
+
+void ProgressPrinter::abort() {
+    if (open_line_) std::fputc('\n', stderr);
+    open_line_ = false;
+}
+
+namespace {
+
+/// CLI11's help with the app's own synopsis first: usage, about, options, footer.
+class HelpFormatter : public CLI::Formatter {
+  public:
+    explicit HelpFormatter(std::string usage) : usage_(std::move(usage)) { column_width(28); }
+    std::string make_help(const CLI::App* app, std::string,
+                          CLI::AppFormatMode mode) const override {
+        std::string out = usage_ + "\n";
+        if (!app->get_description().empty()) out += "\n" + app->get_description() + "\n";
+        out += make_positionals(app) + make_groups(app, mode) + "\n" + make_footer(app);
+        return out;
+    }
+
+  private:
+    std::string usage_;
+};
+
+}  // namespace
+
+Cli::Cli(std::string name, const std::string& synopsis, std::string about, std::string footer)
+    : name_(std::move(name)), app_(std::move(about), name_) {
+    app_.formatter(std::make_shared<HelpFormatter>("Usage: " + name_ + " " + synopsis));
+    app_.footer(std::move(footer));
+    app_.set_help_flag("-h,--help", "this text");
+    // Like the hand-written parsers before: a repeated option keeps its last value.
+    app_.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+}
+
+void Cli::addQuiet(const std::string& help) { flag("-q,--quiet", quiet_, help); }
+
+void Cli::addVersion(const std::string& version) {
+    app_.set_version_flag("--version", name_ + " " + version, "version");
+}
+
+ProgressPrinter* Cli::progress() {
+    if (quiet_) return nullptr;
+    if (!progress_) progress_.emplace(name_);
+    return &*progress_;
+}
+
+std::string Cli::unexpected(int argc, char** argv) const {
+    // CLI11's message, with the arguments in command-line order (2.1 prints them reversed).
+    std::vector<std::string> left = app_.remaining(), ordered;
+    for (int i = 1; i < argc; ++i) {
+        const auto it = std::find(left.begin(), left.end(), argv[i]);
+        if (it == left.end()) continue;
+        ordered.push_back(*it);
+        left.erase(it);
+    }
+    ordered.insert(ordered.end(), left.begin(), left.end());
+    return (ordered.size() > 1 ? "The following arguments were not expected: "
+                               : "The following argument was not expected: ") +
+           CLI::detail::join(ordered, " ");
+}
+
+int Cli::usageError(const std::string& message) const {
+    std::fprintf(stderr, "%s: %s\nTry '%s --help'.\n", name_.c_str(), message.c_str(),
+                 name_.c_str());
+    return 2;
+}
+
+int Cli::run(int argc, char** argv, const std::function<void()>& body) {
+    try {
+        app_.parse(argc, argv);
+    } catch (const CLI::CallForHelp&) {
+        std::fputs(app_.help().c_str(), stdout);
+        return 0;
+    } catch (const CLI::CallForVersion& e) {
+        std::printf("%s\n", e.what());
+        return 0;
+    } catch (const CLI::ExtrasError&) {
+        return usageError(unexpected(argc, argv));
+    } catch (const CLI::RequiredError& e) {
+        // An unknown argument explains a missing one ("--ouput x"): name it first.
+        return usageError(app_.remaining().empty() ? e.what() : unexpected(argc, argv));
+    } catch (const CLI::ParseError& e) {
+        return usageError(e.what());
+    }
+    try {
+        body();
+        return 0;
+    } catch (const UsageError& e) {
+        if (progress_) progress_->abort();
+        return usageError(e.what());
+    } catch (const std::exception& e) {  // kfd::Error and anything else the libraries throw
+        if (progress_) progress_->abort();
+        std::fprintf(stderr, "%s: %s\n", name_.c_str(), e.what());
+        return 1;
+    }
+}
+
+}  // namespace kfd::app

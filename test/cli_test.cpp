@@ -1,0 +1,314 @@
+// The apps' command-line layer (apps/common/cli.h): number parsing, the exit-code contract and
+// the message format, directly and through every built app.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "common/cli.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// --- The layer itself -----------------------------------------------------------------------
+
+template <class T>
+std::string numberMessage(const std::string& text) {
+    T value{};
+    return kfd::app::parseNumber(text, value);
+}
+
+TEST(CliNumbers, WholeBaseTenNumbersParse) {
+    int i = 0;
+    EXPECT_EQ(kfd::app::parseNumber("010", i), "");
+    EXPECT_EQ(i, 10);  // not octal
+    EXPECT_EQ(kfd::app::parseNumber("+7", i), "");
+    EXPECT_EQ(i, 7);
+    EXPECT_EQ(kfd::app::parseNumber("-3", i), "");
+    EXPECT_EQ(i, -3);
+    double d = 0.0;
+    EXPECT_EQ(kfd::app::parseNumber("1e-3", d), "");
+    EXPECT_DOUBLE_EQ(d, 1e-3);
+    EXPECT_EQ(kfd::app::parseNumber("-0.5", d), "");
+    EXPECT_DOUBLE_EQ(d, -0.5);
+    std::uint32_t u = 0;
+    EXPECT_EQ(kfd::app::parseNumber("4000000000", u), "");
+    EXPECT_EQ(u, 4000000000u);
+}
+
+TEST(CliNumbers, BadTextIsNamedWithWhatWasExpected) {
+    EXPECT_EQ(numberMessage<int>("abc"), "'abc' is not an integer");
+    EXPECT_EQ(numberMessage<int>("1.5"), "'1.5' is not an integer");
+    EXPECT_EQ(numberMessage<int>("0x10"), "'0x10' is not an integer");
+    EXPECT_EQ(numberMessage<int>(""), "'' is not an integer");
+    EXPECT_EQ(numberMessage<int>(" 1"), "' 1' is not an integer");
+    EXPECT_EQ(numberMessage<int>("+-1"), "'+-1' is not an integer");
+    EXPECT_EQ(numberMessage<double>("1.5abc"), "'1.5abc' is not a number");  // stod took 1.5
+    EXPECT_EQ(numberMessage<double>("1,5"), "'1,5' is not a number");
+    EXPECT_EQ(numberMessage<std::uint32_t>("-1"), "'-1' is not a non-negative integer");
+    EXPECT_EQ(numberMessage<int>("99999999999"), "'99999999999' is out of range");
+    EXPECT_EQ(numberMessage<std::uint32_t>("4294967296"), "'4294967296' is out of range");
+    EXPECT_EQ(numberMessage<double>("1e999"), "'1e999' is out of range");
+    EXPECT_THROW(kfd::app::toNumber<double>("x"), kfd::app::UsageError);
+    EXPECT_EQ(kfd::app::toNumber<long>("42"), 42);
+}
+
+TEST(CliNumbers, RangeValidatorNamesTheBounds) {
+    auto range = kfd::app::inRange(0, 9);
+    std::string text = "9";
+    EXPECT_EQ(range(text), "");
+    text = "10";
+    EXPECT_EQ(range(text), "'10' is outside [0, 9]");
+    text = "x";
+    EXPECT_EQ(range(text), "'x' is not an integer");
+}
+
+/// Runs a Cli over `args` with `body`; returns the exit status, stderr in `err`.
+int runCli(kfd::app::Cli& cli, std::vector<std::string> args, const std::function<void()>& body,
+           std::string* err) {
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    testing::internal::CaptureStdout();
+    testing::internal::CaptureStderr();
+    const int status = cli.run(static_cast<int>(argv.size()), argv.data(), body);
+    testing::internal::GetCapturedStdout();
+    *err = testing::internal::GetCapturedStderr();
+    return status;
+}
+
+TEST(Cli, ExitCodesFollowTheContract) {
+    std::string err;
+    int n = 0;
+    bool ran = false;
+    auto make = [&](kfd::app::Cli& cli) { cli.option("-n,--number", n, "a number"); };
+    {
+        kfd::app::Cli cli("app", "[-n N]", "about");
+        make(cli);
+        EXPECT_EQ(runCli(
+                      cli, {"app", "-n", "4"}, [&] { ran = true; }, &err),
+                  0);
+        EXPECT_TRUE(ran);
+        EXPECT_EQ(n, 4);
+        EXPECT_EQ(err, "");
+    }
+    {
+        kfd::app::Cli cli("app", "[-n N]", "about");
+        make(cli);
+        ran = false;
+        EXPECT_EQ(runCli(
+                      cli, {"app", "-n", "4x"}, [&] { ran = true; }, &err),
+                  2);
+        EXPECT_FALSE(ran);  // the body never runs on bad usage
+        EXPECT_EQ(err, "app: --number: '4x' is not an integer\nTry 'app --help'.\n");
+    }
+    {
+        kfd::app::Cli cli("app", "[-n N]", "about");
+        make(cli);
+        EXPECT_EQ(runCli(
+                      cli, {"app"}, [] { throw kfd::app::UsageError("give -n"); }, &err),
+                  2);
+        EXPECT_EQ(err, "app: give -n\nTry 'app --help'.\n");
+    }
+    {
+        kfd::app::Cli cli("app", "[-n N]", "about");
+        make(cli);
+        EXPECT_EQ(runCli(
+                      cli, {"app"}, [] { throw kfd::Error("cannot open x", "x"); }, &err),
+                  1);
+        EXPECT_EQ(err, "app: cannot open x\n");  // bad input: no usage hint
+    }
+    {
+        kfd::app::Cli cli("app", "[-n N]", "about");
+        make(cli);
+        EXPECT_EQ(runCli(
+                      cli, {"app", "-n", "1", "-n", "2"}, [] {}, &err),
+                  0);
+        EXPECT_EQ(n, 2);  // a repeated option keeps its last value, as before
+    }
+}
+
+TEST(Cli, ProgressIsOneLinePerTenPercentOffATerminalAndOffWithQuiet) {
+    kfd::app::ProgressPrinter p("app");
+    testing::internal::CaptureStderr();
+    for (double f : {0.0, 0.05, 0.12, 0.19, 1.0}) p.update(f, 3, 2);
+    p.abort();  // no unfinished line off a terminal
+    EXPECT_EQ(testing::internal::GetCapturedStderr(),
+              "[app]   0%  3 scans, 2 kept\n[app]  12%  3 scans, 2 kept\n"
+              "[app] 100%  3 scans, 2 kept\n");
+    kfd::app::Cli cli("app", "", "about");
+    cli.addQuiet();
+    std::string err;
+    ASSERT_EQ(runCli(
+                  cli, {"app", "-q"}, [] {}, &err),
+              0);
+    EXPECT_EQ(cli.progress(), nullptr);
+}
+
+// --- Every app ------------------------------------------------------------------------------
+
+struct Result {
+    int status = -1;
+    std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream f(p);
+    return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
+/// Runs `exe args` through the shell, stdout and stderr kept apart.
+Result runApp(const std::string& exe, const std::string& args) {
+    const fs::path dir = fs::temp_directory_path() / ("kfd_cli_test_" + std::to_string(getpid()));
+    fs::create_directories(dir);
+    const std::string cmd = "'" + exe + "' " + args + " > '" + (dir / "out").string() + "' 2> '" +
+                            (dir / "err").string() + "'";
+    const int st = std::system(cmd.c_str());
+    Result r{WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(dir / "out"), slurp(dir / "err")};
+    fs::remove_all(dir);
+    return r;
+}
+
+struct App {
+    const char* name;
+    const char* exe;
+};
+
+std::vector<App> apps() {
+    std::vector<App> a{{"kfd-filter", KFD_FILTER_EXE},
+                       {"kfd-icp-slam", KFD_ICP_SLAM_EXE},
+                       {"kfd-eval", KFD_EVAL_EXE},
+                       {"kfd-simulate", KFD_SIMULATE_EXE},
+                       {"kfd-denoise-eval", KFD_DENOISE_EVAL_EXE},
+                       {"kfd-chart", KFD_CHART_EXE}};
+#ifdef KFD_RENDER_EXE
+    a.push_back({"kfd-render", KFD_RENDER_EXE});
+#endif
+    return a;
+}
+
+/// Bad usage: status 2, "APP: message" and "Try 'APP --help'." on stderr, nothing on stdout.
+void expectUsageError(const App& app, const std::string& args, const std::string& message) {
+    SCOPED_TRACE(std::string(app.name) + " " + args);
+    const Result r = runApp(app.exe, args);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(r.err.rfind(std::string(app.name) + ": ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(std::string("\nTry '") + app.name + " --help'.\n"), std::string::npos)
+        << r.err;
+}
+
+struct UsageCase {
+    const char* app;
+    const char* args;
+    const char* message;  // a part of the message
+};
+
+/// Every case through expectUsageError (kfd-render's only where it is built).
+void expectUsageErrors(const std::vector<UsageCase>& cases) {
+    const auto built = apps();
+    for (const auto& c : cases) {
+        const auto it = std::find_if(built.begin(), built.end(),
+                                     [&](const App& a) { return c.app == std::string(a.name); });
+        if (it != built.end())
+            expectUsageError(*it, c.args, c.message);
+        else
+            EXPECT_STREQ(c.app, "kfd-render") << "not built";
+    }
+}
+
+TEST(CliApps, HelpExitsZeroWithUsageOnStdout) {
+    for (const auto& a : apps()) {
+        SCOPED_TRACE(a.name);
+        for (const char* flag : {"--help", "-h"}) {
+            const Result r = runApp(a.exe, flag);
+            EXPECT_EQ(r.status, 0);
+            EXPECT_EQ(r.out.rfind(std::string("Usage: ") + a.name + " ", 0), 0u) << r.out;
+            EXPECT_NE(r.out.find("-h,--help"), std::string::npos) << r.out;
+            EXPECT_EQ(r.err, "");
+        }
+    }
+}
+
+TEST(CliApps, UnknownFlagIsBadUsage) {
+    for (const auto& a : apps()) expectUsageError(a, "--bogus", "not expected: --bogus");
+    expectUsageErrors({
+        // Named even when it leaves a required argument out (a typo: "--ouput x").
+        {"kfd-simulate", "--ouput x.rawlog", "not expected: --ouput x.rawlog"},
+        {"kfd-eval", "est.tum -r gt.relations extra.tum", "not expected: extra.tum"},
+    });
+}
+
+TEST(CliApps, BadUsageExitsTwoAndSaysWhatIsWrong) {
+    expectUsageErrors({
+        // A bad number names the flag and the value.
+        {"kfd-filter", "-i a -o b --compress abc", "--compress: 'abc' is not an integer"},
+        {"kfd-filter", "-i a -o b --compress 12", "--compress: '12' is outside"},
+        {"kfd-filter", "--suggest-window 0.4 5x", "--suggest-window: '5x' is not a number"},
+        {"kfd-icp-slam", "x.ini --max-dt 1ms", "--max-dt: '1ms' is not a number"},
+        {"kfd-icp-slam", "x.ini -m odometry --match-drop ten",
+         "--match-drop: 'ten' is not a number"},
+        {"kfd-eval", "est.tum -r gt.relations --rpe-delta 1,5",
+         "--rpe-delta: '1,5' is not a number"},
+        {"kfd-simulate", "-o x.rawlog -v fast", "--speed: 'fast' is not a number"},
+        {"kfd-simulate", "-o x.rawlog --seed -1", "--seed: '-1' is not a non-negative integer"},
+        {"kfd-chart", "in.csv -o out.png --size 640 wide", "--size: 'wide' is not an integer"},
+        {"kfd-render", "-i a -o b.png --index 3rd", "--index: '3rd' is not an integer"},
+        // A missing required argument.
+        {"kfd-filter", "-o out.rawlog", "no input rawlog (-i)"},
+        {"kfd-icp-slam", "", "CONFIG.ini is required"},
+        {"kfd-eval", "-r gt.relations", "EST.tum is required"},
+        {"kfd-simulate", "-w office", "--output is required"},
+        {"kfd-denoise-eval", "-i a.rawlog -l a.labels.csv", "-c is required"},
+        {"kfd-chart", "in.csv", "-o is required"},
+        {"kfd-render", "-i a --index 1", "-o is required"},
+        // A missing value, or arguments that contradict each other.
+        {"kfd-eval", "est.tum -r", "--relations"},
+        {"kfd-eval", "est.tum", "give --relations and/or --gt"},
+        {"kfd-icp-slam", "x.ini a.rawlog -i b.rawlog", "rawlog given twice"},
+        {"kfd-icp-slam", "x.ini --match-drop 10", "--match-drop applies to --mode odometry only"},
+        {"kfd-icp-slam", "x.ini --mode fast", "--mode: unknown pre-filter mode"},
+        {"kfd-simulate", "-o x.rawlog --gridmap g", "--gridmap and --route"},
+        {"kfd-chart", "in.csv -o out.png --size 640", "--size"},
+        {"kfd-render", "-i a -o b.png", "give exactly one of --index and --time"},
+    });
+}
+
+TEST(CliApps, BadInputExitsOneWithoutTheUsageHint) {
+    const Result r = runApp(KFD_DENOISE_EVAL_EXE, "-i a -l b -c /nonexistent.ini");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.err.rfind("kfd-denoise-eval: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("/nonexistent.ini"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("Try "), std::string::npos) << r.err;
+    EXPECT_EQ(runApp(KFD_CHART_EXE, "/nonexistent.csv -o out.png").status, 1);
+}
+
+TEST(CliApps, FilterVersionAndEarlyExits) {
+    Result r = runApp(KFD_FILTER_EXE, "--version");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_EQ(r.out.rfind("kfd-filter ", 0), 0u) << r.out;
+    r = runApp(KFD_FILTER_EXE, "--suggest-window 0.752 40");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.out.find("window = "), std::string::npos) << r.out;
+    r = runApp(KFD_FILTER_EXE, "--suggest-window 0.4 5 0.9");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.out.find("p_pair = 0.9 "), std::string::npos) << r.out;
+    expectUsageErrors({{"kfd-filter", "--suggest-window 0.4 5 2", "--suggest-window: p_pair"}});
+    r = runApp(KFD_FILTER_EXE, "--list-keys");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.out.find("min_range"), std::string::npos) << r.out;
+    r = runApp(KFD_FILTER_EXE, "--compress 0 --print-config");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_EQ(r.out.rfind("[KFD]", 0), 0u) << r.out;
+}
+
+}  // namespace
