@@ -6,6 +6,7 @@
 #include <string>
 
 #include "kfd/core/clusters.h"
+#include "kfd/core/error.h"
 #include "kfd/core/range_aware_clustering.h"
 #include "kfd/core/ring_clustering.h"
 #include "kfd/core/scan.h"
@@ -17,7 +18,7 @@ enum class DenoiseVariant : std::uint8_t {
     RangeAware,  // kfd's improved variant (RangeAwareClustering + range-adaptive threshold)
 };
 const char* toString(DenoiseVariant v);
-/// Parses "reference" or "range_aware"; throws std::invalid_argument otherwise.
+/// Parses "reference" or "range_aware"; throws kfd::ParameterError otherwise.
 DenoiseVariant parseDenoiseVariant(const std::string& s);
 
 class Denoiser {
@@ -50,7 +51,7 @@ class Denoiser {
 
     Denoiser() { initialize(Params{}); }
     explicit Denoiser(const Params& p) { initialize(p); }
-    void initialize(const Params& p);  // std::invalid_argument on bad values
+    void initialize(const Params& p);  // kfd::ParameterError on bad values
     const Params& params() const { return params_; }
 
     /// Clusters the scan and clears the valid flag of every noise point.

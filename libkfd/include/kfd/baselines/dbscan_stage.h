@@ -1,0 +1,30 @@
+// DBSCAN denoise as a pipeline stage, named "dbscan" (baseline, beyond the paper).
+#pragma once
+
+#include <vector>
+
+#include "kfd/baselines/dbscan.h"
+#include "kfd/core/stage.h"
+
+namespace kfd {
+
+/// Never drops a scan; invalidates noise points. Diagnostics: DbscanFilter::Result.
+class DbscanStage : public Stage {
+  public:
+    static constexpr const char* kName = "dbscan";
+    static constexpr const char* kHelp =
+        "baseline: DBSCAN denoise (Ester et al. 1996; the paper's comparison, Sec. 4)";
+    using Params = DbscanFilter::Params;
+    /// Keys: dbscan_eps_m, dbscan_min_pts.
+    static std::vector<StageKey> keys();
+
+    explicit DbscanStage(const Params& p = {}) : algo_(p) {}
+    const char* name() const override { return kName; }
+    bool process(Scan& scan, StageReport& report, const ScanReport& chain) override;
+    const DbscanFilter& filter() const { return algo_; }
+
+  private:
+    DbscanFilter algo_;
+};
+
+}  // namespace kfd
