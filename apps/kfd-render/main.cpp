@@ -120,7 +120,7 @@ int main(int argc, char** argv) {
         o.half_extent_m = extent;
         o.ring_r_max =
             p.get<kfd::DenoiseStage>().variant == kfd::DenoiseVariant::Reference ? r.r_max : 0.0;
-        o.rings = p.get<kfd::DenoiseStage>().rings;
+        o.rings = p.get<kfd::DenoiseStage>().reference.rings.rings;
         kfd::ClusterFigure fig(o);
         auto img = fig.render(scan, den.clusters());
         if (!img.saveToFile(out)) throw std::runtime_error("cannot write " + out);

@@ -193,18 +193,18 @@ TEST(Denoiser, RangeAwareKeepsFarSmallObject) {
 
 TEST(Denoiser, ReferenceIgnoresMinObjectSize) {
     auto p = variant(DenoiseVariant::Reference);
-    p.min_object_size_m = 0.1;
-    p.min_points_floor = 1;
+    p.filter.min_object_size_m = 0.1;
+    p.filter.min_points_floor = 1;
     Scan scan = wallAndFarSmallObject();
     EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 4u);
 }
 
 TEST(Denoiser, MThresholdIsConfigurable) {
     auto p = variant(DenoiseVariant::Reference);
-    p.m_threshold = 4;  // the 4-point object now reaches the bar
+    p.filter.m_threshold = 4;  // the 4-point object now reaches the bar
     Scan scan = wallAndFarSmallObject();
     EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 0u);
-    p.m_threshold = 5;
+    p.filter.m_threshold = 5;
     scan = wallAndFarSmallObject();
     EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 4u);
 }
@@ -212,10 +212,10 @@ TEST(Denoiser, MThresholdIsConfigurable) {
 TEST(Denoiser, MinPointsFloorIsConfigurable) {
     // The far object's range-adaptive bar is the floor: 4 points pass a floor of 4, not of 5.
     auto p = variant(DenoiseVariant::RangeAware);
-    p.min_points_floor = 4;
+    p.filter.min_points_floor = 4;
     Scan scan = wallAndFarSmallObject();
     EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 0u);
-    p.min_points_floor = 5;
+    p.filter.min_points_floor = 5;
     scan = wallAndFarSmallObject();
     EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 4u);
 }
@@ -223,7 +223,7 @@ TEST(Denoiser, MinPointsFloorIsConfigurable) {
 TEST(Denoiser, ReferenceResultReportsRingsAndBlocks) {
     Scan scan = wallAndFarSmallObject();
     auto p = variant(DenoiseVariant::Reference);
-    p.ring_r_max = 20.0;  // r_1 = 8.94 m: everything in ring 1
+    p.reference.rings.r_max = 20.0;  // r_1 = 8.94 m: everything in ring 1
     const auto res = Denoiser(p).filter(scan);
     EXPECT_DOUBLE_EQ(res.r_max, 20.0);
     EXPECT_EQ(res.blocks, 2u);
@@ -235,8 +235,8 @@ TEST(Denoiser, AngleGapFactorReachesBothVariants) {
     // With theta = 30 deg the far object (22 deg from the wall) joins the wall's block in the
     // reference variant (everything in ring 1 with r_max = 20 m) and is no longer removed.
     auto p = variant(DenoiseVariant::Reference);
-    p.ring_r_max = 20.0;
-    p.angle_gap_factor = 30.0;
+    p.reference.rings.r_max = 20.0;
+    p.reference.angle_gap_factor = p.range_aware.angle_gap_factor = 30.0;
     Scan scan = wallAndFarSmallObject();
     auto res = Denoiser(p).filter(scan);
     EXPECT_EQ(res.clusters, 1u);
@@ -250,9 +250,10 @@ TEST(Denoiser, AngleGapFactorReachesBothVariants) {
 TEST(Denoiser, DefaultsAreThePapers) {
     const Denoiser d;
     EXPECT_EQ(d.params().variant, DenoiseVariant::Reference);
-    EXPECT_EQ(d.params().rings, 5u);
-    EXPECT_EQ(d.params().m_threshold, 10u);
-    EXPECT_DOUBLE_EQ(d.params().angle_gap_factor, 10.0);
+    EXPECT_EQ(d.params().reference.rings.rings, 5u);
+    EXPECT_EQ(d.params().filter.m_threshold, 10u);
+    EXPECT_DOUBLE_EQ(d.params().reference.angle_gap_factor, 10.0);
+    EXPECT_DOUBLE_EQ(d.params().range_aware.angle_gap_factor, 10.0);
 }
 
 TEST(Denoiser, VariantNames) {
@@ -275,16 +276,17 @@ TEST(Denoiser, RejectsBadParams) {
         mutate(p);
         EXPECT_THROW(Denoiser{p}, kfd::ParameterError);
     };
-    bad([](auto& p) { p.m_threshold = 0; });
-    bad([](auto& p) { p.min_points_floor = 0; });
-    bad([](auto& p) { p.min_object_size_m = -0.1; });
-    bad([](auto& p) { p.min_object_size_m = std::nan(""); });
-    bad([](auto& p) { p.rings = 0; });
-    bad([](auto& p) { p.ring_r_max = -1.0; });
-    bad([](auto& p) { p.angle_gap_factor = 0.0; });
-    bad([](auto& p) { p.merge_distance_m = -1.0; });
-    bad([](auto& p) { p.jump_lambda_deg = 90.0; });
-    bad([](auto& p) { p.jump_sigma_m = -0.01; });
+    bad([](auto& p) { p.filter.m_threshold = 0; });
+    bad([](auto& p) { p.filter.min_points_floor = 0; });
+    bad([](auto& p) { p.filter.min_object_size_m = -0.1; });
+    bad([](auto& p) { p.filter.min_object_size_m = std::nan(""); });
+    bad([](auto& p) { p.reference.rings.rings = 0; });
+    bad([](auto& p) { p.reference.rings.r_max = -1.0; });
+    bad([](auto& p) { p.reference.angle_gap_factor = 0.0; });
+    bad([](auto& p) { p.range_aware.angle_gap_factor = 0.0; });
+    bad([](auto& p) { p.reference.merge_distance_m = -1.0; });
+    bad([](auto& p) { p.range_aware.jump_lambda_deg = 90.0; });
+    bad([](auto& p) { p.range_aware.jump_sigma_m = -0.01; });
 }
 
 }  // namespace

@@ -99,7 +99,7 @@ TEST(Pipeline, InvalidStageParamsThrow) {
     p.get<kfd::DistanceStage>().max_range = 1.0;
     EXPECT_THROW(Pipeline{p}, kfd::ParameterError);
     p = withStages({"denoise"});
-    p.get<kfd::DenoiseStage>().m_threshold = 0;
+    p.get<kfd::DenoiseStage>().filter.m_threshold = 0;
     EXPECT_THROW(Pipeline{p}, kfd::ParameterError);
 }
 

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "kfd/baselines/stages.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/mrpt/default_stages.h"
 
 namespace {
 
@@ -49,9 +49,10 @@ TEST(Config, PaperPresetsHoldThePublishedValues) {
     EXPECT_EQ(b.get<kfd::KeyframeStage>().bins, 15u);
     EXPECT_DOUBLE_EQ(b.get<kfd::KeyframeStage>().p_pair, 0.99);
     for (const auto& p : {a, b}) {
-        EXPECT_EQ(p.get<kfd::DenoiseStage>().rings, 5u);
-        EXPECT_DOUBLE_EQ(p.get<kfd::DenoiseStage>().angle_gap_factor, 10.0);
-        EXPECT_EQ(p.get<kfd::DenoiseStage>().m_threshold, 10u);
+        EXPECT_EQ(p.get<kfd::DenoiseStage>().reference.rings.rings, 5u);
+        EXPECT_DOUBLE_EQ(p.get<kfd::DenoiseStage>().reference.angle_gap_factor, 10.0);
+        EXPECT_DOUBLE_EQ(p.get<kfd::DenoiseStage>().range_aware.angle_gap_factor, 10.0);
+        EXPECT_EQ(p.get<kfd::DenoiseStage>().filter.m_threshold, 10u);
         EXPECT_EQ(p.get<kfd::DenoiseStage>().variant, kfd::DenoiseVariant::Reference);
         // The published method has no guards.
         EXPECT_EQ(p.get<kfd::KeyframeStage>().max_consecutive_drops, 0u);
@@ -223,4 +224,44 @@ TEST(Config, RadiusAndSorKeysLoadAndAreRangeChecked) {
         }
     }
     EXPECT_EQ(found, 4u);
+}
+
+TEST(Config, ConfigErrorIsAKfdErrorNamingTheKey) {
+    try {
+        fromIniText("[KFD]\nradius_min_neighbors = 0\n");
+        FAIL();
+    } catch (const kfd::Error& e) {  // the one exception root
+        EXPECT_EQ(e.field(), "radius_min_neighbors");
+        EXPECT_NE(dynamic_cast<const kfd::ConfigError*>(&e), nullptr);
+    }
+}
+
+TEST(Config, KeyTableIsDerivedFromTheStageRegistry) {
+    const auto& reg = kfd::defaultStageRegistry();
+    std::vector<std::string> want{"pipeline"};
+    for (const auto& s : reg.stages())
+        for (const auto& k : s.keys) want.push_back(k.name);
+    std::vector<std::string> got;
+    for (const auto& k : kfd::configKeys()) got.push_back(k.name);
+    EXPECT_EQ(got, want);
+    EXPECT_EQ(kfd::configKeys().front().range, reg.names());
+    // Every key, and only those, printed by toIni in the same order.
+    const std::string ini = kfd::toIni(kfd::Pipeline::Params{});
+    std::size_t pos = 0;
+    for (const auto& k : want) {
+        const auto at = ini.find("\n" + k + " = ", pos);
+        ASSERT_NE(at, std::string::npos) << k;
+        pos = at + 1;
+    }
+    // A registry with the core stages only has only the core keys.
+    std::size_t core_keys = 1;
+    for (const auto& s : kfd::coreStageRegistry().stages()) core_keys += s.keys.size();
+    EXPECT_EQ(kfd::configKeys(kfd::coreStageRegistry()).size(), core_keys);
+}
+
+TEST(Config, AngleGapFactorReachesBothDenoiseVariants) {
+    const auto p = fromIniText("[KFD]\nangle_gap_factor = 30\n");
+    EXPECT_EQ(p.get<kfd::DenoiseStage>().reference.angle_gap_factor, 30.0);
+    EXPECT_EQ(p.get<kfd::DenoiseStage>().range_aware.angle_gap_factor, 30.0);
+    EXPECT_NE(kfd::toIni(p).find("angle_gap_factor = 30\n"), std::string::npos);
 }

@@ -173,6 +173,29 @@ TEST(IcpSlamRunner, BadInputIsAClearError) {
     EXPECT_THROW(kfd::IcpSlamRunner().run(o), kfd::ConfigError);
 }
 
+TEST(IcpSlamRunner, ModesAreNamedStageListsOfTheRegistry) {
+    const auto& modes = kfd::prefilterModes();
+    std::vector<std::string> names;
+    for (const auto& m : modes) {
+        names.push_back(m.name);
+        EXPECT_FALSE(m.description.empty()) << m.name;
+        EXPECT_STREQ(kfd::toString(m.mode), m.name.c_str());
+        EXPECT_EQ(kfd::parsePrefilterMode(m.name), m.mode);
+        for (const auto& s : m.stages)
+            EXPECT_NE(kfd::defaultStageRegistry().find(s), nullptr) << m.name << ": " << s;
+        kfd::Pipeline::Params kfd_params;
+        kfd_params.stages = {"denoise"};  // the [KFD] list: only the kfd mode keeps it
+        const auto p = kfd::pipelineForMode(m.mode, kfd_params);
+        EXPECT_EQ(p.stages, m.uses_kfd_stages ? kfd_params.stages : m.stages) << m.name;
+    }
+    EXPECT_EQ(names, (std::vector<std::string>{"none", "odometry", "keyframe", "kfd", "dbscan",
+                                               "radius", "sor"}));
+    // The baseline modes run "distance" and then the baseline, described by its stage's help.
+    EXPECT_EQ(modes[6].stages, (std::vector<std::string>{"distance", "sor"}));
+    EXPECT_NE(modes[6].description.find(kfd::defaultStageRegistry().find("sor")->help),
+              std::string::npos);
+}
+
 TEST(IcpSlamRunner, ModesParseAndMapToPipelines) {
     EXPECT_EQ(kfd::parsePrefilterMode("dbscan"), kfd::PrefilterMode::Dbscan);
     EXPECT_THROW(kfd::parsePrefilterMode("fast"), kfd::ParameterError);

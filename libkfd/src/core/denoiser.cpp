@@ -16,25 +16,15 @@ DenoiseVariant parseDenoiseVariant(const std::string& s) {
 }
 
 void Denoiser::initialize(const Params& p) {
-    if (p.m_threshold < 1) throw ParameterError("m_threshold", "m_threshold must be >= 1");
-    if (!(p.min_object_size_m >= 0.0))
+    if (p.filter.m_threshold < 1) throw ParameterError("m_threshold", "m_threshold must be >= 1");
+    if (!(p.filter.min_object_size_m >= 0.0))
         throw ParameterError("min_object_size_m", "min_object_size_m must be >= 0");
-    if (p.min_points_floor < 1)
+    if (p.filter.min_points_floor < 1)
         throw ParameterError("min_points_floor", "min_points_floor must be >= 1");
-    RingClustering::Params rp;
-    rp.rings.rings = p.rings;
-    rp.rings.r_max = p.ring_r_max;
-    rp.angle_gap_factor = p.angle_gap_factor;
-    rp.merge_distance_m = p.merge_distance_m;
-    reference_.initialize(rp);
-    RangeAwareClustering::Params ap;
-    ap.angle_gap_factor = p.angle_gap_factor;
-    ap.jump_lambda_deg = p.jump_lambda_deg;
-    ap.jump_sigma_m = p.jump_sigma_m;
-    range_aware_.initialize(ap);
-    filter_.m_threshold = p.m_threshold;
-    filter_.min_points_floor = p.min_points_floor;
-    filter_.min_object_size_m = p.variant == DenoiseVariant::RangeAware ? p.min_object_size_m : 0.0;
+    reference_.initialize(p.reference);
+    range_aware_.initialize(p.range_aware);
+    filter_ = p.filter;
+    if (p.variant != DenoiseVariant::RangeAware) filter_.min_object_size_m = 0.0;
     params_ = p;
 }
 

@@ -23,18 +23,18 @@ DenoiseVariant parseDenoiseVariant(const std::string& s);
 
 class Denoiser {
   public:
+    /// The parameters of the two clustering variants and of the cluster filter, nested (the
+    /// config key angle_gap_factor sets both variants' factor).
     struct Params {
         DenoiseVariant variant = DenoiseVariant::Reference;
-        std::size_t rings = 5;           // t (Sec. 3.2.1), reference variant
-        double ring_r_max = 0.0;         // m; 0 = farthest valid point (Formulas 6-8)
-        double angle_gap_factor = 10.0;  // theta_threshold = factor x resolution (Sec. 3.2.2)
-        double merge_distance_m = 0.0;   // d_threshold (Formula 10); 0 = automatic
-        std::size_t m_threshold = 10;    // minimum cluster size, points (Sec. 3.2.4)
-        // Range-aware variant only:
-        double jump_lambda_deg = 10.0;     // breakpoint incidence limit (deg)
-        double jump_sigma_m = 0.03;        // range noise (m)
-        double min_object_size_m = 0.10;   // a cluster must be this wide in beams at its range
-        std::size_t min_points_floor = 3;  // ... but never fewer points than this
+        /// Reference variant: t, r_max (Formulas 6-8), theta_threshold factor (Sec. 3.2.2),
+        /// d_threshold (Formula 10).
+        RingClustering::Params reference;
+        /// Range-aware variant: theta_threshold factor, breakpoint lambda and sigma.
+        RangeAwareClustering::Params range_aware;
+        /// Sec. 3.2.4: m_threshold (both variants); min_object_size_m and min_points_floor
+        /// (range-aware variant only: the reference variant always uses the fixed m_threshold).
+        ClusterFilterParams filter{10, 0.10, 3};
     };
 
     struct Result {
