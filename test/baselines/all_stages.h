@@ -8,12 +8,7 @@
 namespace kfd::test {
 
 inline const StageRegistry& allStages() {
-    static const StageRegistry r = [] {
-        StageRegistry reg;
-        registerCoreStages(reg);
-        registerBaselineStages(reg);
-        return reg;
-    }();
+    static const StageRegistry r = makeStageRegistry({registerCoreStages, registerBaselineStages});
     return r;
 }
 

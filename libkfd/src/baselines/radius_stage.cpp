@@ -13,12 +13,4 @@ std::vector<StageKey> RadiusStage::keys() {
                            [](P& p) -> std::size_t& { return p.min_neighbors; })};
 }
 
-bool RadiusStage::process(Scan& scan, StageReport& report, const ScanReport&) {
-    const auto r = algo_.filter(scan);
-    report.noise = true;
-    report.points_removed = r.points_removed;
-    report.setDiagnostics(r);
-    return true;
-}
-
 }  // namespace kfd

@@ -14,12 +14,4 @@ std::vector<StageKey> SorStage::keys() {
                           0, 100, false, [](P& p) -> double& { return p.std_mul; })};
 }
 
-bool SorStage::process(Scan& scan, StageReport& report, const ScanReport&) {
-    const auto r = algo_.filter(scan);
-    report.noise = true;
-    report.points_removed = r.points_removed;
-    report.setDiagnostics(r);
-    return true;
-}
-
 }  // namespace kfd

@@ -57,12 +57,4 @@ std::vector<StageKey> DenoiseStage::keys() {
                        [](P& p) -> std::size_t& { return p.filter.min_points_floor; })};
 }
 
-bool DenoiseStage::process(Scan& scan, StageReport& report, const ScanReport&) {
-    const Denoiser::Result r = algo_.filter(scan);
-    report.noise = true;
-    report.points_removed = r.points_removed;
-    report.setDiagnostics(r);
-    return true;
-}
-
 }  // namespace kfd

@@ -107,7 +107,7 @@ void Pipeline::reset() {
 
 const Clusters* Pipeline::lastClusters() const {
     const auto* d = find<DenoiseStage>();
-    return d ? &d->denoiser().clusters() : nullptr;
+    return d ? &d->algorithm().clusters() : nullptr;
 }
 
 }  // namespace kfd

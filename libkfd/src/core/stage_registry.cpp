@@ -39,12 +39,14 @@ void registerCoreStages(StageRegistry& registry) {
     registry.add<DenoiseStage>();
 }
 
+StageRegistry makeStageRegistry(std::initializer_list<void (*)(StageRegistry&)> registrars) {
+    StageRegistry r;
+    for (auto* add : registrars) add(r);
+    return r;
+}
+
 const StageRegistry& coreStageRegistry() {
-    static const StageRegistry r = [] {
-        StageRegistry reg;
-        registerCoreStages(reg);
-        return reg;
-    }();
+    static const StageRegistry r = makeStageRegistry({registerCoreStages});
     return r;
 }
 

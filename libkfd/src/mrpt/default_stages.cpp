@@ -3,12 +3,7 @@
 namespace kfd {
 
 const StageRegistry& defaultStageRegistry() {
-    static const StageRegistry r = [] {
-        StageRegistry reg;
-        registerCoreStages(reg);
-        registerBaselineStages(reg);
-        return reg;
-    }();
+    static const StageRegistry r = makeStageRegistry({registerCoreStages, registerBaselineStages});
     return r;
 }
 

@@ -9,22 +9,16 @@
 namespace kfd {
 
 /// Never drops a scan; invalidates noise points. Diagnostics: DbscanFilter::Result.
-class DbscanStage : public Stage {
+class DbscanStage : public DenoisingStage<DbscanFilter> {
   public:
     static constexpr const char* kName = "dbscan";
     static constexpr const char* kHelp =
         "baseline: DBSCAN denoise (Ester et al. 1996; the paper's comparison, Sec. 4)";
-    using Params = DbscanFilter::Params;
     /// Keys: dbscan_eps_m, dbscan_min_pts.
     static std::vector<StageKey> keys();
 
-    explicit DbscanStage(const Params& p = {}) : algo_(p) {}
+    explicit DbscanStage(const Params& p = {}) : DenoisingStage(p) {}
     const char* name() const override { return kName; }
-    bool process(Scan& scan, StageReport& report, const ScanReport& chain) override;
-    const DbscanFilter& filter() const { return algo_; }
-
-  private:
-    DbscanFilter algo_;
 };
 
 }  // namespace kfd

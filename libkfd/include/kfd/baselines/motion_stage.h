@@ -22,6 +22,7 @@ class MotionStage : public Stage {
     const char* name() const override { return kName; }
     bool process(Scan& scan, StageReport& report, const ScanReport& chain) override;
     void reset() override { algo_.reset(); }
+    const MotionFilter& algorithm() const { return algo_; }
 
   private:
     MotionFilter algo_;

@@ -9,21 +9,16 @@
 namespace kfd {
 
 /// Never drops a scan; invalidates noise points. Diagnostics: RadiusOutlierFilter::Result.
-class RadiusStage : public Stage {
+class RadiusStage : public DenoisingStage<RadiusOutlierFilter> {
   public:
     static constexpr const char* kName = "radius";
     static constexpr const char* kHelp =
         "baseline: radius outlier removal (PCL's RadiusOutlierRemoval)";
-    using Params = RadiusOutlierFilter::Params;
     /// Keys: radius_m, radius_min_neighbors.
     static std::vector<StageKey> keys();
 
-    explicit RadiusStage(const Params& p = {}) : algo_(p) {}
+    explicit RadiusStage(const Params& p = {}) : DenoisingStage(p) {}
     const char* name() const override { return kName; }
-    bool process(Scan& scan, StageReport& report, const ScanReport& chain) override;
-
-  private:
-    RadiusOutlierFilter algo_;
 };
 
 }  // namespace kfd

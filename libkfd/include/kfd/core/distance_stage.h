@@ -21,7 +21,7 @@ class DistanceStage : public Stage {
     explicit DistanceStage(const Params& p = {}) : algo_(p) {}
     const char* name() const override { return kName; }
     bool process(Scan& scan, StageReport& report, const ScanReport& chain) override;
-    const DistanceFilter& filter() const { return algo_; }
+    const DistanceFilter& algorithm() const { return algo_; }
 
   private:
     DistanceFilter algo_;

@@ -23,7 +23,7 @@ class KeyframeStage : public Stage {
     const char* name() const override { return kName; }
     bool process(Scan& scan, StageReport& report, const ScanReport& chain) override;
     void reset() override { algo_.reset(); }
-    const KeyframeSelector& selector() const { return algo_; }
+    const KeyframeSelector& algorithm() const { return algo_; }
 
   private:
     KeyframeSelector algo_;

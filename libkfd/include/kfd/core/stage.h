@@ -110,6 +110,27 @@ class Stage {
     virtual void reset() {}
 };
 
+/// A stage around a denoising algorithm `Algo` (Params, and Result filter(Scan&) with a
+/// points_removed field): never drops a scan, reports its removals as noise, and keeps the
+/// algorithm's Result as the diagnostics. A concrete stage adds kName, kHelp, keys() and name().
+template <class Algo>
+class DenoisingStage : public Stage {
+  public:
+    using Params = typename Algo::Params;
+    explicit DenoisingStage(const Params& p) : algo_(p) {}
+    bool process(Scan& scan, StageReport& report, const ScanReport&) override {
+        const auto r = algo_.filter(scan);
+        report.noise = true;
+        report.points_removed = r.points_removed;
+        report.setDiagnostics(r);
+        return true;
+    }
+    const Algo& algorithm() const { return algo_; }
+
+  private:
+    Algo algo_;
+};
+
 /// A stage's parameters behind a type-erased handle, so that one Pipeline::Params can hold the
 /// parameters of every stage of a registry without naming their types.
 class StageParams {

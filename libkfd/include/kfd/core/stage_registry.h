@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -72,6 +73,9 @@ class StageRegistry {
   private:
     std::vector<StageInfo> stages_;
 };
+
+/// A registry filled by `registrars` in order, e.g. {registerCoreStages, registerBaselineStages}.
+StageRegistry makeStageRegistry(std::initializer_list<void (*)(StageRegistry&)> registrars);
 
 /// Registers the paper's stages: distance (Algorithm 1), keyframe (Sec. 3.1), denoise
 /// (Sec. 3.2), in that order.
