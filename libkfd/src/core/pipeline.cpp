@@ -81,6 +81,8 @@ ScanReport Pipeline::process(Scan& scan) {
     ScanReport report;
     if (scan.valid.size() != scan.range.size()) throw Error("scan: range and valid sizes differ");
     report.points_in = scan.countValid();
+    // One clock read per stage: each stage's end is the next one's start, and the last one's
+    // end closes the chain's time.
     auto t = t0;
     for (auto& stage : stages_) {
         StageReport& sr = report.stage_reports[report.stage_count++];
@@ -96,8 +98,9 @@ ScanReport Pipeline::process(Scan& scan) {
             break;
         }
     }
+    if (stages_.empty()) t = Clock::now();
+    report.microseconds = std::chrono::duration<double, std::micro>(t - t0).count();
     report.points_out = scan.countValid();
-    report.microseconds = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
     return report;
 }
 

@@ -49,7 +49,7 @@ class StageReport {
 
   private:
     const std::type_info* type_ = nullptr;
-    alignas(std::max_align_t) unsigned char data_[kDiagnosticsBytes] = {};
+    alignas(std::max_align_t) unsigned char data_[kDiagnosticsBytes];  // set with type_
 };
 
 /// Everything the chain learned about one scan: one StageReport per stage that ran, in order.
@@ -62,7 +62,7 @@ struct ScanReport {
     std::size_t points_in = 0;   // valid beams on input
     std::size_t points_out = 0;  // valid beams on output
     double microseconds = 0.0;   // wall time spent in the chain
-    std::array<StageReport, kMaxStages> stage_reports{};
+    std::array<StageReport, kMaxStages> stage_reports;
     std::size_t stage_count = 0;  // stages that ran (the first stage_count of stage_reports)
 
     const StageReport* begin() const { return stage_reports.data(); }
