@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "kfd/core/error.h"
 #include "kfd/core/scan.h"
 
 namespace kfd {
@@ -24,12 +25,12 @@ inline std::vector<std::uint8_t> flags(std::initializer_list<int> v) {
     return std::vector<std::uint8_t>(v.begin(), v.end());
 }
 
-/// The std::invalid_argument text a Filter's constructor gives for `p`, or "<no error>".
+/// The kfd::Error text a Filter's constructor gives for `p`, or "<no error>".
 template <class Filter>
 std::string constructionError(const typename Filter::Params& p) {
     try {
         Filter f(p);
-    } catch (const std::invalid_argument& e) {
+    } catch (const kfd::Error& e) {
         return e.what();
     }
     return "<no error>";

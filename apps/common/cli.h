@@ -122,6 +122,8 @@ class Cli {
             try {
                 (void)parse(text);
                 return {};
+            } catch (const kfd::Error& e) {
+                return e.detail();  // the flag is named by the caller, not the library's field
             } catch (const std::exception& e) {
                 return e.what();
             }

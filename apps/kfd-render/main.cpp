@@ -58,15 +58,16 @@ int main(int argc, char** argv) {
         if (!chosen) throw std::runtime_error("no such scan in " + in);
         kfd::Scan scan;
         kfd::toCore(*chosen, scan);
-        kfd::DistanceFilter(p.distance).filter(scan);
+        kfd::DistanceFilter(p.get<kfd::DistanceStage>()).filter(scan);
         kfd::Scan work = scan;
-        kfd::Denoiser den(p.denoise);
+        kfd::Denoiser den(p.get<kfd::DenoiseStage>());
         const auto r = den.filter(work);
         kfd::ClusterFigureOptions o;
         o.width = o.height = size;
         o.half_extent_m = extent;
-        o.ring_r_max = p.denoise.variant == kfd::DenoiseVariant::Reference ? r.r_max : 0.0;
-        o.rings = p.denoise.rings;
+        o.ring_r_max =
+            p.get<kfd::DenoiseStage>().variant == kfd::DenoiseVariant::Reference ? r.r_max : 0.0;
+        o.rings = p.get<kfd::DenoiseStage>().reference.rings.rings;
         kfd::ClusterFigure fig(o);
         auto img = fig.render(scan, den.clusters());
         if (!img.saveToFile(out)) throw std::runtime_error("cannot write " + out);

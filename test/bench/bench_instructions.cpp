@@ -16,15 +16,15 @@
 #include <vector>
 
 #include "bench_scans.h"
+#include "kfd/baselines/dbscan.h"
+#include "kfd/baselines/radius_outlier.h"
+#include "kfd/baselines/statistical_outlier.h"
 #include "kfd/core/correlation.h"
-#include "kfd/core/dbscan.h"
 #include "kfd/core/denoiser.h"
 #include "kfd/core/distance_filter.h"
 #include "kfd/core/histogram.h"
 #include "kfd/core/keyframe_selector.h"
 #include "kfd/core/pipeline.h"
-#include "kfd/core/radius_outlier.h"
-#include "kfd/core/statistical_outlier.h"
 
 namespace kb = kfd::bench;
 
@@ -37,10 +37,12 @@ struct Context {
     std::vector<std::vector<double>> hist;             // histograms of the keyframe set
     std::vector<double> out;
     kfd::Histogram histogram{kfd::Histogram::Params{20}};
-    kfd::DistanceFilter distance{kb::paperParams().distance};
-    kfd::KeyframeSelector selector{kb::paperParams().keyframe};
-    kfd::Denoiser reference{kb::paperParams(kfd::DenoiseVariant::Reference).denoise};
-    kfd::Denoiser range_aware{kb::paperParams(kfd::DenoiseVariant::RangeAware).denoise};
+    kfd::DistanceFilter distance{kb::paperParams().get<kfd::DistanceStage>()};
+    kfd::KeyframeSelector selector{kb::paperParams().get<kfd::KeyframeStage>()};
+    kfd::Denoiser reference{
+        kb::paperParams(kfd::DenoiseVariant::Reference).get<kfd::DenoiseStage>()};
+    kfd::Denoiser range_aware{
+        kb::paperParams(kfd::DenoiseVariant::RangeAware).get<kfd::DenoiseStage>()};
     kfd::DbscanFilter dbscan{kfd::DbscanFilter::Params{0.7, 10}};
     kfd::RadiusOutlierFilter radius{kfd::RadiusOutlierFilter::Params{}};
     kfd::StatisticalOutlierFilter sor{kfd::StatisticalOutlierFilter::Params{}};

@@ -36,16 +36,16 @@ inline ScanGeometry mitGeometry() { return ScanGeometry{kBeams, kAperture, true}
 inline Pipeline::Params paperParams(DenoiseVariant variant = DenoiseVariant::Reference) {
     Pipeline::Params p;
     p.stages = {"distance", "keyframe", "denoise"};
-    p.distance.min_range = 0.1;
-    p.distance.max_range = kMaxRange;
-    p.keyframe.bins = 20;
-    p.keyframe.window = 8;
-    p.keyframe.p_pair = 0.985;
-    p.keyframe.max_consecutive_drops = 0;
-    p.keyframe.max_interval_s = 0.0;
-    p.keyframe.max_translation_m = 0.0;
-    p.keyframe.max_rotation_deg = 0.0;
-    p.denoise.variant = variant;
+    p.get<DistanceStage>().min_range = 0.1;
+    p.get<DistanceStage>().max_range = kMaxRange;
+    p.get<KeyframeStage>().bins = 20;
+    p.get<KeyframeStage>().window = 8;
+    p.get<KeyframeStage>().p_pair = 0.985;
+    p.get<KeyframeStage>().max_consecutive_drops = 0;
+    p.get<KeyframeStage>().max_interval_s = 0.0;
+    p.get<KeyframeStage>().max_translation_m = 0.0;
+    p.get<KeyframeStage>().max_rotation_deg = 0.0;
+    p.get<DenoiseStage>().variant = variant;
     return p;
 }
 
@@ -188,7 +188,7 @@ struct Scenario {
 inline Scenario makeScenario(unsigned seed = kSeed) {
     const IndoorScene scene = IndoorScene::officeFloor();
     const Pipeline::Params params = paperParams();
-    const DistanceFilter distance(params.distance);
+    const DistanceFilter distance(params.get<DistanceStage>());
     Scenario sc;
 
     const Pose2D places[] = {{12.0, 4.6, 0.0}, {3.0, 0.0, 0.3}, {8.0, 3.0, 0.6}, {20.0, 0.2, 0.9}};
@@ -200,9 +200,9 @@ inline Scenario makeScenario(unsigned seed = kSeed) {
         sc.keyframes.push_back(std::move(s));
     }
 
-    KeyframeSelector selector(params.keyframe);
+    KeyframeSelector selector(params.get<KeyframeStage>());
     std::size_t i = 0;
-    for (; selector.windowSize() < params.keyframe.window; ++i) {
+    for (; selector.windowSize() < params.get<KeyframeStage>().window; ++i) {
         if (i > 20000) throw std::runtime_error("bench scenario: the window never fills");
         Scan s = simulateScan(scene, loopPose(i), seed, i);
         distance.filter(s);

@@ -11,15 +11,15 @@
 #include <vector>
 
 #include "bench_scans.h"
+#include "kfd/baselines/dbscan.h"
+#include "kfd/baselines/radius_outlier.h"
+#include "kfd/baselines/statistical_outlier.h"
 #include "kfd/core/correlation.h"
-#include "kfd/core/dbscan.h"
 #include "kfd/core/denoiser.h"
 #include "kfd/core/distance_filter.h"
 #include "kfd/core/histogram.h"
 #include "kfd/core/keyframe_selector.h"
 #include "kfd/core/pipeline.h"
-#include "kfd/core/radius_outlier.h"
-#include "kfd/core/statistical_outlier.h"
 
 namespace {
 
@@ -72,7 +72,7 @@ BENCHMARK(BM_RestoreValid);
 
 // Algorithm 1.
 void BM_DistanceFilter(benchmark::State& state) {
-    const kfd::DistanceFilter f(kb::paperParams().distance);
+    const kfd::DistanceFilter f(kb::paperParams().get<kfd::DistanceStage>());
     runOnKeyframes(state, [&](Scan& s) {
         const auto r = f.filter(s);
         return r.removed_non_finite + r.removed_out_of_range;
@@ -116,7 +116,7 @@ BENCHMARK(BM_Pearson);
 // drops (the paper's 0.233 ms per dropped scan).
 void BM_KeyframeDecision(benchmark::State& state) {
     const auto& sc = scenario();
-    kfd::KeyframeSelector sel(kb::paperParams().keyframe);
+    kfd::KeyframeSelector sel(kb::paperParams().get<kfd::KeyframeStage>());
     for (const auto& s : sc.prefix) sel.filter(s);
     std::size_t k = 0, kept = 0;
     for (auto _ : state) {
@@ -133,14 +133,14 @@ BENCHMARK(BM_KeyframeDecision)->Unit(benchmark::kMicrosecond);
 // Algorithm 2 as published (t = 5 rings, theta = 10 x resolution) + the m_threshold = 10
 // cluster filter.
 void BM_DenoiseReference(benchmark::State& state) {
-    kfd::Denoiser d(kb::paperParams(kfd::DenoiseVariant::Reference).denoise);
+    kfd::Denoiser d(kb::paperParams(kfd::DenoiseVariant::Reference).get<kfd::DenoiseStage>());
     runOnKeyframes(state, [&](Scan& s) { return d.filter(s).points_removed; });
 }
 BENCHMARK(BM_DenoiseReference)->Unit(benchmark::kMicrosecond);
 
 // kfd's range-aware clustering + range-adaptive cluster filter (default.ini's values).
 void BM_DenoiseRangeAware(benchmark::State& state) {
-    kfd::Denoiser d(kb::paperParams(kfd::DenoiseVariant::RangeAware).denoise);
+    kfd::Denoiser d(kb::paperParams(kfd::DenoiseVariant::RangeAware).get<kfd::DenoiseStage>());
     runOnKeyframes(state, [&](Scan& s) { return d.filter(s).points_removed; });
 }
 BENCHMARK(BM_DenoiseRangeAware)->Unit(benchmark::kMicrosecond);

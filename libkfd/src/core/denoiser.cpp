@@ -1,6 +1,6 @@
 #include "kfd/core/denoiser.h"
 
-#include <stdexcept>
+#include "kfd/core/error.h"
 
 namespace kfd {
 
@@ -11,29 +11,20 @@ const char* toString(DenoiseVariant v) {
 DenoiseVariant parseDenoiseVariant(const std::string& s) {
     if (s == "reference") return DenoiseVariant::Reference;
     if (s == "range_aware") return DenoiseVariant::RangeAware;
-    throw std::invalid_argument("unknown denoise variant '" + s +
-                                "' (expected reference or range_aware)");
+    throw ParameterError("variant",
+                         "unknown denoise variant '" + s + "' (expected reference or range_aware)");
 }
 
 void Denoiser::initialize(const Params& p) {
-    if (p.m_threshold < 1) throw std::invalid_argument("m_threshold must be >= 1");
-    if (!(p.min_object_size_m >= 0.0))
-        throw std::invalid_argument("min_object_size_m must be >= 0");
-    if (p.min_points_floor < 1) throw std::invalid_argument("min_points_floor must be >= 1");
-    RingClustering::Params rp;
-    rp.rings.rings = p.rings;
-    rp.rings.r_max = p.ring_r_max;
-    rp.angle_gap_factor = p.angle_gap_factor;
-    rp.merge_distance_m = p.merge_distance_m;
-    reference_.initialize(rp);
-    RangeAwareClustering::Params ap;
-    ap.angle_gap_factor = p.angle_gap_factor;
-    ap.jump_lambda_deg = p.jump_lambda_deg;
-    ap.jump_sigma_m = p.jump_sigma_m;
-    range_aware_.initialize(ap);
-    filter_.m_threshold = p.m_threshold;
-    filter_.min_points_floor = p.min_points_floor;
-    filter_.min_object_size_m = p.variant == DenoiseVariant::RangeAware ? p.min_object_size_m : 0.0;
+    if (p.filter.m_threshold < 1) throw ParameterError("m_threshold", "m_threshold must be >= 1");
+    if (!(p.filter.min_object_size_m >= 0.0))
+        throw ParameterError("min_object_size_m", "min_object_size_m must be >= 0");
+    if (p.filter.min_points_floor < 1)
+        throw ParameterError("min_points_floor", "min_points_floor must be >= 1");
+    reference_.initialize(p.reference);
+    range_aware_.initialize(p.range_aware);
+    filter_ = p.filter;
+    if (p.variant != DenoiseVariant::RangeAware) filter_.min_object_size_m = 0.0;
     params_ = p;
 }
 

@@ -1,15 +1,15 @@
 #include "kfd/core/distance_filter.h"
 
 #include <cmath>
-#include <stdexcept>
+#include "kfd/core/error.h"
 
 namespace kfd {
 
 void DistanceFilter::initialize(const Params& p) {
     if (!(p.min_range >= 0.0) || !std::isfinite(p.min_range))
-        throw std::invalid_argument("min_range must be a finite value >= 0");
+        throw ParameterError("min_range", "min_range must be a finite value >= 0");
     if (!(p.max_range > p.min_range) || !std::isfinite(p.max_range))
-        throw std::invalid_argument("max_range must be finite and greater than min_range");
+        throw ParameterError("max_range", "max_range must be finite and greater than min_range");
     params_ = p;
 }
 

@@ -1,11 +1,11 @@
 #include "kfd/core/histogram.h"
 
-#include <stdexcept>
+#include "kfd/core/error.h"
 
 namespace kfd {
 
 void Histogram::initialize(const Params& p) {
-    if (p.bins == 0) throw std::invalid_argument("histogram bins must be >= 1");
+    if (p.bins == 0) throw ParameterError("bins", "histogram bins must be >= 1");
     params_ = p;
 }
 

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <string>
+#include "kfd/core/error.h"
 
 #include "kfd/core/correlation.h"
 
@@ -30,13 +30,17 @@ const char* toString(KeyframeReason r) {
 }
 
 void KeyframeSelector::initialize(const Params& p) {
-    auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
-    if (p.bins < 2) bad("bins must be >= 2 (a correlation needs at least two columns)");
-    if (p.window < 1) bad("window must be >= 1");
-    if (!(p.p_pair > 0.0 && p.p_pair <= 1.0)) bad("p_pair must be in (0, 1]");
-    if (!(p.max_interval_s >= 0.0)) bad("max_interval_s must be >= 0 (0 = off)");
-    if (!(p.max_translation_m >= 0.0)) bad("max_translation_m must be >= 0 (0 = off)");
-    if (!(p.max_rotation_deg >= 0.0)) bad("max_rotation_deg must be >= 0 (0 = off)");
+    auto bad = [](const char* field, const std::string& what) {
+        throw ParameterError(field, what);
+    };
+    if (p.bins < 2) bad("bins", "bins must be >= 2 (a correlation needs at least two columns)");
+    if (p.window < 1) bad("window", "window must be >= 1");
+    if (!(p.p_pair > 0.0 && p.p_pair <= 1.0)) bad("p_pair", "p_pair must be in (0, 1]");
+    if (!(p.max_interval_s >= 0.0)) bad("max_interval_s", "max_interval_s must be >= 0 (0 = off)");
+    if (!(p.max_translation_m >= 0.0))
+        bad("max_translation_m", "max_translation_m must be >= 0 (0 = off)");
+    if (!(p.max_rotation_deg >= 0.0))
+        bad("max_rotation_deg", "max_rotation_deg must be >= 0 (0 = off)");
     params_ = p;
     histogram_.initialize(Histogram::Params{p.bins});
     window_.assign(p.window * p.bins, 0.0);
@@ -55,7 +59,7 @@ void KeyframeSelector::reset() {
 KeyframeDecision KeyframeSelector::decide(const std::vector<double>& h, double timestamp,
                                           const std::optional<Pose2D>& odometry) {
     if (h.size() != params_.bins)
-        throw std::invalid_argument("histogram size does not match the configured bins");
+        throw ParameterError("histogram", "histogram size does not match the configured bins");
     KeyframeDecision d;
     d.references = count_;
     if (count_ == 0) {

@@ -1,121 +1,106 @@
 #include "kfd/core/pipeline.h"
 
-#include <algorithm>
 #include <chrono>
-#include <stdexcept>
+
+#include "kfd/core/denoise_stage.h"
 
 namespace kfd {
 
-bool DistanceStage::filter(Scan& scan, ScanReport& report) {
-    report.distance = algo_.filter(scan);
-    return true;
+PipelineParams::PipelineParams(const PipelineParams& o) : stages(o.stages) {
+    for (const auto& e : o.entries_) entries_.push_back(Entry{e.stage, e.params->clone()});
 }
 
-bool KeyframeStage::filter(Scan& scan, ScanReport& report) {
-    report.keyframe = algo_.filter(scan);
-    report.keyframe_evaluated = true;
-    return report.keyframe.keyframe;
+PipelineParams& PipelineParams::operator=(const PipelineParams& o) {
+    if (this != &o) {
+        PipelineParams copy(o);
+        *this = std::move(copy);
+    }
+    return *this;
 }
 
-bool DenoiseStage::filter(Scan& scan, ScanReport& report) {
-    report.denoise = algo_.filter(scan);
-    report.denoised = true;
-    return true;
+StageParams& PipelineParams::at(const StageInfo& stage) {
+    if (StageParams* p = find(stage.name)) return *p;
+    entries_.push_back(Entry{stage.name, stage.defaults()});
+    return *entries_.back().params;
 }
 
-bool MotionStage::filter(Scan& scan, ScanReport&) {
-    return algo_.keep(scan.timestamp, scan.odometry);
+StageParams* PipelineParams::find(std::string_view name) {
+    for (auto& e : entries_)
+        if (e.stage == name) return e.params.get();
+    return nullptr;
 }
 
-bool DbscanStage::filter(Scan& scan, ScanReport& report) {
-    report.dbscan = algo_.filter(scan);
-    return true;
+const StageParams* PipelineParams::find(std::string_view name) const {
+    for (const auto& e : entries_)
+        if (e.stage == name) return e.params.get();
+    return nullptr;
 }
 
-bool RadiusStage::filter(Scan& scan, ScanReport& report) {
-    report.radius = algo_.filter(scan);
-    return true;
-}
-
-bool SorStage::filter(Scan& scan, ScanReport& report) {
-    report.sor = algo_.filter(scan);
-    return true;
-}
-
-void Pipeline::initialize(const Params& p) {
-    // Validate every stage's parameters, listed or not, so a bad value in a config file is
-    // reported even while its stage is switched off.
-    DistanceFilter{p.distance};
-    KeyframeSelector{p.keyframe};
-    Denoiser{p.denoise};
-    MotionFilter{p.motion};
-    DbscanFilter{p.dbscan};
-    RadiusOutlierFilter{p.radius};
-    StatisticalOutlierFilter{p.sor};
-    std::vector<std::unique_ptr<ScanFilter>> stages;
+void Pipeline::initialize(const Params& p, const StageRegistry& registry) {
+    if (p.stages.size() > ScanReport::kMaxStages)
+        throw ParameterError("stages",
+                             "more than " + std::to_string(ScanReport::kMaxStages) + " stages");
+    std::vector<const StageInfo*> infos;
     for (const auto& name : p.stages) {
-        for (const auto& s : stages)
-            if (name == s->name())
-                throw std::invalid_argument("pipeline: stage '" + name + "' listed twice");
-        if (name == "distance") {
-            auto s = std::make_unique<DistanceStage>();
-            s->initialize(p.distance);
-            stages.push_back(std::move(s));
-        } else if (name == "keyframe") {
-            auto s = std::make_unique<KeyframeStage>();
-            s->initialize(p.keyframe);
-            stages.push_back(std::move(s));
-        } else if (name == "denoise") {
-            auto s = std::make_unique<DenoiseStage>();
-            s->initialize(p.denoise);
-            stages.push_back(std::move(s));
-        } else if (name == "motion") {
-            auto s = std::make_unique<MotionStage>();
-            s->initialize(p.motion);
-            stages.push_back(std::move(s));
-        } else if (name == "dbscan") {
-            auto s = std::make_unique<DbscanStage>();
-            s->initialize(p.dbscan);
-            stages.push_back(std::move(s));
-        } else if (name == "radius") {
-            auto s = std::make_unique<RadiusStage>();
-            s->initialize(p.radius);
-            stages.push_back(std::move(s));
-        } else if (name == "sor") {
-            auto s = std::make_unique<SorStage>();
-            s->initialize(p.sor);
-            stages.push_back(std::move(s));
-        } else {
-            throw std::invalid_argument(
-                "pipeline: unknown stage '" + name +
-                "' (known: distance, keyframe, denoise, motion, dbscan, radius, sor)");
-        }
+        const StageInfo* info = registry.find(name);
+        if (!info)
+            throw ParameterError("stages", "pipeline: unknown stage '" + name +
+                                               "' (known: " + registry.names() + ")");
+        for (const auto* s : infos)
+            if (s == info)
+                throw ParameterError("stages", "pipeline: stage '" + name + "' listed twice");
+        infos.push_back(info);
+    }
+    // Set but not listed: validated here (listed stages validate when they are built).
+    for (const auto& e : p.entries()) {
+        const StageInfo* info = registry.find(e.stage);
+        bool listed = false;
+        for (const auto* s : infos) listed = listed || s == info;
+        if (info && !listed) info->validate(*e.params);
+    }
+    std::vector<std::unique_ptr<Stage>> stages;
+    for (const auto* info : infos) {
+        const StageParams* set = p.find(info->name);
+        stages.push_back(set ? info->create(*set) : info->create(*info->defaults()));
     }
     stages_ = std::move(stages);
     params_ = p;
+    registry_ = &registry;
 }
 
-void Pipeline::add(std::unique_ptr<ScanFilter> stage) {
-    if (!stage) throw std::invalid_argument("pipeline: null stage");
+void Pipeline::add(std::unique_ptr<Stage> stage) {
+    if (!stage) throw Error("pipeline: null stage");
+    if (stages_.size() >= ScanReport::kMaxStages)
+        throw Error("pipeline: more than " + std::to_string(ScanReport::kMaxStages) + " stages");
     stages_.push_back(std::move(stage));
 }
 
 ScanReport Pipeline::process(Scan& scan) {
-    const auto t0 = std::chrono::steady_clock::now();
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
     ScanReport report;
-    if (scan.valid.size() != scan.range.size())
-        throw std::invalid_argument("scan: range and valid sizes differ");
+    if (scan.valid.size() != scan.range.size()) throw Error("scan: range and valid sizes differ");
     report.points_in = scan.countValid();
+    // One clock read per stage: each stage's end is the next one's start, and the last one's
+    // end closes the chain's time.
+    auto t = t0;
     for (auto& stage : stages_) {
-        if (!stage->filter(scan, report)) {
+        StageReport& sr = report.stage_reports[report.stage_count++];
+        sr.name = stage->name();
+        const bool keep = stage->process(scan, sr, report);
+        const auto now = Clock::now();
+        sr.microseconds = std::chrono::duration<double, std::micro>(now - t).count();
+        t = now;
+        if (!keep) {
+            sr.dropped = true;
             report.keep = false;
             report.dropped_by = stage->name();
             break;
         }
     }
+    if (stages_.empty()) t = Clock::now();
+    report.microseconds = std::chrono::duration<double, std::micro>(t - t0).count();
     report.points_out = scan.countValid();
-    report.microseconds =
-        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
     return report;
 }
 
@@ -124,10 +109,8 @@ void Pipeline::reset() {
 }
 
 const Clusters* Pipeline::lastClusters() const {
-    for (const auto& s : stages_)
-        if (const auto* d = dynamic_cast<const DenoiseStage*>(s.get()))
-            return &d->denoiser().clusters();
-    return nullptr;
+    const auto* d = find<DenoiseStage>();
+    return d ? &d->algorithm().clusters() : nullptr;
 }
 
 }  // namespace kfd

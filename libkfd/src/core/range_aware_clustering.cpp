@@ -2,17 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
+#include "kfd/core/error.h"
 
 namespace kfd {
 
 void RangeAwareClustering::initialize(const Params& p) {
     if (!(p.angle_gap_factor > 0.0) || !std::isfinite(p.angle_gap_factor))
-        throw std::invalid_argument("angle_gap_factor must be > 0");
+        throw ParameterError("angle_gap_factor", "angle_gap_factor must be > 0");
     if (!(p.jump_lambda_deg > 0.0 && p.jump_lambda_deg < 90.0))
-        throw std::invalid_argument("jump_lambda_deg must be in (0, 90)");
+        throw ParameterError("jump_lambda_deg", "jump_lambda_deg must be in (0, 90)");
     if (!(p.jump_sigma_m >= 0.0) || !std::isfinite(p.jump_sigma_m))
-        throw std::invalid_argument("jump_sigma_m must be >= 0");
+        throw ParameterError("jump_sigma_m", "jump_sigma_m must be >= 0");
     params_ = p;
     sin_lambda_ = std::sin(p.jump_lambda_deg * kPi / 180.0);
     half_lambda_ = 0.5 * p.jump_lambda_deg * kPi / 180.0;

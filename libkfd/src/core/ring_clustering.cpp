@@ -2,15 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
+#include "kfd/core/error.h"
 
 namespace kfd {
 
 void RingClustering::initialize(const Params& p) {
     if (!(p.angle_gap_factor > 0.0) || !std::isfinite(p.angle_gap_factor))
-        throw std::invalid_argument("angle_gap_factor must be > 0");
+        throw ParameterError("angle_gap_factor", "angle_gap_factor must be > 0");
     if (!(p.merge_distance_m >= 0.0) || !std::isfinite(p.merge_distance_m))
-        throw std::invalid_argument("merge_distance_m must be >= 0 (0 = automatic)");
+        throw ParameterError("merge_distance_m", "merge_distance_m must be >= 0 (0 = automatic)");
     partition_.initialize(p.rings);
     params_ = p;
     ring_blocks_.resize(p.rings.rings);

@@ -2,14 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
+#include "kfd/core/error.h"
 
 namespace kfd {
 
 void RingPartition::initialize(const Params& p) {
-    if (p.rings < 1 || p.rings > 254) throw std::invalid_argument("rings must be in [1, 254]");
+    if (p.rings < 1 || p.rings > 254) throw ParameterError("rings", "rings must be in [1, 254]");
     if (!(p.r_max >= 0.0) || !std::isfinite(p.r_max))
-        throw std::invalid_argument("ring_r_max must be >= 0 (0 = farthest point)");
+        throw ParameterError("r_max", "ring_r_max must be >= 0 (0 = farthest point)");
     params_ = p;
 }
 

@@ -2,19 +2,20 @@
 
 #include <cmath>
 #include <cstdio>
-#include <stdexcept>
+#include "kfd/core/error.h"
 
 namespace kfd {
 
 WindowSuggestion suggestWindow(double speed_mps, double rate_hz, double p_pair,
                                const WindowHelperParams& p) {
     if (!(speed_mps > 0.0) || !std::isfinite(speed_mps))
-        throw std::invalid_argument("speed must be > 0 m/s");
+        throw ParameterError("speed", "speed must be > 0 m/s");
     if (!(rate_hz > 0.0) || !std::isfinite(rate_hz))
-        throw std::invalid_argument("scan rate must be > 0 Hz");
-    if (!(p_pair > 0.0 && p_pair <= 1.0)) throw std::invalid_argument("p_pair must be in (0, 1]");
+        throw ParameterError("rate", "scan rate must be > 0 Hz");
+    if (!(p_pair > 0.0 && p_pair <= 1.0))
+        throw ParameterError("p_pair", "p_pair must be in (0, 1]");
     if (!(p.lower >= 0.0 && p.upper > p.lower) || p.max_window < 1)
-        throw std::invalid_argument("invalid Formula 5 bounds");
+        throw ParameterError("bounds", "invalid Formula 5 bounds");
 
     WindowSuggestion s;
     s.dx_cm = 100.0 * speed_mps / rate_hz;  // Formula 4

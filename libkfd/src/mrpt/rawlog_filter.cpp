@@ -49,14 +49,17 @@ class CsvWriter {
     bool isOpen() const { return out_.is_open(); }
     void row(std::size_t index, double stamp, const StreamResult& r) {
         const ScanReport& s = r.report;
+        const auto* kf = s.find<KeyframeDecision>();
+        const auto k = s.findOrDefault<KeyframeDecision>();
+        const auto d = s.findOrDefault<DistanceFilter::Result>();
+        const auto n = s.findOrDefault<Denoiser::Result>();
         char buf[512];
-        std::snprintf(
-            buf, sizeof(buf), "%zu,%.6f,%s,%d,%s,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu,%zu,%zu,%.2f\n",
-            index, stamp, r.sensor_label.c_str(), r.keep ? 1 : 0,
-            s.keyframe_evaluated ? toString(s.keyframe.reason) : "none", s.keyframe.p_common,
-            s.keyframe.p_threshold, s.keyframe.references, s.points_in,
-            s.distance.removed_non_finite + s.distance.removed_out_of_range, s.denoise.clusters,
-            s.denoise.noise_clusters, s.noiseRemoved(), s.points_out, s.microseconds);
+        std::snprintf(buf, sizeof(buf),
+                      "%zu,%.6f,%s,%d,%s,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu,%zu,%zu,%.2f\n", index,
+                      stamp, r.sensor_label.c_str(), r.keep ? 1 : 0,
+                      kf ? toString(kf->reason) : "none", k.p_common, k.p_threshold, k.references,
+                      s.points_in, d.removed_non_finite + d.removed_out_of_range, n.clusters,
+                      n.noise_clusters, s.noiseRemoved(), s.points_out, s.microseconds);
         out_ << buf;
     }
     void close() {
@@ -121,8 +124,8 @@ bool Run::handleScan(CObservation2DRangeScan& scan) {
     sum_.geometry_resets += r.geometry_reset ? 1 : 0;
     if (r.keep) {
         ++sum_.scans_kept;
-        sum_.points_removed_range +=
-            r.report.distance.removed_non_finite + r.report.distance.removed_out_of_range;
+        const auto d = r.report.findOrDefault<DistanceFilter::Result>();
+        sum_.points_removed_range += d.removed_non_finite + d.removed_out_of_range;
         sum_.points_removed_noise += r.report.noiseRemoved();
     } else {
         ++sum_.scans_dropped;

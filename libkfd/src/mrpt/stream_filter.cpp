@@ -2,20 +2,23 @@
 
 #include <stdexcept>
 
+#include "kfd/mrpt/default_stages.h"
 #include "kfd/mrpt/scan_adapter.h"
 
 namespace kfd {
 
 StreamFilter::StreamFilter(const Pipeline::Params& params, StageFactory extra)
     : params_(params), extra_(std::move(extra)) {
-    Pipeline check(params_);  // validate now, not at the first scan
+    // Validated now, not at the first scan; the first sensor takes this pipeline.
+    spare_ = std::make_unique<Pipeline>(params_, defaultStageRegistry());
 }
 
 StreamFilter::Sensor& StreamFilter::sensorFor(const std::string& label) {
     auto it = sensors_.find(label);
     if (it != sensors_.end()) return it->second;
     Sensor s;
-    s.pipeline = std::make_unique<Pipeline>(params_);
+    s.pipeline =
+        spare_ ? std::move(spare_) : std::make_unique<Pipeline>(params_, defaultStageRegistry());
     if (extra_) extra_(*s.pipeline);
     return sensors_.emplace(label, std::move(s)).first->second;
 }

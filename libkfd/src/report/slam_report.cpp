@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "kfd/baselines/motion_stage.h"
 #include "kfd/render/map_figure.h"
 
 namespace kfd {
@@ -93,8 +94,8 @@ std::string toJson(const IcpSlamSummary& s) {
     j["icp_ms_per_kept_scan"] = s.icp_ms_per_kept_scan;
     j["cpu_s_total"] = s.cpu_s_total;
     j["wall_s_total"] = s.wall_s_total;
-    j["motion_distance_m"] = s.pipeline.motion.max_distance_m;
-    j["motion_angle_deg"] = s.pipeline.motion.max_angle_deg;
+    j["motion_distance_m"] = s.pipeline.get<MotionStage>().max_distance_m;
+    j["motion_angle_deg"] = s.pipeline.get<MotionStage>().max_angle_deg;
     if (s.ate_rmse) j["ate_rmse_m"] = *s.ate_rmse;
     if (s.relations) {
         const auto& r = *s.relations;

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "kfd/baselines/motion_stage.h"
 #include "kfd/eval/ate.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/source.h"
@@ -137,63 +138,6 @@ MotionFilter::Params matchDropRate(const std::vector<ScanStamp>& scans, double t
 
 }  // namespace
 
-const char* toString(PrefilterMode m) {
-    switch (m) {
-        case PrefilterMode::None:
-            return "none";
-        case PrefilterMode::Odometry:
-            return "odometry";
-        case PrefilterMode::Keyframe:
-            return "keyframe";
-        case PrefilterMode::Kfd:
-            return "kfd";
-        case PrefilterMode::Dbscan:
-            return "dbscan";
-        case PrefilterMode::Radius:
-            return "radius";
-        case PrefilterMode::Sor:
-            return "sor";
-    }
-    return "unknown";
-}
-
-PrefilterMode parsePrefilterMode(const std::string& s) {
-    for (auto m :
-         {PrefilterMode::None, PrefilterMode::Odometry, PrefilterMode::Keyframe, PrefilterMode::Kfd,
-          PrefilterMode::Dbscan, PrefilterMode::Radius, PrefilterMode::Sor})
-        if (s == toString(m)) return m;
-    throw std::invalid_argument(
-        "unknown pre-filter mode '" + s +
-        "' (expected none, odometry, keyframe, kfd, dbscan, radius or sor)");
-}
-
-Pipeline::Params pipelineForMode(PrefilterMode mode, const Pipeline::Params& kfd) {
-    Pipeline::Params p = kfd;
-    switch (mode) {
-        case PrefilterMode::None:
-            p.stages = {};
-            break;
-        case PrefilterMode::Odometry:
-            p.stages = {"motion"};
-            break;
-        case PrefilterMode::Keyframe:
-            p.stages = {"distance", "keyframe"};
-            break;
-        case PrefilterMode::Kfd:
-            break;
-        case PrefilterMode::Dbscan:
-            p.stages = {"distance", "dbscan"};
-            break;
-        case PrefilterMode::Radius:
-            p.stages = {"distance", "radius"};
-            break;
-        case PrefilterMode::Sor:
-            p.stages = {"distance", "sor"};
-            break;
-    }
-    return p;
-}
-
 IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
     const auto wall0 = std::chrono::steady_clock::now();
     const std::clock_t cpu0 = std::clock();
@@ -220,7 +164,7 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
         const double target = *opts.odometry_target_drop_pct;
         if (!(target >= 0.0 && target < 100.0))
             throw SlamError("the target drop rate must be in [0, 100)");
-        sum.pipeline.motion = matchDropRate(scanOdometry(sum.rawlog), target);
+        sum.pipeline.get<MotionStage>() = matchDropRate(scanOdometry(sum.rawlog), target);
     }
     StreamFilter prefilter(sum.pipeline);
 
@@ -308,11 +252,11 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
             if (e.odometry) res.odometry.push_back(StampedPose{s.t, *e.odometry});
             traj.push_back(StampedPose{s.t, Pose2D{pose.x(), pose.y(), pose.yaw()}});
             const auto& rep = s.r.report;
+            const auto* kf = rep.find<KeyframeDecision>();
             std::snprintf(buf, sizeof(buf), "%zu,%.6f,%s,%d,%s,%.6f,%zu,%zu,%.2f,%.6f,%.6f,%.6f\n",
                           traj.size() - 1, s.t, s.sensor.c_str(), s.r.keep ? 1 : 0,
-                          rep.keyframe_evaluated ? toString(rep.keyframe.reason)
-                                                 : (s.r.keep ? "kept" : rep.dropped_by.c_str()),
-                          rep.keyframe.p_common, rep.points_in, rep.points_in - rep.points_out,
+                          kf ? toString(kf->reason) : (s.r.keep ? "kept" : rep.dropped_by.c_str()),
+                          kf ? kf->p_common : 0.0, rep.points_in, rep.points_in - rep.points_out,
                           rep.microseconds, pose.x(), pose.y(), pose.yaw());
             f_csv << buf;
         }

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "kfd/core/clusters.h"
+#include "kfd/core/error.h"
 #include "kfd/core/range_aware_clustering.h"
 #include "kfd/core/ring_clustering.h"
 #include "kfd/core/scan.h"
@@ -17,23 +18,23 @@ enum class DenoiseVariant : std::uint8_t {
     RangeAware,  // kfd's improved variant (RangeAwareClustering + range-adaptive threshold)
 };
 const char* toString(DenoiseVariant v);
-/// Parses "reference" or "range_aware"; throws std::invalid_argument otherwise.
+/// Parses "reference" or "range_aware"; throws kfd::ParameterError otherwise.
 DenoiseVariant parseDenoiseVariant(const std::string& s);
 
 class Denoiser {
   public:
+    /// The parameters of the two clustering variants and of the cluster filter, nested (the
+    /// config key angle_gap_factor sets both variants' factor).
     struct Params {
         DenoiseVariant variant = DenoiseVariant::Reference;
-        std::size_t rings = 5;           // t (Sec. 3.2.1), reference variant
-        double ring_r_max = 0.0;         // m; 0 = farthest valid point (Formulas 6-8)
-        double angle_gap_factor = 10.0;  // theta_threshold = factor x resolution (Sec. 3.2.2)
-        double merge_distance_m = 0.0;   // d_threshold (Formula 10); 0 = automatic
-        std::size_t m_threshold = 10;    // minimum cluster size, points (Sec. 3.2.4)
-        // Range-aware variant only:
-        double jump_lambda_deg = 10.0;     // breakpoint incidence limit (deg)
-        double jump_sigma_m = 0.03;        // range noise (m)
-        double min_object_size_m = 0.10;   // a cluster must be this wide in beams at its range
-        std::size_t min_points_floor = 3;  // ... but never fewer points than this
+        /// Reference variant: t, r_max (Formulas 6-8), theta_threshold factor (Sec. 3.2.2),
+        /// d_threshold (Formula 10).
+        RingClustering::Params reference;
+        /// Range-aware variant: theta_threshold factor, breakpoint lambda and sigma.
+        RangeAwareClustering::Params range_aware;
+        /// Sec. 3.2.4: m_threshold (both variants); min_object_size_m and min_points_floor
+        /// (range-aware variant only: the reference variant always uses the fixed m_threshold).
+        ClusterFilterParams filter{10, 0.10, 3};
     };
 
     struct Result {
@@ -50,7 +51,7 @@ class Denoiser {
 
     Denoiser() { initialize(Params{}); }
     explicit Denoiser(const Params& p) { initialize(p); }
-    void initialize(const Params& p);  // std::invalid_argument on bad values
+    void initialize(const Params& p);  // kfd::ParameterError on bad values
     const Params& params() const { return params_; }
 
     /// Clusters the scan and clears the valid flag of every noise point.

@@ -3,6 +3,7 @@
 
 #include <cstddef>
 
+#include "kfd/core/error.h"
 #include "kfd/core/scan.h"
 
 namespace kfd {
@@ -26,7 +27,7 @@ class DistanceFilter {
     DistanceFilter() = default;
     explicit DistanceFilter(const Params& p) { initialize(p); }
 
-    /// Throws std::invalid_argument on inconsistent parameters.
+    /// Throws kfd::ParameterError on inconsistent parameters.
     void initialize(const Params& p);
     const Params& params() const { return params_; }
 

@@ -11,12 +11,18 @@ namespace kfd {
 /// is known: a parameter (core), a configuration key (config layer), a flag, or a file and line.
 class Error : public std::runtime_error {
   public:
-    explicit Error(const std::string& message, std::string field = {})
-        : std::runtime_error(message), field_(std::move(field)) {}
+    explicit Error(const std::string& message, std::string field = {}, std::string detail = {})
+        : std::runtime_error(message),
+          field_(std::move(field)),
+          detail_(detail.empty() ? message : std::move(detail)) {}
     const std::string& field() const { return field_; }
+    /// The message without the field's name in front, for callers that name the field their
+    /// own way (the config layer names the key, the command line names the flag).
+    const std::string& detail() const { return detail_; }
 
   private:
     std::string field_;
+    std::string detail_;
 };
 
 /// A parameter outside its documented range; `field()` is the parameter's name in its Params
@@ -24,7 +30,7 @@ class Error : public std::runtime_error {
 class ParameterError : public Error {
   public:
     ParameterError(const std::string& field, const std::string& message)
-        : Error(field + ": " + message, field) {}
+        : Error(field + ": " + message, field, message) {}
 };
 
 }  // namespace kfd

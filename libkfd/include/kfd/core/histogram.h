@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "kfd/core/error.h"
 #include "kfd/core/scan.h"
 
 namespace kfd {
@@ -26,7 +27,7 @@ class Histogram {
     Histogram() = default;
     explicit Histogram(const Params& p) { initialize(p); }
 
-    /// Throws std::invalid_argument when bins == 0.
+    /// Throws kfd::ParameterError when bins == 0.
     void initialize(const Params& p);
     const Params& params() const { return params_; }
 

@@ -6,6 +6,7 @@
 #include <optional>
 #include <vector>
 
+#include "kfd/core/error.h"
 #include "kfd/core/histogram.h"
 #include "kfd/core/scan.h"
 
@@ -60,7 +61,7 @@ class KeyframeSelector {
     KeyframeSelector() { initialize(Params{}); }
     explicit KeyframeSelector(const Params& p) { initialize(p); }
 
-    /// Validates and applies parameters (std::invalid_argument naming the field), then resets.
+    /// Validates and applies parameters (kfd::ParameterError naming the field), then resets.
     void initialize(const Params& p);
     const Params& params() const { return params_; }
 

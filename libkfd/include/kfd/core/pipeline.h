@@ -1,174 +1,124 @@
-// The per-scan filter chain (Figure 1 of the paper): distance filter -> keyframe -> denoise.
+// The per-scan filter chain (Figure 1 of the paper): distance filter -> keyframe -> denoise, as a
+// list of stages found by name in a StageRegistry (std only).
 #pragma once
 
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
-#include "kfd/core/dbscan.h"
-#include "kfd/core/denoiser.h"
-#include "kfd/core/distance_filter.h"
-#include "kfd/core/keyframe_selector.h"
-#include "kfd/core/motion_filter.h"
-#include "kfd/core/radius_outlier.h"
+#include "kfd/core/clusters.h"
+#include "kfd/core/denoise_stage.h"
+#include "kfd/core/distance_stage.h"
+#include "kfd/core/error.h"
+#include "kfd/core/keyframe_stage.h"
 #include "kfd/core/scan.h"
-#include "kfd/core/statistical_outlier.h"
+#include "kfd/core/stage.h"
+#include "kfd/core/stage_registry.h"
 
 namespace kfd {
 
-/// Everything the chain learned about one scan.
-struct ScanReport {
-    bool keep = true;                 // false: a stage dropped the scan
-    std::string dropped_by;           // stage name that dropped it (empty when kept)
-    bool keyframe_evaluated = false;  // the keyframe stage ran
-    bool denoised = false;            // the denoise stage ran
-    DistanceFilter::Result distance;
-    KeyframeDecision keyframe;
-    Denoiser::Result denoise;
-    DbscanFilter::Result dbscan;           // when the dbscan stage ran
-    RadiusOutlierFilter::Result radius;    // when the radius stage ran
-    StatisticalOutlierFilter::Result sor;  // when the sor stage ran
-    std::size_t points_in = 0;             // valid beams on input
-    std::size_t points_out = 0;            // valid beams on output
-    double microseconds = 0.0;             // wall time spent in the chain
+/// The stage list and every configured stage's parameters, typed:
+///
+///     kfd::Pipeline::Params p;
+///     p.stages = {"distance", "keyframe", "denoise"};
+///     p.get<kfd::KeyframeStage>().window = 3;  // S::Params of stage class S
+///
+/// Stages whose parameters were never set run with their Params defaults.
+class PipelineParams {
+  public:
+    /// Stage names in order, each at most once (see StageRegistry::names()).
+    std::vector<std::string> stages{"distance", "keyframe", "denoise"};
 
-    /// Points invalidated as noise by whichever denoising stages ran (denoise, dbscan, radius,
-    /// sor); the distance stage's removals are not noise.
-    std::size_t noiseRemoved() const {
-        return denoise.points_removed + dbscan.points_removed + radius.points_removed +
-               sor.points_removed;
+    PipelineParams() = default;
+    PipelineParams(const PipelineParams& o);
+    PipelineParams& operator=(const PipelineParams& o);
+    PipelineParams(PipelineParams&&) = default;
+    PipelineParams& operator=(PipelineParams&&) = default;
+
+    /// The parameters of stage class S (created with defaults when missing).
+    template <class S>
+    typename S::Params& get() {
+        using P = typename S::Params;
+        if (StageParams* p = find(S::kName)) {
+            StageRegistry::paramsOf<P>(*p, S::kName);  // type check
+            return *static_cast<P*>(p->data());
+        }
+        auto holder = std::make_unique<StageParamsOf<P>>();
+        P& ref = holder->value;
+        entries_.push_back(Entry{S::kName, std::move(holder)});
+        return ref;
     }
-};
+    /// The parameters of stage class S (its defaults when never set).
+    template <class S>
+    const typename S::Params& get() const {
+        using P = typename S::Params;
+        if (const StageParams* p = find(S::kName)) return StageRegistry::paramsOf<P>(*p, S::kName);
+        static const P defaults{};
+        return defaults;
+    }
 
-/// One stage of the chain, as in mp2p_icp's filter pipelines: configured once, then called for
-/// every scan. filter() returns false to drop the scan (later stages then do not run).
-class ScanFilter {
-  public:
-    virtual ~ScanFilter() = default;
-    virtual const char* name() const = 0;
-    virtual bool filter(Scan& scan, ScanReport& report) = 0;
-    /// Forget all stream state (called when the sensor's geometry changes).
-    virtual void reset() {}
-};
+    /// The parameters of a registered stage by name (created with its defaults when missing).
+    StageParams& at(const StageInfo& stage);
+    /// The parameters set for stage `name`, or nullptr.
+    StageParams* find(std::string_view name);
+    const StageParams* find(std::string_view name) const;
 
-/// Algorithm 1 as a stage. Never drops a scan; invalidates out-of-range beams.
-class DistanceStage : public ScanFilter {
-  public:
-    void initialize(const DistanceFilter::Params& p) { algo_.initialize(p); }
-    const char* name() const override { return "distance"; }
-    bool filter(Scan& scan, ScanReport& report) override;
-
-  private:
-    DistanceFilter algo_;
-};
-
-/// Keyframe extraction (Sec. 3.1) as a stage. Drops non-keyframes.
-class KeyframeStage : public ScanFilter {
-  public:
-    void initialize(const KeyframeSelector::Params& p) { algo_.initialize(p); }
-    const char* name() const override { return "keyframe"; }
-    bool filter(Scan& scan, ScanReport& report) override;
-    void reset() override { algo_.reset(); }
+    struct Entry {
+        std::string stage;
+        std::unique_ptr<StageParams> params;
+    };
+    /// The stages whose parameters were set, in the order they were first set.
+    const std::vector<Entry>& entries() const { return entries_; }
 
   private:
-    KeyframeSelector algo_;
-};
-
-/// Clustering denoise (Sec. 3.2) as a stage. Never drops a scan; invalidates noise points.
-class DenoiseStage : public ScanFilter {
-  public:
-    void initialize(const Denoiser::Params& p) { algo_.initialize(p); }
-    const char* name() const override { return "denoise"; }
-    bool filter(Scan& scan, ScanReport& report) override;
-    const Denoiser& denoiser() const { return algo_; }
-
-  private:
-    Denoiser algo_;
-};
-
-/// The odometry motion filter (baseline) as a stage. Drops scans taken before enough motion.
-class MotionStage : public ScanFilter {
-  public:
-    void initialize(const MotionFilter::Params& p) { algo_.initialize(p); }
-    const char* name() const override { return "motion"; }
-    bool filter(Scan& scan, ScanReport& report) override;
-    void reset() override { algo_.reset(); }
-
-  private:
-    MotionFilter algo_;
-};
-
-/// DBSCAN denoise (baseline) as a stage. Never drops a scan; invalidates noise points.
-class DbscanStage : public ScanFilter {
-  public:
-    void initialize(const DbscanFilter::Params& p) { algo_.initialize(p); }
-    const char* name() const override { return "dbscan"; }
-    bool filter(Scan& scan, ScanReport& report) override;
-
-  private:
-    DbscanFilter algo_;
-};
-
-/// Radius outlier removal (baseline) as a stage. Never drops a scan; invalidates noise points.
-class RadiusStage : public ScanFilter {
-  public:
-    void initialize(const RadiusOutlierFilter::Params& p) { algo_.initialize(p); }
-    const char* name() const override { return "radius"; }
-    bool filter(Scan& scan, ScanReport& report) override;
-
-  private:
-    RadiusOutlierFilter algo_;
-};
-
-/// Statistical outlier removal (baseline) as a stage. Never drops a scan; invalidates noise
-/// points.
-class SorStage : public ScanFilter {
-  public:
-    void initialize(const StatisticalOutlierFilter::Params& p) { algo_.initialize(p); }
-    const char* name() const override { return "sor"; }
-    bool filter(Scan& scan, ScanReport& report) override;
-
-  private:
-    StatisticalOutlierFilter algo_;
+    std::vector<Entry> entries_;
 };
 
 class Pipeline {
   public:
-    struct Params {
-        /// Stage names in order, each at most once. kfd's: "distance", "keyframe", "denoise";
-        /// baselines: "motion" (odometry motion filter), "dbscan" (DBSCAN denoise), "radius"
-        /// (radius outlier removal), "sor" (statistical outlier removal).
-        std::vector<std::string> stages{"distance", "keyframe", "denoise"};
-        DistanceFilter::Params distance;
-        KeyframeSelector::Params keyframe;
-        Denoiser::Params denoise;
-        MotionFilter::Params motion;
-        DbscanFilter::Params dbscan;
-        RadiusOutlierFilter::Params radius;
-        StatisticalOutlierFilter::Params sor;
-    };
+    using Params = PipelineParams;
 
-    Pipeline() { initialize(Params{}); }
-    explicit Pipeline(const Params& p) { initialize(p); }
-    /// Builds the stages. Throws std::invalid_argument on an unknown or repeated stage name or
-    /// on invalid stage parameters.
-    void initialize(const Params& p);
+    Pipeline() : Pipeline(Params{}) {}
+    /// Builds the stages listed in p.stages from `registry` (the core stages by default; the
+    /// MRPT layer's kfd::defaultStageRegistry() adds the baselines).
+    /// The registry must outlive the pipeline (the built-in ones are static).
+    explicit Pipeline(const Params& p, const StageRegistry& registry = coreStageRegistry()) {
+        initialize(p, registry);
+    }
+    /// Builds the stages. Throws kfd::ParameterError (field "stages") on an unknown or repeated
+    /// stage name, and the stage's kfd::ParameterError on invalid stage parameters. Parameters
+    /// of registered stages that are set but not listed are validated too, so that a bad value
+    /// is reported even while its stage is switched off.
+    void initialize(const Params& p, const StageRegistry& registry);
+    /// Rebuilds from the registry given at construction.
+    void initialize(const Params& p) { initialize(p, *registry_); }
+    const StageRegistry& registry() const { return *registry_; }
     const Params& params() const { return params_; }
 
-    /// Appends a custom stage (e.g. a baseline denoiser).
-    void add(std::unique_ptr<ScanFilter> stage);
+    /// Appends a custom stage (kfd::Error on nullptr or beyond ScanReport::kMaxStages).
+    void add(std::unique_ptr<Stage> stage);
 
     /// Runs the scan through every stage until one drops it. Modifies only valid flags.
+    /// kfd::Error when the scan's range and valid sizes differ.
     ScanReport process(Scan& scan);
     void reset();
 
-    const std::vector<std::unique_ptr<ScanFilter>>& stages() const { return stages_; }
+    const std::vector<std::unique_ptr<Stage>>& stages() const { return stages_; }
+    /// The first stage of class S, or nullptr.
+    template <class S>
+    const S* find() const {
+        for (const auto& s : stages_)
+            if (const auto* t = dynamic_cast<const S*>(s.get())) return t;
+        return nullptr;
+    }
     /// The denoise stage's clusters of the last denoised scan, or nullptr without that stage.
     const Clusters* lastClusters() const;
 
   private:
     Params params_;
-    std::vector<std::unique_ptr<ScanFilter>> stages_;
+    const StageRegistry* registry_ = &coreStageRegistry();
+    std::vector<std::unique_ptr<Stage>> stages_;
 };
 
 }  // namespace kfd

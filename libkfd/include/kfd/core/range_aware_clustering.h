@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kfd/core/clusters.h"
+#include "kfd/core/error.h"
 #include "kfd/core/scan.h"
 
 namespace kfd {
@@ -44,7 +45,7 @@ class RangeAwareClustering {
 
     RangeAwareClustering() { initialize(Params{}); }
     explicit RangeAwareClustering(const Params& p) { initialize(p); }
-    void initialize(const Params& p);  // std::invalid_argument on bad values
+    void initialize(const Params& p);  // kfd::ParameterError on bad values
     const Params& params() const { return params_; }
 
     Result cluster(const Scan& scan, Clusters& out);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kfd/core/clusters.h"
+#include "kfd/core/error.h"
 #include "kfd/core/rings.h"
 #include "kfd/core/scan.h"
 
@@ -46,7 +47,7 @@ class RingClustering {
 
     RingClustering() { initialize(Params{}); }
     explicit RingClustering(const Params& p) { initialize(p); }
-    void initialize(const Params& p);  // std::invalid_argument on bad values
+    void initialize(const Params& p);  // kfd::ParameterError on bad values
     const Params& params() const { return params_; }
 
     /// Clusters the valid beams of `scan` into `out` (labels, sizes, mean ranges).

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "kfd/core/error.h"
 #include "kfd/core/scan.h"
 
 namespace kfd {
@@ -21,7 +22,7 @@ class RingPartition {
 
     RingPartition() = default;
     explicit RingPartition(const Params& p) { initialize(p); }
-    /// Throws std::invalid_argument when rings == 0, rings > 254 (255 marks
+    /// Throws kfd::ParameterError when rings == 0, rings > 254 (255 marks
     /// invalid beams) or r_max < 0.
     void initialize(const Params& p);
     const Params& params() const { return params_; }

@@ -4,6 +4,8 @@
 #include <cstddef>
 #include <string>
 
+#include "kfd/core/error.h"
+
 namespace kfd {
 
 /// Window suggestion from robot speed and scan rate.
@@ -32,7 +34,7 @@ struct WindowHelperParams {
 ///  - dx^2 >= upper (fast robot or slow scanner, e.g. 5 Hz logs with dx ~ 10-20 cm): m = 1,
 ///    each scan is compared with the last keyframe only; `note` says so.
 ///  - the allowed range lies above max_window (robot almost still): m = max_window.
-/// Throws std::invalid_argument for non-positive speed/rate or p_pair outside (0, 1].
+/// Throws kfd::ParameterError for non-positive speed/rate or p_pair outside (0, 1].
 WindowSuggestion suggestWindow(double speed_mps, double rate_hz, double p_pair,
                                const WindowHelperParams& p = {});
 

@@ -1,11 +1,12 @@
 // Configuration of the kfd pipeline from an MRPT-style .ini section or from YAML.
 #pragma once
 
-#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "kfd/core/error.h"
 #include "kfd/core/pipeline.h"
+#include "kfd/core/stage_registry.h"
 
 namespace mrpt::config {
 class CConfigFileBase;
@@ -16,16 +17,13 @@ class yaml;
 
 namespace kfd {
 
-/// A configuration problem. `key()` names the offending key (empty for file-level problems).
-class ConfigError : public std::runtime_error {
+/// A configuration problem. `key()` (= field()) names the offending key (empty for file-level
+/// problems).
+class ConfigError : public Error {
   public:
     ConfigError(const std::string& key, const std::string& message)
-        : std::runtime_error(key.empty() ? message : "config key '" + key + "': " + message),
-          key_(key) {}
-    const std::string& key() const { return key_; }
-
-  private:
-    std::string key_;
+        : Error(key.empty() ? message : "config key '" + key + "': " + message, key) {}
+    const std::string& key() const { return field(); }
 };
 
 /// One recognised key: name, meaning (with unit), and the allowed values.
@@ -34,8 +32,20 @@ struct ConfigKeyInfo {
     std::string help;
     std::string range;
 };
-/// Every key the loaders accept, in documentation order.
+/// Every key the loaders accept, in documentation order: "pipeline", then the keys of every
+/// stage of `registry` in registration order (derived from the stages' own key lists).
+std::vector<ConfigKeyInfo> configKeys(const StageRegistry& registry);
+/// configKeys(defaultStageRegistry()).
 const std::vector<ConfigKeyInfo>& configKeys();
+
+/// Sets one key (e.g. "window" = "3") in `p`: "pipeline" takes a comma-separated stage list,
+/// every other key belongs to a stage of `registry`. ConfigError naming the key on an unknown
+/// key or a bad value.
+void applyConfigKey(Pipeline::Params& p, const std::string& key, const std::string& value,
+                    const StageRegistry& registry);
+/// Validates every stage's parameters set in `p` once (each stage's own checks); ConfigError
+/// naming the user's key for the stage's kfd::ParameterError.
+void validateConfig(const Pipeline::Params& p, const StageRegistry& registry);
 
 /// Reads the keys of `section` (default "KFD") over the defaults of Pipeline::Params.
 /// Unknown keys and out-of-range values throw ConfigError naming the key. Other sections are
@@ -51,7 +61,8 @@ Pipeline::Params loadYaml(const mrpt::containers::yaml& doc);
 /// file is missing, unreadable, or has no [KFD] section / kfd keys.
 Pipeline::Params loadConfigFile(const std::string& path, const std::string& section = "KFD");
 
-/// The effective configuration as an .ini [KFD] section (every key, current values).
+/// The effective configuration as an .ini [KFD] section (every key of the default registry,
+/// current values).
 std::string toIni(const Pipeline::Params& p, const std::string& section = "KFD");
 
 }  // namespace kfd

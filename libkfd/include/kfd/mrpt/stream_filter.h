@@ -61,6 +61,7 @@ class StreamFilter {
 
     Pipeline::Params params_;
     StageFactory extra_;
+    std::unique_ptr<Pipeline> spare_;  // built (and validated) by the constructor
     std::map<std::string, Sensor> sensors_;
 };
 

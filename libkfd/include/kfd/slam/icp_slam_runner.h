@@ -13,26 +13,9 @@
 #include "kfd/core/pipeline.h"
 #include "kfd/eval/relations.h"
 #include "kfd/eval/trajectory.h"
+#include "kfd/slam/prefilter_modes.h"
 
 namespace kfd {
-
-/// How scans are pre-filtered before scan matching.
-enum class PrefilterMode {
-    None,      // plain ICP-SLAM, identical to MRPT's icp-slam
-    Odometry,  // drop by travelled distance/angle (motion stage), a baseline
-    Keyframe,  // keyframe extraction only (distance + keyframe stages)
-    Kfd,       // the full method: the [KFD] pipeline (distance, keyframe, denoise)
-    Dbscan,    // the paper's comparison: DBSCAN denoise of every scan (distance + dbscan)
-    Radius,    // baseline: radius outlier removal of every scan (distance + radius)
-    Sor,       // baseline: statistical outlier removal of every scan (distance + sor)
-};
-const char* toString(PrefilterMode m);
-/// "none", "odometry", "keyframe", "kfd", "dbscan", "radius", "sor"; std::invalid_argument
-/// otherwise.
-PrefilterMode parsePrefilterMode(const std::string& s);
-
-/// The pipeline a mode runs, built from the [KFD] parameters.
-Pipeline::Params pipelineForMode(PrefilterMode mode, const Pipeline::Params& kfd);
 
 struct IcpSlamProgress {
     std::size_t entries = 0, scans_in = 0, scans_kept = 0;

@@ -1,0 +1,62 @@
+// 2D neighbour search for the DBSCAN, radius-outlier and statistical-outlier baselines: a thin
+// wrapper over nanoflann's k-d tree (kept out of this header). std only in the interface.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "kfd/core/scan.h"
+
+namespace kfd {
+
+/// The Cartesian points of a scan's valid beams, for the neighbour-based denoisers (DBSCAN,
+/// radius and statistical outlier removal). Buffers are reused between scans.
+struct ScanPoints {
+    std::vector<float> x, y;               // m, sensor frame
+    std::vector<std::uint32_t> beam;       // point -> beam index
+    std::vector<std::uint32_t> nonfinite;  // valid beams without a finite range (no position)
+    /// Rebuilds the points from the scan's valid beams with a finite range.
+    void assign(const Scan& scan);
+    std::size_t size() const { return x.size(); }
+};
+
+/// A static 2D k-d tree (nanoflann's KDTreeSingleIndexAdaptor, L2 in float) built over a point
+/// set once per scan. The index object and the caller's output vectors are reused across builds,
+/// so steady state needs no operator new (nanoflann's node pool takes its blocks from malloc at
+/// each build). Points are stored by index into the caller's x/y arrays.
+///
+/// Distances are float dx*dx + dy*dy, as the brute-force references compute them. Differences
+/// from nanoflann's own result sets, made so the answers are unique and match the references:
+/// radius() is inclusive (nanoflann's RadiusResultSet keeps d2 < r2 only), and knn() breaks
+/// equal distances by increasing index everywhere, also at the k-th place (nanoflann's
+/// KNNResultSet keeps whichever tied point it visits first).
+class NeighbourSearch2D {
+  public:
+    NeighbourSearch2D();
+    ~NeighbourSearch2D();
+    NeighbourSearch2D(const NeighbourSearch2D&) = delete;
+    NeighbourSearch2D& operator=(const NeighbourSearch2D&) = delete;
+
+    /// Builds the tree over n points. The arrays must outlive the queries.
+    void build(const float* x, const float* y, std::size_t n);
+
+    /// Writes to `out` (cleared first) the indices of all points within `radius` (inclusive)
+    /// of (qx, qy), in no particular order. O(log n + k) on average.
+    void radius(float qx, float qy, float radius, std::vector<std::uint32_t>& out) const;
+
+    /// Writes to `idx` and `dist2` (both cleared first) the min(k, n) points nearest to
+    /// (qx, qy) and their squared distances (float, dx*dx + dy*dy as in radius()), by increasing
+    /// distance; equal distances by increasing index, so the answer is unique. Nothing is
+    /// excluded: a query at a data point returns that point (distance 0) among the others, and
+    /// callers that want neighbours only skip it. Allocates only while the vectors grow.
+    void knn(float qx, float qy, std::size_t k, std::vector<std::uint32_t>& idx,
+             std::vector<float>& dist2) const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace kfd

@@ -1,0 +1,16 @@
+// The baseline stages (motion, dbscan, radius, sor) and their registration.
+#pragma once
+
+#include "kfd/baselines/dbscan_stage.h"
+#include "kfd/baselines/motion_stage.h"
+#include "kfd/baselines/radius_stage.h"
+#include "kfd/baselines/sor_stage.h"
+#include "kfd/core/stage_registry.h"
+
+namespace kfd {
+
+/// Registers the baselines after the core stages: motion (odometry motion filter), dbscan
+/// (DBSCAN denoise), radius (radius outlier removal), sor (statistical outlier removal).
+void registerBaselineStages(StageRegistry& registry);
+
+}  // namespace kfd

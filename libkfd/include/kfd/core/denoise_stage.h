@@ -1,0 +1,25 @@
+// Clustering denoise (Sec. 3.2) as a pipeline stage, named "denoise".
+#pragma once
+
+#include <vector>
+
+#include "kfd/core/denoiser.h"
+#include "kfd/core/stage.h"
+
+namespace kfd {
+
+/// Never drops a scan; invalidates the points of noise clusters. Diagnostics: Denoiser::Result.
+class DenoiseStage : public DenoisingStage<Denoiser> {
+  public:
+    static constexpr const char* kName = "denoise";
+    static constexpr const char* kHelp =
+        "clustering denoise (Sec. 3.2, Algorithm 2): drop points of small clusters";
+    /// Keys: variant, rings, ring_r_max, angle_gap_factor, merge_distance_m, m_threshold,
+    /// jump_lambda_deg, jump_sigma_m, min_object_size_m, min_points_floor.
+    static std::vector<StageKey> keys();
+
+    explicit DenoiseStage(const Params& p = {}) : DenoisingStage(p) {}
+    const char* name() const override { return kName; }
+};
+
+}  // namespace kfd

@@ -1,0 +1,12 @@
+#include "kfd/baselines/stages.h"
+
+namespace kfd {
+
+void registerBaselineStages(StageRegistry& registry) {
+    registry.add<MotionStage>();
+    registry.add<DbscanStage>();
+    registry.add<RadiusStage>();
+    registry.add<SorStage>();
+}
+
+}  // namespace kfd

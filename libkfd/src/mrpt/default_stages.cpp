@@ -1,0 +1,10 @@
+#include "kfd/mrpt/default_stages.h"
+
+namespace kfd {
+
+const StageRegistry& defaultStageRegistry() {
+    static const StageRegistry r = makeStageRegistry({registerCoreStages, registerBaselineStages});
+    return r;
+}
+
+}  // namespace kfd

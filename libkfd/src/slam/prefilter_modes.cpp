@@ -1,0 +1,67 @@
+#include "kfd/slam/prefilter_modes.h"
+
+#include "kfd/core/error.h"
+#include "kfd/mrpt/default_stages.h"
+
+namespace kfd {
+namespace {
+
+// A mode that runs `stages`; described by the last stage's registry help unless told.
+PrefilterModeInfo mode(PrefilterMode m, const char* name, std::vector<std::string> stages,
+                       std::string description = {}) {
+    const StageRegistry& reg = defaultStageRegistry();
+    for (const auto& s : stages)
+        if (!reg.find(s))
+            throw Error("pre-filter mode '" + std::string(name) + "': no stage '" + s + "'", s);
+    if (description.empty()) description = reg.find(stages.back())->help + " (after distance)";
+    return PrefilterModeInfo{m, name, std::move(stages), false, std::move(description)};
+}
+
+std::vector<PrefilterModeInfo> buildModes() {
+    std::vector<PrefilterModeInfo> v;
+    v.push_back(mode(PrefilterMode::None, "none", {}, "no pre-filter: plain ICP-SLAM"));
+    v.push_back(mode(PrefilterMode::Odometry, "odometry", {"motion"},
+                     defaultStageRegistry().find("motion")->help));
+    v.push_back(mode(PrefilterMode::Keyframe, "keyframe", {"distance", "keyframe"},
+                     "keyframe extraction only (distance + keyframe stages)"));
+    PrefilterModeInfo kfd = mode(PrefilterMode::Kfd, "kfd", {"distance", "keyframe", "denoise"},
+                                 "the full method: the [KFD] section's pipeline (default "
+                                 "distance, keyframe, denoise)");
+    kfd.uses_kfd_stages = true;
+    v.push_back(kfd);
+    v.push_back(mode(PrefilterMode::Dbscan, "dbscan", {"distance", "dbscan"}));
+    v.push_back(mode(PrefilterMode::Radius, "radius", {"distance", "radius"}));
+    v.push_back(mode(PrefilterMode::Sor, "sor", {"distance", "sor"}));
+    return v;
+}
+
+}  // namespace
+
+const std::vector<PrefilterModeInfo>& prefilterModes() {
+    static const std::vector<PrefilterModeInfo> modes = buildModes();
+    return modes;
+}
+
+const char* toString(PrefilterMode m) {
+    for (const auto& info : prefilterModes())
+        if (info.mode == m) return info.name.c_str();
+    return "unknown";
+}
+
+PrefilterMode parsePrefilterMode(const std::string& s) {
+    std::string names;
+    for (const auto& info : prefilterModes()) {
+        if (s == info.name) return info.mode;
+        names += (names.empty() ? "" : ", ") + info.name;
+    }
+    throw ParameterError("mode", "unknown pre-filter mode '" + s + "' (expected " + names + ")");
+}
+
+Pipeline::Params pipelineForMode(PrefilterMode mode, const Pipeline::Params& kfd) {
+    Pipeline::Params p = kfd;
+    for (const auto& info : prefilterModes())
+        if (info.mode == mode && !info.uses_kfd_stages) p.stages = info.stages;
+    return p;
+}
+
+}  // namespace kfd

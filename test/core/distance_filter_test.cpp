@@ -1,0 +1,145 @@
+#include "kfd/core/distance_filter.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "test_scans.h"
+
+namespace kfd {
+namespace {
+
+using test::makeScan;
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+DistanceFilter makeFilter(double min_range, double max_range) {
+    DistanceFilter::Params p;
+    p.min_range = min_range;
+    p.max_range = max_range;
+    return DistanceFilter(p);
+}
+
+TEST(DistanceFilter, KeepsRangesInsideTheInterval) {
+    Scan scan = makeScan({0.5f, 1.0f, 2.25f, 4.0f});
+    const auto res = makeFilter(0.5, 4.0).filter(scan);
+    // Both ends of [min_range, max_range] are usable (Algorithm 1 uses <=).
+    EXPECT_EQ(scan.valid, (std::vector<std::uint8_t>{1, 1, 1, 1}));
+    EXPECT_EQ(res.valid_in, 4u);
+    EXPECT_EQ(res.valid_out, 4u);
+    EXPECT_EQ(res.removed_out_of_range, 0u);
+    EXPECT_EQ(res.removed_non_finite, 0u);
+}
+
+TEST(DistanceFilter, RemovesOutOfRange) {
+    Scan scan = makeScan({0.25f, 0.5f, 3.0f, 4.0f, 4.5f, 0.0f, -1.0f});
+    const auto res = makeFilter(0.5, 4.0).filter(scan);
+    EXPECT_EQ(scan.valid, (std::vector<std::uint8_t>{0, 1, 1, 1, 0, 0, 0}));
+    EXPECT_EQ(res.valid_in, 7u);
+    EXPECT_EQ(res.removed_out_of_range, 4u);
+    EXPECT_EQ(res.removed_non_finite, 0u);
+    EXPECT_EQ(res.valid_out, 3u);
+}
+
+TEST(DistanceFilter, RemovesNaNAndInfinity) {
+    Scan scan = makeScan({1.0f, kNaN, kInf, -kInf, 2.0f});
+    const auto res = makeFilter(0.1, 30.0).filter(scan);
+    EXPECT_EQ(scan.valid, (std::vector<std::uint8_t>{1, 0, 0, 0, 1}));
+    EXPECT_EQ(res.valid_in, 5u);
+    EXPECT_EQ(res.removed_non_finite, 3u);
+    EXPECT_EQ(res.removed_out_of_range, 0u);
+    EXPECT_EQ(res.valid_out, 2u);
+}
+
+TEST(DistanceFilter, AlreadyInvalidBeamsAreNotCounted) {
+    // Beams the driver already flagged stay invalid, whatever their range, and are not counted
+    // as removed by Algorithm 1.
+    Scan scan = makeScan({1.0f, kNaN, 50.0f, 1.0f, 0.01f, 2.0f});
+    scan.valid = {0, 0, 0, 0, 1, 1};
+    const auto res = makeFilter(0.1, 30.0).filter(scan);
+    EXPECT_EQ(scan.valid, (std::vector<std::uint8_t>{0, 0, 0, 0, 0, 1}));
+    EXPECT_EQ(res.valid_in, 2u);
+    EXPECT_EQ(res.removed_non_finite, 0u);
+    EXPECT_EQ(res.removed_out_of_range, 1u);
+    EXPECT_EQ(res.valid_out, 1u);
+}
+
+TEST(DistanceFilter, CountsAddUp) {
+    Scan scan = makeScan({kNaN, 0.05f, 1.0f, 40.0f, kInf, 3.0f, 29.0f, 31.0f});
+    scan.valid[2] = 0;
+    const auto res = makeFilter(0.1, 30.0).filter(scan);
+    EXPECT_EQ(res.valid_in, 7u);
+    EXPECT_EQ(res.removed_non_finite, 2u);
+    EXPECT_EQ(res.removed_out_of_range, 3u);
+    EXPECT_EQ(res.valid_out, 2u);
+    EXPECT_EQ(res.valid_out, scan.countValid());
+}
+
+TEST(DistanceFilter, PreservesBeamCountAndRanges) {
+    const std::vector<float> ranges{0.05f, 1.0f, kNaN, 35.0f, kInf, 2.5f};
+    Scan scan = makeScan(ranges);
+    makeFilter(0.1, 30.0).filter(scan);
+    ASSERT_EQ(scan.size(), ranges.size());
+    ASSERT_EQ(scan.valid.size(), ranges.size());
+    EXPECT_EQ(scan.geometry.beams, ranges.size());
+    for (std::size_t i = 0; i < ranges.size(); ++i) {
+        if (std::isnan(ranges[i]))
+            EXPECT_TRUE(std::isnan(scan.range[i])) << i;
+        else
+            EXPECT_EQ(scan.range[i], ranges[i]) << i;
+    }
+}
+
+TEST(DistanceFilter, FilteringTwiceChangesNothing) {
+    Scan scan = makeScan({0.05f, 1.0f, kNaN, 35.0f, 2.0f});
+    const DistanceFilter f = makeFilter(0.1, 30.0);
+    f.filter(scan);
+    const auto valid = scan.valid;
+    const auto res = f.filter(scan);
+    EXPECT_EQ(scan.valid, valid);
+    EXPECT_EQ(res.valid_in, 2u);
+    EXPECT_EQ(res.valid_out, 2u);
+    EXPECT_EQ(res.removed_non_finite + res.removed_out_of_range, 0u);
+}
+
+TEST(DistanceFilter, EmptyScan) {
+    Scan scan = makeScan({});
+    const auto res = makeFilter(0.1, 30.0).filter(scan);
+    EXPECT_EQ(res.valid_in, 0u);
+    EXPECT_EQ(res.valid_out, 0u);
+}
+
+TEST(DistanceFilter, DefaultsAreThePapersSensorLimits) {
+    const DistanceFilter f;
+    EXPECT_DOUBLE_EQ(f.params().min_range, 0.1);
+    EXPECT_DOUBLE_EQ(f.params().max_range, 30.0);
+}
+
+TEST(DistanceFilter, RejectsInconsistentParams) {
+    DistanceFilter f;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double inf = std::numeric_limits<double>::infinity();
+    EXPECT_THROW(f.initialize({-0.1, 30.0}), kfd::ParameterError);
+    EXPECT_THROW(f.initialize({nan, 30.0}), kfd::ParameterError);
+    EXPECT_THROW(f.initialize({1.0, 1.0}), kfd::ParameterError);
+    EXPECT_THROW(f.initialize({2.0, 1.0}), kfd::ParameterError);
+    EXPECT_THROW(f.initialize({0.1, inf}), kfd::ParameterError);
+    EXPECT_THROW(f.initialize({0.1, nan}), kfd::ParameterError);
+    EXPECT_NO_THROW(f.initialize({0.0, 1.0}));
+    EXPECT_DOUBLE_EQ(f.params().min_range, 0.0);
+    EXPECT_DOUBLE_EQ(f.params().max_range, 1.0);
+}
+
+TEST(DistanceFilter, FailedInitializeKeepsPreviousParams) {
+    DistanceFilter f = makeFilter(0.5, 4.0);
+    EXPECT_THROW(f.initialize({3.0, 1.0}), kfd::ParameterError);
+    EXPECT_DOUBLE_EQ(f.params().min_range, 0.5);
+    EXPECT_DOUBLE_EQ(f.params().max_range, 4.0);
+}
+
+}  // namespace
+}  // namespace kfd

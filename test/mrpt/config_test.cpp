@@ -1,0 +1,267 @@
+// Configuration loaders: every shipped config, key validation, INI/YAML agreement.
+#include <gtest/gtest.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/containers/yaml.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "kfd/mrpt/config.h"
+#include "kfd/mrpt/default_stages.h"
+
+namespace {
+
+kfd::Pipeline::Params fromIniText(const std::string& text) {
+    mrpt::config::CConfigFileMemory cfg(text);
+    return kfd::loadIni(cfg);
+}
+
+std::string errorKey(const std::string& text) {
+    try {
+        fromIniText(text);
+    } catch (const kfd::ConfigError& e) {
+        return e.key();
+    }
+    return "<no error>";
+}
+
+}  // namespace
+
+TEST(Config, EveryShippedConfigLoads) {
+    std::size_t n = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(KFD_SHARE_DIR)) {
+        SCOPED_TRACE(entry.path().string());
+        EXPECT_NO_THROW(kfd::loadConfigFile(entry.path().string()));
+        ++n;
+    }
+    EXPECT_GE(n, 4u);  // default.ini, default.yaml and the two paper presets
+}
+
+TEST(Config, PaperPresetsHoldThePublishedValues) {
+    const auto a = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/paper-mit-0.752.ini");
+    EXPECT_EQ(a.get<kfd::KeyframeStage>().window, 8u);
+    EXPECT_EQ(a.get<kfd::KeyframeStage>().bins, 20u);
+    EXPECT_DOUBLE_EQ(a.get<kfd::KeyframeStage>().p_pair, 0.985);
+    const auto b = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/paper-mit-0.575.ini");
+    EXPECT_EQ(b.get<kfd::KeyframeStage>().window, 9u);
+    EXPECT_EQ(b.get<kfd::KeyframeStage>().bins, 15u);
+    EXPECT_DOUBLE_EQ(b.get<kfd::KeyframeStage>().p_pair, 0.99);
+    for (const auto& p : {a, b}) {
+        EXPECT_EQ(p.get<kfd::DenoiseStage>().reference.rings.rings, 5u);
+        EXPECT_DOUBLE_EQ(p.get<kfd::DenoiseStage>().reference.angle_gap_factor, 10.0);
+        EXPECT_DOUBLE_EQ(p.get<kfd::DenoiseStage>().range_aware.angle_gap_factor, 10.0);
+        EXPECT_EQ(p.get<kfd::DenoiseStage>().filter.m_threshold, 10u);
+        EXPECT_EQ(p.get<kfd::DenoiseStage>().variant, kfd::DenoiseVariant::Reference);
+        // The published method has no guards.
+        EXPECT_EQ(p.get<kfd::KeyframeStage>().max_consecutive_drops, 0u);
+        EXPECT_EQ(p.get<kfd::KeyframeStage>().max_interval_s, 0.0);
+        EXPECT_EQ(p.get<kfd::KeyframeStage>().max_translation_m, 0.0);
+        EXPECT_EQ(p.get<kfd::KeyframeStage>().max_rotation_deg, 0.0);
+    }
+}
+
+TEST(Config, YamlAndIniDefaultsAgree) {
+    const auto ini = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.ini");
+    const auto yml = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.yaml");
+    EXPECT_EQ(kfd::toIni(ini), kfd::toIni(yml));
+    EXPECT_EQ(ini.get<kfd::DenoiseStage>().variant, kfd::DenoiseVariant::RangeAware);
+}
+
+TEST(Config, MissingKeysKeepTheBuiltInDefaults) {
+    const auto p = fromIniText("[KFD]\nwindow = 3\n");
+    EXPECT_EQ(p.get<kfd::KeyframeStage>().window, 3u);
+    EXPECT_EQ(kfd::toIni(p), kfd::toIni([] {
+                  kfd::Pipeline::Params d;
+                  d.get<kfd::KeyframeStage>().window = 3;
+                  return d;
+              }()));
+}
+
+TEST(Config, UnknownKeyIsRejectedByName) {
+    EXPECT_EQ(errorKey("[KFD]\nwindw = 3\n"), "windw");
+    try {
+        fromIniText("[KFD]\nwindw = 3\n");
+        FAIL();
+    } catch (const kfd::ConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("windw"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("window"), std::string::npos);  // lists known keys
+    }
+}
+
+TEST(Config, OutOfRangeValuesNameTheKey) {
+    EXPECT_EQ(errorKey("[KFD]\nwindow = 0\n"), "window");
+    EXPECT_EQ(errorKey("[KFD]\np_pair = 1.5\n"), "p_pair");
+    EXPECT_EQ(errorKey("[KFD]\np_pair = 0\n"), "p_pair");
+    EXPECT_EQ(errorKey("[KFD]\nbins = 1\n"), "bins");
+    EXPECT_EQ(errorKey("[KFD]\nmin_range = -1\n"), "min_range");
+    EXPECT_EQ(errorKey("[KFD]\nrings = 0\n"), "rings");
+    EXPECT_EQ(errorKey("[KFD]\nmax_rotation_deg = 400\n"), "max_rotation_deg");
+    EXPECT_EQ(errorKey("[KFD]\nmin_range = 5\nmax_range = 2\n"), "max_range");
+}
+
+TEST(Config, MalformedValuesNameTheKey) {
+    EXPECT_EQ(errorKey("[KFD]\nwindow = eight\n"), "window");
+    EXPECT_EQ(errorKey("[KFD]\nwindow = 2.5\n"), "window");
+    EXPECT_EQ(errorKey("[KFD]\nmax_range = 30m\n"), "max_range");
+    EXPECT_EQ(errorKey("[KFD]\nvariant = fancy\n"), "variant");
+    EXPECT_EQ(errorKey("[KFD]\npipeline = distance, smooth\n"), "pipeline");
+    EXPECT_EQ(errorKey("[KFD]\npipeline = keyframe, keyframe\n"), "pipeline");
+}
+
+TEST(Config, PipelineOrderIsRead) {
+    const auto p = fromIniText("[KFD]\npipeline = distance, denoise\n");
+    ASSERT_EQ(p.stages.size(), 2u);
+    EXPECT_EQ(p.stages[0], "distance");
+    EXPECT_EQ(p.stages[1], "denoise");
+}
+
+TEST(Config, OtherSectionsAreIgnoredButTheSectionMustExist) {
+    EXPECT_NO_THROW(fromIniText("[ICP]\nfoo = 1\n[KFD]\nwindow = 2\n"));
+    EXPECT_THROW(fromIniText("[ICP]\nfoo = 1\n"), kfd::ConfigError);
+}
+
+TEST(Config, YamlTopLevelOrKfdMap) {
+    auto top = mrpt::containers::yaml::FromText("window: 4\nvariant: range_aware\n");
+    EXPECT_EQ(kfd::loadYaml(top).get<kfd::KeyframeStage>().window, 4u);
+    auto nested = mrpt::containers::yaml::FromText("kfd:\n  window: 5\n");
+    EXPECT_EQ(kfd::loadYaml(nested).get<kfd::KeyframeStage>().window, 5u);
+    auto bad = mrpt::containers::yaml::FromText("kfd:\n  windoww: 5\n");
+    try {
+        kfd::loadYaml(bad);
+        FAIL();
+    } catch (const kfd::ConfigError& e) {
+        EXPECT_EQ(e.key(), "windoww");
+    }
+}
+
+TEST(Config, FileErrorsAreClear) {
+    EXPECT_THROW(kfd::loadConfigFile("/nonexistent/kfd.ini"), kfd::ConfigError);
+    const auto tmp = std::filesystem::temp_directory_path() / "kfd_config_test.toml";
+    std::ofstream(tmp) << "window = 3\n";
+    EXPECT_THROW(kfd::loadConfigFile(tmp.string()), kfd::ConfigError);
+    std::filesystem::remove(tmp);
+}
+
+TEST(Config, PrintedConfigReadsBackTheSame) {
+    const auto p = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/paper-mit-0.575.ini");
+    EXPECT_EQ(kfd::toIni(fromIniText(kfd::toIni(p))), kfd::toIni(p));
+}
+
+TEST(Config, EveryKeyIsDocumented) {
+    for (const auto& k : kfd::configKeys()) {
+        EXPECT_FALSE(k.help.empty()) << k.name;
+        EXPECT_FALSE(k.range.empty()) << k.name;
+    }
+}
+
+TEST(Config, RadiusAndSorKeysLoadAndAreRangeChecked) {
+    // Built-in defaults when absent.
+    const auto d = fromIniText("[KFD]\nwindow = 2\n");
+    EXPECT_EQ(d.get<kfd::RadiusStage>().radius_m, 0.3);
+    EXPECT_EQ(d.get<kfd::RadiusStage>().min_neighbors, 3u);
+    EXPECT_EQ(d.get<kfd::SorStage>().k, 8u);
+    EXPECT_EQ(d.get<kfd::SorStage>().std_mul, 1.0);
+
+    const auto p = fromIniText(
+        "[KFD]\npipeline = distance, radius, sor\nradius_m = 0.45\nradius_min_neighbors = 5\n"
+        "sor_k = 12\nsor_std_mul = 2.5\n");
+    EXPECT_EQ(p.stages, (std::vector<std::string>{"distance", "radius", "sor"}));
+    EXPECT_DOUBLE_EQ(p.get<kfd::RadiusStage>().radius_m, 0.45);
+    EXPECT_EQ(p.get<kfd::RadiusStage>().min_neighbors, 5u);
+    EXPECT_EQ(p.get<kfd::SorStage>().k, 12u);
+    EXPECT_DOUBLE_EQ(p.get<kfd::SorStage>().std_mul, 2.5);
+    EXPECT_EQ(kfd::toIni(fromIniText(kfd::toIni(p))), kfd::toIni(p));  // printed and read back
+    EXPECT_NE(kfd::toIni(p).find("radius_min_neighbors = 5"), std::string::npos);
+
+    auto yml = mrpt::containers::yaml::FromText(
+        "kfd:\n  pipeline: [distance, sor]\n  sor_k: 4\n  sor_std_mul: 0\n  radius_m: 1\n");
+    const auto y = kfd::loadYaml(yml);
+    EXPECT_EQ(y.stages, (std::vector<std::string>{"distance", "sor"}));
+    EXPECT_EQ(y.get<kfd::SorStage>().k, 4u);
+    EXPECT_EQ(y.get<kfd::SorStage>().std_mul, 0.0);
+    EXPECT_EQ(y.get<kfd::RadiusStage>().radius_m, 1.0);
+
+    // Limits are inclusive where documented.
+    EXPECT_NO_THROW(fromIniText("[KFD]\nradius_m = 100\nradius_min_neighbors = 1\n"));
+    EXPECT_NO_THROW(fromIniText("[KFD]\nsor_k = 1\nsor_std_mul = 0\n"));
+    EXPECT_NO_THROW(fromIniText("[KFD]\nsor_k = 1000\nsor_std_mul = 100\n"));
+
+    EXPECT_EQ(errorKey("[KFD]\nradius_m = 0\n"), "radius_m");
+    EXPECT_EQ(errorKey("[KFD]\nradius_m = -0.3\n"), "radius_m");
+    EXPECT_EQ(errorKey("[KFD]\nradius_m = 100.5\n"), "radius_m");
+    EXPECT_EQ(errorKey("[KFD]\nradius_m = wide\n"), "radius_m");
+    EXPECT_EQ(errorKey("[KFD]\nradius_min_neighbors = 0\n"), "radius_min_neighbors");
+    EXPECT_EQ(errorKey("[KFD]\nradius_min_neighbors = 2.5\n"), "radius_min_neighbors");
+    EXPECT_EQ(errorKey("[KFD]\nsor_k = 0\n"), "sor_k");
+    EXPECT_EQ(errorKey("[KFD]\nsor_k = 1001\n"), "sor_k");
+    EXPECT_EQ(errorKey("[KFD]\nsor_k = 3.5\n"), "sor_k");
+    EXPECT_EQ(errorKey("[KFD]\nsor_std_mul = -0.1\n"), "sor_std_mul");
+    EXPECT_EQ(errorKey("[KFD]\nsor_std_mul = 100.5\n"), "sor_std_mul");
+    EXPECT_EQ(errorKey("[KFD]\npipeline = radius, sor, radius\n"), "pipeline");
+    EXPECT_EQ(errorKey("[KFD]\npipeline = distance, pcl\n"), "pipeline");
+    try {
+        fromIniText("[KFD]\npipeline = distance, pcl\n");
+        FAIL();
+    } catch (const kfd::ConfigError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("radius"), std::string::npos) << what;
+        EXPECT_NE(what.find("sor"), std::string::npos) << what;
+    }
+
+    // Listed with units in their help texts, and the pipeline key lists the new stages.
+    std::size_t found = 0;
+    for (const auto& k : kfd::configKeys()) {
+        if (k.name == "radius_m" || k.name == "radius_min_neighbors" || k.name == "sor_k" ||
+            k.name == "sor_std_mul") {
+            ++found;
+            EXPECT_NE(k.help.find('('), std::string::npos) << k.name << ": " << k.help;
+        }
+        if (k.name == "pipeline") {
+            EXPECT_NE(k.range.find("radius"), std::string::npos) << k.range;
+            EXPECT_NE(k.range.find("sor"), std::string::npos) << k.range;
+        }
+    }
+    EXPECT_EQ(found, 4u);
+}
+
+TEST(Config, ConfigErrorIsAKfdErrorNamingTheKey) {
+    try {
+        fromIniText("[KFD]\nradius_min_neighbors = 0\n");
+        FAIL();
+    } catch (const kfd::Error& e) {  // the one exception root
+        EXPECT_EQ(e.field(), "radius_min_neighbors");
+        EXPECT_NE(dynamic_cast<const kfd::ConfigError*>(&e), nullptr);
+    }
+}
+
+TEST(Config, KeyTableIsDerivedFromTheStageRegistry) {
+    const auto& reg = kfd::defaultStageRegistry();
+    std::vector<std::string> want{"pipeline"};
+    for (const auto& s : reg.stages())
+        for (const auto& k : s.keys) want.push_back(k.name);
+    std::vector<std::string> got;
+    for (const auto& k : kfd::configKeys()) got.push_back(k.name);
+    EXPECT_EQ(got, want);
+    EXPECT_EQ(kfd::configKeys().front().range, reg.names());
+    // Every key, and only those, printed by toIni in the same order.
+    const std::string ini = kfd::toIni(kfd::Pipeline::Params{});
+    std::size_t pos = 0;
+    for (const auto& k : want) {
+        const auto at = ini.find("\n" + k + " = ", pos);
+        ASSERT_NE(at, std::string::npos) << k;
+        pos = at + 1;
+    }
+    // A registry with the core stages only has only the core keys.
+    std::size_t core_keys = 1;
+    for (const auto& s : kfd::coreStageRegistry().stages()) core_keys += s.keys.size();
+    EXPECT_EQ(kfd::configKeys(kfd::coreStageRegistry()).size(), core_keys);
+}
+
+TEST(Config, AngleGapFactorReachesBothDenoiseVariants) {
+    const auto p = fromIniText("[KFD]\nangle_gap_factor = 30\n");
+    EXPECT_EQ(p.get<kfd::DenoiseStage>().reference.angle_gap_factor, 30.0);
+    EXPECT_EQ(p.get<kfd::DenoiseStage>().range_aware.angle_gap_factor, 30.0);
+    EXPECT_NE(kfd::toIni(p).find("angle_gap_factor = 30\n"), std::string::npos);
+}

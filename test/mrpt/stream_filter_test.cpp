@@ -1,0 +1,153 @@
+// StreamFilter: the per-scan API over CObservation2DRangeScan.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "kfd/mrpt/scan_adapter.h"
+#include "kfd/mrpt/stream_filter.h"
+
+namespace {
+
+// A scan of a square room of half-side `half` seen from its centre, with a given rotation.
+mrpt::obs::CObservation2DRangeScan roomScan(std::size_t beams, double aperture, double half,
+                                            const std::string& label = "LASER",
+                                            double rotation = 0.0) {
+    mrpt::obs::CObservation2DRangeScan s;
+    s.sensorLabel = label;
+    s.aperture = static_cast<float>(aperture);
+    s.rightToLeft = true;
+    s.resizeScan(beams);
+    for (std::size_t i = 0; i < beams; ++i) {
+        const double a = s.getScanAngle(i) + rotation;
+        const double r = half / std::max(std::abs(std::cos(a)), std::abs(std::sin(a)));
+        s.setScanRange(i, static_cast<float>(r));
+        s.setScanRangeValidity(i, true);
+    }
+    return s;
+}
+
+kfd::Pipeline::Params paperParams() {
+    kfd::Pipeline::Params p;  // built-in defaults with the guards off
+    p.get<kfd::KeyframeStage>().max_consecutive_drops = 0;
+    p.get<kfd::KeyframeStage>().max_interval_s = 0;
+    p.get<kfd::KeyframeStage>().max_translation_m = 0;
+    p.get<kfd::KeyframeStage>().max_rotation_deg = 0;
+    return p;
+}
+
+}  // namespace
+
+TEST(StreamFilter, IdenticalScansAfterTheFirstAreDropped) {
+    kfd::StreamFilter f(paperParams());
+    auto s = roomScan(361, M_PI, 3.0);
+    EXPECT_TRUE(f.process(s).keep);
+    for (int k = 0; k < 5; ++k) {
+        auto t = roomScan(361, M_PI, 3.0);
+        const auto r = f.process(t);
+        EXPECT_FALSE(r.keep);
+        EXPECT_EQ(r.report.findOrDefault<kfd::KeyframeDecision>().reason,
+                  kfd::KeyframeReason::Similar);
+        EXPECT_EQ(r.report.dropped_by, "keyframe");
+    }
+}
+
+TEST(StreamFilter, KeepsSeparateStatePerSensor) {
+    kfd::StreamFilter f(paperParams());
+    auto a = roomScan(361, M_PI, 3.0, "FRONT");
+    auto b = roomScan(361, M_PI, 3.0, "REAR");
+    EXPECT_TRUE(f.process(a).keep);
+    const auto rb = f.process(b);
+    EXPECT_TRUE(rb.keep);  // first scan of its own stream
+    EXPECT_EQ(rb.report.findOrDefault<kfd::KeyframeDecision>().reason, kfd::KeyframeReason::First);
+    EXPECT_EQ(rb.sensor_label, "REAR");
+    EXPECT_EQ(f.sensorCount(), 2u);
+}
+
+TEST(StreamFilter, ResetsWhenGeometryChanges) {
+    kfd::StreamFilter f(paperParams());
+    auto a = roomScan(361, M_PI, 3.0);
+    f.process(a);
+    auto same = roomScan(361, M_PI, 3.0);
+    EXPECT_FALSE(f.process(same).geometry_reset);
+
+    auto more_beams = roomScan(721, M_PI, 3.0);
+    auto r = f.process(more_beams);
+    EXPECT_TRUE(r.geometry_reset);
+    EXPECT_TRUE(r.keep);
+    EXPECT_EQ(r.report.findOrDefault<kfd::KeyframeDecision>().reason, kfd::KeyframeReason::First);
+
+    auto wider = roomScan(721, 1.5 * M_PI, 3.0);
+    EXPECT_TRUE(f.process(wider).geometry_reset);
+
+    auto flipped = roomScan(721, 1.5 * M_PI, 3.0);
+    flipped.rightToLeft = false;
+    r = f.process(flipped);
+    EXPECT_TRUE(r.geometry_reset);
+    EXPECT_EQ(r.report.findOrDefault<kfd::KeyframeDecision>().reason, kfd::KeyframeReason::First);
+}
+
+TEST(StreamFilter, CleansInPlaceKeepingBeamsAndRanges) {
+    kfd::StreamFilter f(paperParams());
+    auto s = roomScan(361, M_PI, 3.0);
+    s.setScanRange(100, 1.0f);   // an isolated spike
+    s.setScanRange(200, 50.0f);  // beyond max_range
+    const auto before = s;
+    const auto r = f.process(s);
+    ASSERT_TRUE(r.keep);
+    ASSERT_EQ(s.getScanSize(), before.getScanSize());
+    for (std::size_t i = 0; i < s.getScanSize(); ++i)
+        EXPECT_EQ(s.getScanRange(i), before.getScanRange(i));
+    EXPECT_FALSE(s.getScanRangeValidity(100));
+    EXPECT_FALSE(s.getScanRangeValidity(200));
+    EXPECT_TRUE(s.getScanRangeValidity(150));
+    EXPECT_EQ(r.report.findOrDefault<kfd::DistanceFilter::Result>().removed_out_of_range, 1u);
+    EXPECT_GE(r.report.findOrDefault<kfd::Denoiser::Result>().points_removed, 1u);
+}
+
+TEST(StreamFilter, RotationInPlaceStillProducesKeyframes) {
+    // A square room seen from its centre: turning in place barely changes the scan (exactly
+    // nothing after 90 degrees), so without odometry nothing would mark the turn.
+    auto count_kept = [](double guard_deg) {
+        kfd::Pipeline::Params p = paperParams();
+        p.get<kfd::KeyframeStage>().max_rotation_deg = guard_deg;
+        kfd::StreamFilter f(p);
+        std::size_t kept = 0;
+        for (int k = 0; k < 36; ++k) {  // 10 degrees per scan, one full turn
+            auto s = roomScan(360, 2 * M_PI * 359 / 360, 3.0);
+            const double yaw = std::remainder(k * 10.0 * M_PI / 180.0, 2 * M_PI);
+            if (f.process(s, kfd::Pose2D{0, 0, yaw}).keep) ++kept;
+        }
+        return kept;
+    };
+    EXPECT_EQ(count_kept(0.0), 1u);    // guard off: only the first scan
+    EXPECT_EQ(count_kept(15.0), 18u);  // guard on: every second scan (20 degrees >= 15)
+}
+
+TEST(StreamFilter, EmptyScanIsRejected) {
+    kfd::StreamFilter f;
+    mrpt::obs::CObservation2DRangeScan s;
+    EXPECT_THROW(f.process(s), std::invalid_argument);
+}
+
+TEST(StreamFilter, InvalidParametersAreRejectedUpFront) {
+    kfd::Pipeline::Params p;
+    p.get<kfd::KeyframeStage>().window = 0;
+    EXPECT_THROW(kfd::StreamFilter{p}, kfd::ParameterError);
+}
+
+TEST(ScanAdapter, RoundTripKeepsGeometryAndValidity) {
+    auto s = roomScan(181, M_PI, 2.0);
+    s.setScanRangeValidity(7, false);
+    kfd::Scan core;
+    kfd::toCore(s, core);
+    EXPECT_EQ(core.size(), 181u);
+    EXPECT_FALSE(core.valid[7]);
+    for (std::size_t i : {0u, 90u, 180u})
+        EXPECT_NEAR(core.geometry.angle(i), s.getScanAngle(i), 1e-6);
+    core.valid[9] = 0;
+    EXPECT_EQ(kfd::applyValidity(core, s), 1u);
+    EXPECT_FALSE(s.getScanRangeValidity(9));
+    core.valid[7] = 1;  // never re-validates a beam
+    kfd::applyValidity(core, s);
+    EXPECT_FALSE(s.getScanRangeValidity(7));
+}

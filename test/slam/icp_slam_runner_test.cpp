@@ -1,0 +1,393 @@
+// kfd-icp-slam end to end: equality with MRPT's icp-slam, pose error on a real log, every mode.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "kfd/eval/trajectory.h"
+#include "kfd/mrpt/config.h"
+#include "kfd/mrpt/default_stages.h"
+#include "kfd/report/slam_report.h"
+#include "kfd/sim/simulator.h"
+#include "kfd/slam/icp_slam_runner.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kSena =
+    std::string(KFD_MRPT_DATASETS_DIR) + "/2006-01ENE-21-SENA_Telecom Faculty_one_loop_only.rawlog";
+const std::string kMitCsail = std::string(KFD_DATASETS_DIR) + "/mit-csail/mit-csail.rawlog";
+const std::string kMitCsailRel = std::string(KFD_DATASETS_DIR) + "/mit-csail/mit-csail.relations";
+const std::string kConfig = std::string(KFD_SOURCE_DIR) + "/share/kfd-icp-slam/sick-180-5hz.ini";
+
+struct TempDir {
+    fs::path path;
+    TempDir() {
+        path = fs::temp_directory_path() /
+               (std::string("kfd_slam_") +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~TempDir() { fs::remove_all(path); }
+    std::string operator/(const std::string& f) const { return (path / f).string(); }
+};
+
+std::string text(const std::string& path) {
+    std::ifstream f(path);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+std::size_t lines(const std::string& path) {
+    std::ifstream f(path);
+    std::size_t n = 0;
+    std::string l;
+    while (std::getline(f, l)) ++n;
+    return n;
+}
+
+// A run and its report, as kfd-icp-slam does.
+kfd::IcpSlamSummary runAndReport(const kfd::IcpSlamOptions& o) {
+    const auto result = kfd::IcpSlamRunner().run(o);
+    kfd::writeIcpSlamReport(result);
+    return result.summary;
+}
+
+kfd::IcpSlamOptions options(const std::string& rawlog, const std::string& out,
+                            kfd::PrefilterMode mode) {
+    kfd::IcpSlamOptions o;
+    o.config_file = kConfig;
+    o.rawlog = rawlog;
+    o.output_dir = out;
+    o.mode = mode;
+    return o;
+}
+
+}  // namespace
+
+TEST(IcpSlamRunner, ModeNoneMatchesMrptIcpSlam) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    if (std::system("command -v icp-slam > /dev/null") != 0)
+        GTEST_SKIP() << "MRPT's icp-slam not installed (mrpt-apps)";
+    TempDir dir;
+    // icp-slam writes into logOutput_dir; give it a config copy that points there.
+    std::string cfg = text(kConfig);
+    const auto pos = cfg.find("\nlogOutput_dir");
+    ASSERT_NE(pos, std::string::npos);
+    cfg.replace(pos + 1, cfg.find('\n', pos + 1) - pos - 1, "logOutput_dir=" + (dir / "mrpt"));
+    std::ofstream(dir / "icp.ini") << cfg;
+    const std::string cmd =
+        "icp-slam '" + (dir / "icp.ini") + "' '" + kSena + "' > '" + (dir / "icp.log") + "' 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << text(dir / "icp.log");
+
+    const auto s = runAndReport(options(kSena, dir / "kfd", kfd::PrefilterMode::None));
+    EXPECT_EQ(s.scans_kept, s.scans_in);
+    const std::string mine = text(dir / "kfd/log_estimated_path.txt");
+    const std::string theirs = text(dir / "mrpt/log_estimated_path.txt");
+    EXPECT_GT(lines(dir / "kfd/log_estimated_path.txt"), 200u);
+    EXPECT_EQ(mine, theirs);
+}
+
+TEST(IcpSlamRunner, KfdOnMitCsailHasBoundedErrorAndAPoseForEveryScan) {
+    if (!fs::exists(kMitCsail)) GTEST_SKIP() << "dataset missing: " << kMitCsail;
+    TempDir dir;
+    auto o = options(kMitCsail, dir / "out", kfd::PrefilterMode::Kfd);
+    o.relations = kMitCsailRel;
+    const auto s = runAndReport(o);
+    EXPECT_EQ(s.scans_in, 1988u);
+    EXPECT_GT(s.dropped_pct, 5.0);
+    ASSERT_TRUE(s.relations.has_value());
+    EXPECT_EQ(s.relations->unmatched, 0u);  // every relation stamp found a pose
+    EXPECT_EQ(s.relations->used, 1172u);
+    // Bounds well above the measured value (docs/RESULTS.md) and far below a failed run
+    // (lost tracking gives metres).
+    EXPECT_LT(s.relations->trans_mean, 0.6);
+    EXPECT_LT(s.relations->rot_mean_deg, 4.0);
+    const auto traj = kfd::readTum(dir / "out/trajectory.tum");
+    EXPECT_EQ(traj.size(), s.scans_in);
+    EXPECT_EQ(lines(dir / "out/scans.csv"), s.scans_in + 1);
+    for (const char* f : {"summary.json", "final_map.simplemap", "map.png", "map_figure.png",
+                          "report.md", "log_estimated_path.txt"})
+        EXPECT_TRUE(fs::exists(dir / (std::string("out/") + f))) << f;
+    const std::string json = text(dir / "out/summary.json");
+    for (const char* key : {"\"scans_in\"", "\"scans_kept\"", "\"dropped_pct\"",
+                            "\"points_removed\"", "\"prefilter_us_per_scan\"",
+                            "\"icp_ms_per_scan\"", "\"cpu_s_total\"", "\"trans_mean_m\""})
+        EXPECT_NE(json.find(key), std::string::npos) << key;
+}
+
+TEST(IcpSlamRunner, EveryModeRunsAndAccountsForEveryScan) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    for (auto mode :
+         {kfd::PrefilterMode::None, kfd::PrefilterMode::Odometry, kfd::PrefilterMode::Keyframe,
+          kfd::PrefilterMode::Kfd, kfd::PrefilterMode::Dbscan}) {
+        SCOPED_TRACE(kfd::toString(mode));
+        auto o = options(kSena, dir / kfd::toString(mode), mode);
+        o.write_map = false;
+        const auto s = runAndReport(o);
+        // MRPT's action/frame reader (as in icp-slam, which also logs 224 poses) yields 224 of
+        // the file's 225 scans.
+        EXPECT_EQ(s.scans_in, 224u);
+        EXPECT_EQ(kfd::readTum(dir / (std::string(kfd::toString(mode)) + "/trajectory.tum")).size(),
+                  224u);
+        const bool drops = mode == kfd::PrefilterMode::Odometry ||
+                           mode == kfd::PrefilterMode::Keyframe || mode == kfd::PrefilterMode::Kfd;
+        if (drops) {
+            EXPECT_LT(s.scans_kept, s.scans_in);
+        } else {
+            EXPECT_EQ(s.scans_kept, s.scans_in);
+        }
+        const bool denoises = mode == kfd::PrefilterMode::Kfd || mode == kfd::PrefilterMode::Dbscan;
+        if (denoises) {
+            EXPECT_GT(s.points_removed, 0u);
+        }
+        if (mode == kfd::PrefilterMode::None) {
+            EXPECT_EQ(s.points_removed, 0u);
+        }
+    }
+}
+
+TEST(IcpSlamRunner, OdometryModeMatchesATargetDropRate) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    for (double target : {20.0, 50.0}) {
+        auto o = options(kSena, dir / "odo", kfd::PrefilterMode::Odometry);
+        o.write_map = false;
+        o.odometry_target_drop_pct = target;
+        const auto s = runAndReport(o);
+        EXPECT_NEAR(s.dropped_pct, target, 3.0);  // 225 scans: steps of 0.44 %
+        EXPECT_GT(s.pipeline.get<kfd::MotionStage>().max_distance_m, 0.0);
+    }
+}
+
+TEST(IcpSlamRunner, BadInputIsAClearError) {
+    TempDir dir;
+    auto o = options(dir / "missing.rawlog", dir / "out", kfd::PrefilterMode::Kfd);
+    EXPECT_THROW(runAndReport(o), kfd::SlamError);
+    o.config_file = dir / "missing.ini";
+    EXPECT_THROW(runAndReport(o), kfd::SlamError);
+    std::ofstream(dir / "text.rawlog") << "not a rawlog\n";
+    o = options(dir / "text.rawlog", dir / "out", kfd::PrefilterMode::Kfd);
+    EXPECT_THROW(runAndReport(o), kfd::SlamError);
+    std::ofstream(dir / "bad.ini") << text(kConfig) << "\n[KFD]\nwindw = 2\n";
+    o = options(kSena, dir / "out", kfd::PrefilterMode::Kfd);
+    o.config_file = dir / "bad.ini";
+    EXPECT_THROW(runAndReport(o), kfd::ConfigError);
+}
+
+TEST(IcpSlamRunner, ModesAreNamedStageListsOfTheRegistry) {
+    const auto& modes = kfd::prefilterModes();
+    std::vector<std::string> names;
+    for (const auto& m : modes) {
+        names.push_back(m.name);
+        EXPECT_FALSE(m.description.empty()) << m.name;
+        EXPECT_STREQ(kfd::toString(m.mode), m.name.c_str());
+        EXPECT_EQ(kfd::parsePrefilterMode(m.name), m.mode);
+        for (const auto& s : m.stages)
+            EXPECT_NE(kfd::defaultStageRegistry().find(s), nullptr) << m.name << ": " << s;
+        kfd::Pipeline::Params kfd_params;
+        kfd_params.stages = {"denoise"};  // the [KFD] list: only the kfd mode keeps it
+        const auto p = kfd::pipelineForMode(m.mode, kfd_params);
+        EXPECT_EQ(p.stages, m.uses_kfd_stages ? kfd_params.stages : m.stages) << m.name;
+    }
+    EXPECT_EQ(names, (std::vector<std::string>{"none", "odometry", "keyframe", "kfd", "dbscan",
+                                               "radius", "sor"}));
+    // The baseline modes run "distance" and then the baseline, described by its stage's help.
+    EXPECT_EQ(modes[6].stages, (std::vector<std::string>{"distance", "sor"}));
+    EXPECT_NE(modes[6].description.find(kfd::defaultStageRegistry().find("sor")->help),
+              std::string::npos);
+}
+
+TEST(IcpSlamRunner, ModesParseAndMapToPipelines) {
+    EXPECT_EQ(kfd::parsePrefilterMode("dbscan"), kfd::PrefilterMode::Dbscan);
+    EXPECT_THROW(kfd::parsePrefilterMode("fast"), kfd::ParameterError);
+    kfd::Pipeline::Params p;
+    EXPECT_TRUE(kfd::pipelineForMode(kfd::PrefilterMode::None, p).stages.empty());
+    EXPECT_EQ(kfd::pipelineForMode(kfd::PrefilterMode::Odometry, p).stages,
+              std::vector<std::string>{"motion"});
+    EXPECT_EQ(kfd::pipelineForMode(kfd::PrefilterMode::Kfd, p).stages, p.stages);
+}
+
+TEST(IcpSlamRunner, EveryShippedSlamConfigLoads) {
+    std::size_t n = 0;
+    for (const auto& e :
+         fs::directory_iterator(std::string(KFD_SOURCE_DIR) + "/share/kfd-icp-slam")) {
+        SCOPED_TRACE(e.path().string());
+        EXPECT_NO_THROW(kfd::loadConfigFile(e.path().string()));  // its [KFD] section
+        ++n;
+    }
+    EXPECT_GE(n, 1u);
+}
+
+TEST(KfdIcpSlamCli, UsageErrorsAndHelp) {
+    auto run = [](const std::string& args) {
+        const std::string cmd =
+            std::string("'") + KFD_ICP_SLAM_EXE + "' " + args + " > /dev/null 2>&1";
+        const int st = std::system(cmd.c_str());
+        return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    };
+    EXPECT_EQ(run("--help"), 0);
+    EXPECT_EQ(run(""), 2);
+    EXPECT_EQ(run("x.ini --mode fast"), 2);
+    EXPECT_EQ(run("/nonexistent.ini"), 1);
+}
+
+TEST(IcpSlamRunner, RadiusAndSorModesParseAndMapToPipelines) {
+    EXPECT_EQ(kfd::parsePrefilterMode("radius"), kfd::PrefilterMode::Radius);
+    EXPECT_EQ(kfd::parsePrefilterMode("sor"), kfd::PrefilterMode::Sor);
+    EXPECT_STREQ(kfd::toString(kfd::PrefilterMode::Radius), "radius");
+    EXPECT_STREQ(kfd::toString(kfd::PrefilterMode::Sor), "sor");
+    EXPECT_THROW(kfd::parsePrefilterMode("Radius"), kfd::ParameterError);
+    EXPECT_THROW(kfd::parsePrefilterMode("statistical"), kfd::ParameterError);
+    try {
+        kfd::parsePrefilterMode("fast");
+        FAIL();
+    } catch (const kfd::ParameterError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("radius"), std::string::npos) << what;
+        EXPECT_NE(what.find("sor"), std::string::npos) << what;
+    }
+    kfd::Pipeline::Params p;  // the [KFD] parameters carry over into the modes
+    p.get<kfd::RadiusStage>().radius_m = 0.5;
+    p.get<kfd::SorStage>().k = 5;
+    const auto radius = kfd::pipelineForMode(kfd::PrefilterMode::Radius, p);
+    EXPECT_EQ(radius.stages, (std::vector<std::string>{"distance", "radius"}));
+    EXPECT_EQ(radius.get<kfd::RadiusStage>().radius_m, 0.5);
+    const auto sor = kfd::pipelineForMode(kfd::PrefilterMode::Sor, p);
+    EXPECT_EQ(sor.stages, (std::vector<std::string>{"distance", "sor"}));
+    EXPECT_EQ(sor.get<kfd::SorStage>().k, 5u);
+    EXPECT_EQ(kfd::Pipeline(radius, kfd::defaultStageRegistry()).stages().size(),
+              2u);  // both build
+    EXPECT_EQ(kfd::Pipeline(sor, kfd::defaultStageRegistry()).stages().size(), 2u);
+    // The command line accepts them: a missing config is bad input (1), not bad usage (2).
+    auto run = [](const std::string& args) {
+        const std::string cmd =
+            std::string("'") + KFD_ICP_SLAM_EXE + "' " + args + " > /dev/null 2>&1";
+        const int st = std::system(cmd.c_str());
+        return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    };
+    EXPECT_EQ(run("/nonexistent.ini --mode radius"), 1);
+    EXPECT_EQ(run("/nonexistent.ini --mode sor"), 1);
+    EXPECT_EQ(run("/nonexistent.ini --mode rad"), 2);
+}
+
+TEST(IcpSlamRunner, RadiusAndSorModesRunAndKeepEveryScan) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    for (auto mode : {kfd::PrefilterMode::Radius, kfd::PrefilterMode::Sor}) {
+        SCOPED_TRACE(kfd::toString(mode));
+        auto o = options(kSena, dir / kfd::toString(mode), mode);
+        o.write_map = false;
+        const auto s = runAndReport(o);
+        EXPECT_EQ(s.scans_in, 224u);
+        EXPECT_EQ(s.scans_kept, s.scans_in);  // denoisers never drop scans
+        // Out-of-range and noise removals together (the noise alone is checked in
+        // rawlog_filter_test's BaselineDenoisersCountTheirNoise).
+        EXPECT_GT(s.points_removed, 0u);
+        EXPECT_LT(s.points_removed, s.points_in / 2);
+        EXPECT_EQ(s.pipeline.stages, (std::vector<std::string>{"distance", kfd::toString(mode)}));
+        const std::string json = text(dir / (std::string(kfd::toString(mode)) + "/summary.json"));
+        EXPECT_NE(json.find(std::string("\"mode\": \"") + kfd::toString(mode) + "\""),
+                  std::string::npos);
+    }
+}
+
+TEST(IcpSlamRunner, GroundTruthTrajectoryGivesAteAndAReport) {
+    TempDir dir;
+    kfd::SimulationOptions so;
+    so.duration_s = 8.0;
+    so.output = dir / "sim.rawlog";
+    const auto sim = kfd::Simulator().run(so);
+    auto o = options(sim.rawlog, dir / "out", kfd::PrefilterMode::None);
+    o.ground_truth_tum = sim.ground_truth;
+    const auto s = runAndReport(o);
+    ASSERT_TRUE(s.ate_rmse.has_value());
+    EXPECT_LT(*s.ate_rmse, 0.1);  // ICP-SLAM on clean simulated scans: centimetres
+    EXPECT_NE(text(dir / "out/summary.json").find("\"ate_rmse_m\""), std::string::npos);
+    const std::string report = text(dir / "out/report.md");
+    EXPECT_NE(report.find("ATE RMSE"), std::string::npos);
+    EXPECT_NE(report.find("map_figure.png"), std::string::npos);
+    EXPECT_TRUE(fs::exists(dir / "out/map_figure.png"));
+}
+
+TEST(IcpSlamRunner, TruncatedRawlogIsAnErrorNotAShortRun) {
+    const std::string real = std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog";
+    if (!fs::exists(real)) GTEST_SKIP() << "missing " << real;
+    TempDir dir;
+    {
+        std::ifstream in(real, std::ios::binary);
+        std::string data((std::istreambuf_iterator<char>(in)), {});
+        std::ofstream(dir / "cut.rawlog", std::ios::binary) << data.substr(0, data.size() / 2);
+    }
+    auto o = options(dir / "cut.rawlog", dir / "out", kfd::PrefilterMode::None);
+    o.write_map = false;
+    try {
+        kfd::IcpSlamRunner().run(o);
+        ADD_FAILURE() << "a truncated rawlog ran to its end";
+    } catch (const kfd::SlamError& e) {
+        EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
+    }
+}
+
+TEST(IcpSlamRunner, SummaryJsonKeepsEveryKeyInOrder) {
+    kfd::IcpSlamSummary s;
+    s.mode = kfd::PrefilterMode::Odometry;
+    s.rawlog = "a \"quoted\" \\ path.rawlog";
+    s.pipeline.stages = {"motion"};
+    s.scans_in = 10;
+    s.scans_kept = 4;
+    s.dropped_pct = 60.0;
+    s.ate_rmse = 0.125;
+    s.relations = kfd::RelationsError{};
+    s.relations->used = 7;
+    s.relations_file = "gt.relations";
+    const std::string json = kfd::toJson(s);
+    std::size_t last = 0;
+    for (const char* key : {"\"mode\": \"odometry\"",
+                            "\"rawlog\": \"a \\\"quoted\\\" \\\\ path.rawlog\"",
+                            "\"stages\"",
+                            "\"motion\"",
+                            "\"entries\"",
+                            "\"scans_in\": 10",
+                            "\"scans_kept\": 4",
+                            "\"dropped_pct\": 60.0",
+                            "\"points_in\"",
+                            "\"points_removed\"",
+                            "\"prefilter_us_per_scan\"",
+                            "\"icp_ms_per_scan\"",
+                            "\"icp_ms_per_kept_scan\"",
+                            "\"cpu_s_total\"",
+                            "\"wall_s_total\"",
+                            "\"motion_distance_m\"",
+                            "\"motion_angle_deg\"",
+                            "\"ate_rmse_m\": 0.125",
+                            "\"relations\"",
+                            "\"file\": \"gt.relations\"",
+                            "\"used\": 7",
+                            "\"unmatched\"",
+                            "\"trans_mean_m\"",
+                            "\"trans_std_m\"",
+                            "\"rot_mean_deg\"",
+                            "\"rot_std_deg\"",
+                            "\"trans2_mean_m2\"",
+                            "\"trans2_std_m2\"",
+                            "\"rot2_mean_deg2\"",
+                            "\"rot2_std_deg2\""}) {
+        const auto at = json.find(key, last);
+        ASSERT_NE(at, std::string::npos) << key << " in\n" << json;
+        last = at;
+    }
+    EXPECT_EQ(json.back(), '\n');
+    s.ate_rmse.reset();
+    s.relations.reset();
+    const std::string bare = kfd::toJson(s);
+    EXPECT_EQ(bare.find("ate_rmse_m"), std::string::npos);
+    EXPECT_EQ(bare.find("relations"), std::string::npos);
+}
