@@ -63,6 +63,17 @@ void Cli::addVersion(const std::string& version) {
     app_.set_version_flag("--version", name_ + " " + version, "version");
 }
 
+void Cli::addInfoFlag(const std::string& names, const std::string& help,
+                      std::function<std::string()> text) {
+    app_.add_flag_callback(
+        names,
+        [text = std::move(text)] {
+            std::fputs(text().c_str(), stdout);
+            throw CLI::Success();
+        },
+        help);
+}
+
 ProgressPrinter* Cli::progress() {
     if (quiet_) return nullptr;
     if (!progress_) progress_.emplace(name_);
@@ -98,6 +109,8 @@ int Cli::run(int argc, char** argv, const std::function<void()>& body) {
         return 0;
     } catch (const CLI::CallForVersion& e) {
         std::printf("%s\n", e.what());
+        return 0;
+    } catch (const CLI::Success&) {  // an info flag printed its text
         return 0;
     } catch (const CLI::ExtrasError&) {
         return usageError(unexpected(argc, argv));

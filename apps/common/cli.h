@@ -140,6 +140,10 @@ class Cli {
     void addQuiet(const std::string& help = "no progress on stderr");
     /// --version prints "NAME VERSION".
     void addVersion(const std::string& version);
+    /// A flag that prints `text()` on stdout and exits 0 at once, before required arguments are
+    /// checked (like --version), e.g. `kfd-icp-slam --list-modes`.
+    void addInfoFlag(const std::string& names, const std::string& help,
+                     std::function<std::string()> text);
     /// The progress printer, or null when -q was given.
     ProgressPrinter* progress();
 

@@ -29,12 +29,19 @@ int main(int argc, char** argv) {
                "output folder (default: [MappingApplication] "
                "logOutput_dir)")
         ->type_name("DIR");
-    cli.option("-m,--mode", o.mode,
-               "none | odometry | keyframe | kfd | dbscan | radius | sor\n"
-               "(default kfd); dbscan, radius and sor run the distance stage\n"
-               "and that baseline denoiser on every scan",
+    cli.option("-m,--mode", o.mode, "pre-filter mode (default kfd; see --list-modes)",
                kfd::parsePrefilterMode)
         ->type_name("MODE");
+    cli.addInfoFlag("--list-modes", "list every mode with its stages and exit", [] {
+        std::string text;  // "name<TAB>stages<TAB>description": one line a mode, for scripts
+        for (const auto& m : kfd::prefilterModes()) {
+            std::string stages;
+            for (const auto& st : m.stages) stages += (stages.empty() ? "" : ",") + st;
+            if (m.uses_kfd_stages) stages = "[KFD] pipeline (default " + stages + ")";
+            text += m.name + "\t" + (stages.empty() ? "-" : stages) + "\t" + m.description + "\n";
+        }
+        return text;
+    });
     cli.option("--match-drop", o.odometry_target_drop_pct,
                "odometry mode: pick the motion thresholds that drop PCT %\n"
                "of the scans (e.g. kfd's drop rate on the same log)",

@@ -16,10 +16,11 @@ import re
 import subprocess
 import sys
 
+from kfd_modes import choose
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BIN = os.path.join(ROOT, "build", "apps")
 RUNS = [("office", 0.752), ("office", 0.575), ("corridor", 0.752)]
-MODES = ["kfd", "none", "odometry", "keyframe", "dbscan", "radius", "sor"]
 PAPER = {0.752: (8, 20, 0.985), 0.575: (9, 15, 0.99)}
 
 
@@ -40,7 +41,9 @@ def config(out, speed):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "sim-slam"))
+    ap.add_argument("--modes", nargs="*", help="default: every mode of kfd-icp-slam --list-modes")
     a = ap.parse_args()
+    modes = choose(os.path.join(BIN, "kfd-icp-slam"), a.modes)
     os.makedirs(a.out, exist_ok=True)
     results = {}
     print("| log | mode | dropped | ATE RMSE (m) | ATE max (m) | pre-filter (µs/scan) | "
@@ -56,7 +59,7 @@ def main():
         res = {}
         odo = subprocess.run([os.path.join(BIN, "kfd-eval"), log[:-len(".rawlog")] + ".odom.tum",
                               "--gt", gt], capture_output=True, text=True, check=True).stdout
-        for mode in MODES:
+        for mode in modes:
             out = os.path.join(a.out, tag, mode)
             cmd = [os.path.join(BIN, "kfd-icp-slam"), cfg, log, "-o", out, "-m", mode, "-q",
                    "--no-map"]

@@ -3,9 +3,10 @@
 the Markdown tables of docs/RESULTS.md ("ICP-SLAM with the pre-filter").
 
 Usage: python3 share/scripts/slam_experiment.py [--datasets DIR] [--config INI] [--out DIR]
-                                                 [--only NAME ...]
-Order per dataset: kfd first (its drop rate is the target for the odometry baseline), then
-none, odometry (--match-drop <kfd's drop %>), keyframe, dbscan. Every mode uses the same
+                                                 [--only NAME ...] [--modes MODE ...]
+Modes: every mode of `kfd-icp-slam --list-modes` (or those of --modes), kfd first (its drop
+rate is the target for the odometry baseline, run with --match-drop <kfd's drop %>). Every mode
+uses the same
 ICP-SLAM config and the same [KFD] section; nothing is tuned per dataset.
 """
 import argparse
@@ -14,9 +15,10 @@ import os
 import subprocess
 import sys
 
+from kfd_modes import choose
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DATASETS = ["mit-csail", "intel", "aces", "fr079", "mit-killian"]
-MODES = ["kfd", "none", "odometry", "keyframe", "dbscan"]
 # Kuemmerle et al. 2009, Table 1, scan matching, translation error (m): mean +- std.
 KUEMMERLE = {"aces": (0.173, 0.614), "intel": (0.220, 0.296), "mit-killian": (1.651, 4.138),
              "mit-csail": (0.106, 0.325), "fr079": (0.258, 0.427)}
@@ -41,9 +43,11 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "slam"))
     ap.add_argument("--exe", default=os.path.join(ROOT, "build", "apps", "kfd-icp-slam"))
     ap.add_argument("--only", nargs="*", default=DATASETS)
+    ap.add_argument("--modes", nargs="*", help="default: every mode of kfd-icp-slam --list-modes")
     a = ap.parse_args()
     if not os.access(a.exe, os.X_OK):
         sys.exit("build kfd-icp-slam first (bash share/scripts/demo.sh)")
+    modes = choose(a.exe, a.modes)
     results = {}
     for d in a.only:
         rawlog = os.path.join(a.datasets, d, d + ".rawlog")
@@ -52,7 +56,7 @@ def main():
             print("missing: " + rawlog, file=sys.stderr)
             continue
         results[d] = {}
-        for mode in MODES:
+        for mode in modes:
             extra = {"max_dt": MAX_DT.get(d, 0.001)}
             if mode == "odometry":
                 extra["match_drop"] = results[d]["kfd"]["dropped_pct"]
@@ -65,9 +69,9 @@ def main():
     print("| dataset | mode | dropped | relations trans (m) | relations rot (deg) | "
           "pre-filter (us/scan) | ICP-SLAM (ms/scan) | CPU total (s) |")
     print("|---|---|---:|---:|---:|---:|---:|---:|")
-    for d, modes in results.items():
-        for mode in MODES:
-            s = modes[mode]
+    for d, per_mode in results.items():
+        for mode in modes:
+            s = per_mode[mode]
             r = s["relations"]
             note = " (%d unmatched)" % r["unmatched"] if r["unmatched"] else ""
             print("| %s | %s | %.1f %% | %.3f ± %.3f%s | %.2f ± %.2f | %.1f | %.3f | %.2f |" % (

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -309,6 +310,24 @@ TEST(CliApps, FilterVersionAndEarlyExits) {
     r = runApp(KFD_FILTER_EXE, "--compress 0 --print-config");
     EXPECT_EQ(r.status, 0);
     EXPECT_EQ(r.out.rfind("[KFD]", 0), 0u) << r.out;
+}
+
+// The experiment scripts read the mode list from here (share/scripts/kfd_modes.py): one line a
+// mode, "name<TAB>stages<TAB>description", before the required CONFIG.ini is asked for.
+TEST(CliApps, IcpSlamListsEveryModeWithItsStages) {
+    const Result r = runApp(KFD_ICP_SLAM_EXE, "--list-modes");
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::vector<std::string> names;
+    std::istringstream lines(r.out);
+    for (std::string line; std::getline(lines, line);) {
+        ASSERT_EQ(std::count(line.begin(), line.end(), '\t'), 2) << line;
+        names.push_back(line.substr(0, line.find('\t')));
+    }
+    EXPECT_EQ(names, (std::vector<std::string>{"none", "odometry", "keyframe", "kfd", "dbscan",
+                                               "radius", "sor"}));
+    EXPECT_NE(r.out.find("none\t-\t"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("odometry\tmotion\t"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("radius\tdistance,radius\t"), std::string::npos) << r.out;
 }
 
 }  // namespace
