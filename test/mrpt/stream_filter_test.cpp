@@ -126,7 +126,7 @@ TEST(StreamFilter, RotationInPlaceStillProducesKeyframes) {
 TEST(StreamFilter, EmptyScanIsRejected) {
     kfd::StreamFilter f;
     mrpt::obs::CObservation2DRangeScan s;
-    EXPECT_THROW(f.process(s), std::invalid_argument);
+    EXPECT_THROW(f.process(s), kfd::ScanError);
 }
 
 TEST(StreamFilter, InvalidParametersAreRejectedUpFront) {

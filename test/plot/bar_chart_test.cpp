@@ -47,11 +47,11 @@ TEST(BarChart, TallerValueMeansTallerBar) {
 TEST(BarChart, BadShapesAndLogOfZeroAreErrors) {
     auto c = twoByTwo();
     c.values[1].pop_back();
-    EXPECT_THROW(c.render(), std::invalid_argument);
+    EXPECT_THROW(c.render(), kfd::PlotError);
     c = twoByTwo();
     c.log_y = true;
     c.values[0][0] = 0.0;
-    EXPECT_THROW(c.render(), std::invalid_argument);
+    EXPECT_THROW(c.render(), kfd::PlotError);
     c.values[0][0] = 0.01;
     EXPECT_NO_THROW(c.render());
 }
@@ -67,6 +67,6 @@ TEST(BarChart, ReadsCsvInFirstSeenOrder) {
     EXPECT_DOUBLE_EQ(c.errors[1][1], 0.47);
     EXPECT_TRUE(std::isnan(c.values[1][0]));  // aces/kfd missing: no bar
     std::ofstream(f) << "h\nx,y,notanumber\n";
-    EXPECT_THROW(kfd::readBarChartCsv(f), std::runtime_error);
+    EXPECT_THROW(kfd::readBarChartCsv(f), kfd::PlotError);
     std::filesystem::remove(f);
 }

@@ -51,5 +51,5 @@ TEST(MapFigure, GroundTruthIsAlignedToTheEstimate) {
     bool green = false;
     for (int d = -3; d <= 3; ++d) green |= rgbAt(img, p.first, p.second + d)[1] == 160;
     EXPECT_TRUE(green);
-    EXPECT_THROW(kfd::renderMapFigure(kfd::MapFigureInput{}), std::invalid_argument);
+    EXPECT_THROW(kfd::renderMapFigure(kfd::MapFigureInput{}), kfd::PlotError);
 }

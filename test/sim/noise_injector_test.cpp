@@ -109,9 +109,9 @@ TEST(NoiseInjector, SameSeedSameNoise) {
 TEST(NoiseInjector, InvalidParamsThrow) {
     auto p = none();
     p.isolated_rate = 1.5;
-    EXPECT_THROW(NoiseInjector{p}, std::invalid_argument);
+    EXPECT_THROW(NoiseInjector{p}, kfd::ParameterError);
     p = none();
     p.cluster_min_beams = 5;
     p.cluster_max_beams = 4;
-    EXPECT_THROW(NoiseInjector{p}, std::invalid_argument);
+    EXPECT_THROW(NoiseInjector{p}, kfd::ParameterError);
 }

@@ -166,7 +166,7 @@ TEST(DenoiseQuality, NothingRemovedScoresZeroRecallAndKeepsEveryPoint) {
     EXPECT_EQ(q.removed_noise + q.removed_clean, 0u);
     EXPECT_DOUBLE_EQ(q.recall(), 0.0);
     EXPECT_DOUBLE_EQ(q.cleanKept(), 1.0);
-    EXPECT_THROW(kfd::evaluateDenoising(s.rawlog, s.ground_truth, p), std::runtime_error);
+    EXPECT_THROW(kfd::evaluateDenoising(s.rawlog, s.ground_truth, p), kfd::SimulationError);
 }
 
 TEST(Simulator, ReproducesTheBundledSampleLog) {

@@ -8,7 +8,8 @@ namespace kfd {
 void RadiusOutlierFilter::initialize(const Params& p) {
     if (!(p.radius_m > 0.0) || !std::isfinite(p.radius_m))
         throw ParameterError("radius_m", "radius_m must be finite and > 0");
-    if (p.min_neighbors < 1) throw ParameterError("radius_m", "radius_min_neighbors must be >= 1");
+    if (p.min_neighbors < 1)
+        throw ParameterError("min_neighbors", "radius_min_neighbors must be >= 1");
     params_ = p;
 }
 

@@ -79,7 +79,8 @@ ScanReport Pipeline::process(Scan& scan) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     ScanReport report;
-    if (scan.valid.size() != scan.range.size()) throw Error("scan: range and valid sizes differ");
+    if (scan.valid.size() != scan.range.size())
+        throw ScanError("scan: range and valid sizes differ");
     report.points_in = scan.countValid();
     // One clock read per stage: each stage's end is the next one's start, and the last one's
     // end closes the chain's time.

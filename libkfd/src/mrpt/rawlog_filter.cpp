@@ -116,7 +116,7 @@ bool Run::handleScan(CObservation2DRangeScan& scan) {
     StreamResult r;
     try {
         r = filter_.process(scan, odometry_);
-    } catch (const std::invalid_argument& e) {
+    } catch (const ScanError& e) {
         throw RawlogError("scan " + std::to_string(scan_index_) + ": " + e.what());
     }
     sum_.points_in += r.report.points_in;

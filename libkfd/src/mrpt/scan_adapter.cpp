@@ -28,7 +28,7 @@ void toCore(const mrpt::obs::CObservation2DRangeScan& obs, Scan& out) {
 
 std::size_t applyValidity(const Scan& scan, mrpt::obs::CObservation2DRangeScan& obs) {
     const std::size_t n = obs.getScanSize();
-    if (scan.valid.size() != n) throw std::invalid_argument("applyValidity: beam count differs");
+    if (scan.valid.size() != n) throw ScanError("applyValidity: beam count differs");
     std::size_t changed = 0;
     for (std::size_t i = 0; i < n; ++i) {
         if (!scan.valid[i] && obs.getScanRangeValidity(i)) {

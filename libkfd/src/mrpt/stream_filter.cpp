@@ -25,7 +25,7 @@ StreamFilter::Sensor& StreamFilter::sensorFor(const std::string& label) {
 
 StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
                                    const std::optional<Pose2D>& odometry) {
-    if (obs.getScanSize() == 0) throw std::invalid_argument("scan has no beams");
+    if (obs.getScanSize() == 0) throw ScanError("scan has no beams");
     StreamResult res;
     res.sensor_label = obs.sensorLabel;
     Sensor& s = sensorFor(obs.sensorLabel);

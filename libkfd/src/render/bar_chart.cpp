@@ -17,16 +17,16 @@ mrpt::img::TColor BarChart::seriesColour(std::size_t s) {
 }
 
 mrpt::img::CImage BarChart::render() const {
-    if (values.size() != groups.size()) throw std::invalid_argument("bar chart: rows != groups");
+    if (values.size() != groups.size()) throw PlotError("bar chart: rows != groups");
     double lo = 1e300, hi = -1e300;
     for (std::size_t g = 0; g < groups.size(); ++g) {
         if (values[g].size() != series.size())
-            throw std::invalid_argument("bar chart: a row has the wrong number of values");
+            throw PlotError("bar chart: a row has the wrong number of values");
         for (std::size_t s = 0; s < series.size(); ++s) {
             const double v = values[g][s];
             if (std::isnan(v)) continue;
             const double e = errors.empty() ? 0.0 : errors[g][s];
-            if (log_y && v <= 0) throw std::invalid_argument("bar chart: value <= 0 on a log axis");
+            if (log_y && v <= 0) throw PlotError("bar chart: value <= 0 on a log axis");
             lo = std::min(lo, v);
             hi = std::max(hi, v + (std::isnan(e) ? 0.0 : e));
         }
@@ -105,7 +105,7 @@ mrpt::img::CImage BarChart::render() const {
 
 BarChart readBarChartCsv(const std::string& path) {
     std::ifstream f(path);
-    if (!f) throw std::runtime_error("cannot open " + path);
+    if (!f) throw PlotError("cannot open " + path);
     BarChart c;
     std::string line;
     std::getline(f, line);  // header
@@ -127,14 +127,13 @@ BarChart readBarChartCsv(const std::string& path) {
         std::stringstream ss(line);
         std::string g, s, v, e;
         if (!std::getline(ss, g, ',') || !std::getline(ss, s, ',') || !std::getline(ss, v, ','))
-            throw std::runtime_error(path + ":" + std::to_string(lineno) +
-                                     ": expected group,series,value");
+            throw PlotError(path + ":" + std::to_string(lineno) + ": expected group,series,value");
         std::getline(ss, e, ',');
         try {
             rows.push_back({index(c.groups, g), index(c.series, s), std::stod(v),
                             e.empty() ? 0.0 : std::stod(e)});
         } catch (const std::exception&) {
-            throw std::runtime_error(path + ":" + std::to_string(lineno) + ": not a number");
+            throw PlotError(path + ":" + std::to_string(lineno) + ": not a number");
         }
     }
     c.values.assign(c.groups.size(), std::vector<double>(c.series.size(), std::nan("")));

@@ -31,7 +31,7 @@ std::pair<int, int> mapFigurePixel(const mrpt::maps::COccupancyGridMap2D& g, dou
 }
 
 mrpt::img::CImage renderMapFigure(const MapFigureInput& in) {
-    if (!in.grid) throw std::invalid_argument("map figure: no grid");
+    if (!in.grid) throw PlotError("map figure: no grid");
     const auto& g = *in.grid;
     mrpt::img::CImage img;
     g.getAsImage(img, true, true);  // +y up, RGB

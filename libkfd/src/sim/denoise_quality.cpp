@@ -10,6 +10,7 @@
 
 #include "kfd/mrpt/source.h"
 #include "kfd/mrpt/stream_filter.h"
+#include "kfd/sim/world.h"
 
 namespace kfd {
 namespace {
@@ -17,19 +18,19 @@ namespace {
 NoiseKind parseKind(const std::string& s) {
     for (auto k : {NoiseKind::Isolated, NoiseKind::Clustered, NoiseKind::Edge})
         if (s == toString(k)) return k;
-    throw std::runtime_error("unknown noise kind '" + s + "' in labels");
+    throw SimulationError("unknown noise kind '" + s + "' in labels");
 }
 
 // scan index -> (beam, kind) list
 std::map<std::size_t, std::vector<std::pair<std::size_t, NoiseKind>>> readLabels(
     const std::string& path) {
     std::ifstream f(path);
-    if (!f) throw std::runtime_error("cannot open labels " + path);
+    if (!f) throw SimulationError("cannot open labels " + path);
     std::map<std::size_t, std::vector<std::pair<std::size_t, NoiseKind>>> out;
     std::string line;
     std::getline(f, line);
     if (line != "scan,timestamp,beam,kind")
-        throw std::runtime_error(path + " is not a kfd-simulate label file");
+        throw SimulationError(path + " is not a kfd-simulate label file");
     std::size_t lineno = 1;
     while (std::getline(f, line)) {
         ++lineno;
@@ -37,7 +38,7 @@ std::map<std::size_t, std::vector<std::pair<std::size_t, NoiseKind>>> readLabels
         std::string scan, stamp, beam, kind;
         if (!std::getline(ss, scan, ',') || !std::getline(ss, stamp, ',') ||
             !std::getline(ss, beam, ',') || !std::getline(ss, kind))
-            throw std::runtime_error(path + ":" + std::to_string(lineno) + ": malformed row");
+            throw SimulationError(path + ":" + std::to_string(lineno) + ": malformed row");
         out[std::stoul(scan)].emplace_back(std::stoul(beam), parseKind(kind));
     }
     return out;
@@ -61,7 +62,7 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
         for (std::size_t i = 0; i < n; ++i) before[i] = scan->getScanRangeValidity(i);
         if (const auto it = labels.find(q.scans); it != labels.end())
             for (const auto& [beam, k] : it->second) {
-                if (beam >= n) throw std::runtime_error("labels do not fit the rawlog");
+                if (beam >= n) throw SimulationError("labels do not fit the rawlog");
                 kind[beam] = k;
             }
         const auto r = filter.process(*scan);
@@ -84,9 +85,9 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
         ++q.scans;
     };
     while (source->next(e)) e.forEachScan(score);
-    if (q.scans == 0) throw std::runtime_error("no scans in " + rawlog);
+    if (q.scans == 0) throw SimulationError("no scans in " + rawlog);
     if (!labels.empty() && labels.rbegin()->first >= q.scans)
-        throw std::runtime_error("labels refer to more scans than the rawlog holds");
+        throw SimulationError("labels refer to more scans than the rawlog holds");
     return q;
 }
 

@@ -23,11 +23,11 @@ const char* toString(NoiseKind k) {
 void NoiseInjector::initialize(const Params& p) {
     auto prob = [](double v) { return v >= 0.0 && v <= 1.0; };
     if (!prob(p.isolated_rate) || !prob(p.cluster_rate) || !prob(p.edge_rate))
-        throw std::invalid_argument("noise rates must be probabilities in [0, 1]");
+        throw ParameterError("rates", "noise rates must be probabilities in [0, 1]");
     if (p.cluster_min_beams < 1 || p.cluster_max_beams < p.cluster_min_beams)
-        throw std::invalid_argument("cluster beam counts must satisfy 1 <= min <= max");
+        throw ParameterError("cluster_beams", "cluster beam counts must satisfy 1 <= min <= max");
     if (!(p.cluster_max_range > 0.2) || !(p.edge_jump_m > 0.0) || !(p.min_range >= 0.0))
-        throw std::invalid_argument("invalid noise geometry");
+        throw ParameterError("geometry", "invalid noise geometry");
     params_ = p;
 }
 

@@ -85,7 +85,7 @@ std::vector<Pose2D> sample(const World& w, double rate, double speed, double tur
 SensorModel sensorModel(const std::string& name) {
     if (name == "mit") return SensorModel{40.0, 1081, 270.0, 0.1, 30.0, 0.01};
     if (name == "gazebo") return SensorModel{10.0, 720, 359.5, 0.1, 12.0, 0.01};
-    throw std::invalid_argument("unknown sensor '" + name + "' (known: mit, gazebo)");
+    throw SimulationError("unknown sensor '" + name + "' (known: mit, gazebo)");
 }
 
 SimulationSummary Simulator::run(const SimulationOptions& o) {

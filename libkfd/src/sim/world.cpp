@@ -96,22 +96,22 @@ std::vector<std::string> worldNames() { return {"office", "corridor"}; }
 World makeWorld(const std::string& name) {
     if (name == "office") return office();
     if (name == "corridor") return corridor();
-    throw std::invalid_argument("unknown world '" + name + "' (built-in: office, corridor)");
+    throw SimulationError("unknown world '" + name + "' (built-in: office, corridor)");
 }
 
 World loadWorld(const std::string& gridmap, const std::string& route_file) {
     World w;
     w.name = gridmap;
-    if (!std::ifstream(gridmap)) throw std::invalid_argument("cannot open gridmap " + gridmap);
+    if (!std::ifstream(gridmap)) throw SimulationError("cannot open gridmap " + gridmap);
     mrpt::io::CFileGZInputStream in;
-    if (!in.open(gridmap)) throw std::invalid_argument("cannot open gridmap " + gridmap);
+    if (!in.open(gridmap)) throw SimulationError("cannot open gridmap " + gridmap);
     try {
         mrpt::serialization::archiveFrom(in) >> w.grid;
     } catch (const std::exception& e) {
-        throw std::invalid_argument("cannot read gridmap " + gridmap);
+        throw SimulationError("cannot read gridmap " + gridmap);
     }
     std::ifstream f(route_file);
-    if (!f) throw std::invalid_argument("cannot open route file " + route_file);
+    if (!f) throw SimulationError("cannot open route file " + route_file);
     std::string line;
     std::size_t lineno = 0;
     while (std::getline(f, line)) {
@@ -121,12 +121,12 @@ World loadWorld(const std::string& gridmap, const std::string& route_file) {
         std::istringstream ss(line);
         Waypoint p;
         if (!(ss >> p.x >> p.y))
-            throw std::invalid_argument(route_file + ":" + std::to_string(lineno) +
-                                        ": expected 'x y [stop_s [spin_deg]]'");
+            throw SimulationError(route_file + ":" + std::to_string(lineno) +
+                                  ": expected 'x y [stop_s [spin_deg]]'");
         ss >> p.stop_s >> p.spin_deg;
         w.route.push_back(p);
     }
-    if (w.route.size() < 2) throw std::invalid_argument("a route needs at least two waypoints");
+    if (w.route.size() < 2) throw SimulationError("a route needs at least two waypoints");
     return w;
 }
 

@@ -33,4 +33,10 @@ class ParameterError : public Error {
         : Error(field + ": " + message, field, message) {}
 };
 
+/// A scan the library cannot process as given (no beams, buffers of different sizes).
+class ScanError : public Error {
+  public:
+    using Error::Error;
+};
+
 }  // namespace kfd

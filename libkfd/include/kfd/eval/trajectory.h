@@ -8,14 +8,15 @@
 #include <string>
 #include <vector>
 
+#include "kfd/core/error.h"
 #include "kfd/core/scan.h"
 
 namespace kfd {
 
 /// A file that cannot be read or parsed (path and line in the message).
-class EvalError : public std::runtime_error {
+class EvalError : public Error {
   public:
-    using std::runtime_error::runtime_error;
+    using Error::Error;
 };
 
 struct StampedPose {

@@ -40,7 +40,7 @@ class StreamFilter {
 
     /// Runs the pipeline on `scan`. Noise and out-of-range beams are marked invalid in place
     /// (ranges, beam count and angles are kept). `odometry` (absolute, robot frame) feeds the
-    /// motion guards. Throws std::invalid_argument for an empty scan.
+    /// motion guards. Throws kfd::ScanError for an empty scan.
     StreamResult process(mrpt::obs::CObservation2DRangeScan& scan,
                          const std::optional<Pose2D>& odometry = std::nullopt);
 

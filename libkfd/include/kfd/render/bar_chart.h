@@ -6,7 +6,16 @@
 #include <string>
 #include <vector>
 
+#include "kfd/core/error.h"
+
 namespace kfd {
+
+/// A chart or figure that cannot be drawn from its input (shapes, values), or a chart CSV that
+/// cannot be read (path and line in the message).
+class PlotError : public Error {
+  public:
+    using Error::Error;
+};
 
 struct BarChart {
     std::string title, y_label;
@@ -17,14 +26,14 @@ struct BarChart {
     bool log_y = false;
     int width = 1000, height = 500;
 
-    /// Throws std::invalid_argument when the shapes do not match or a log axis has a value <= 0.
+    /// Throws PlotError when the shapes do not match or a log axis has a value <= 0.
     mrpt::img::CImage render() const;
     /// The colour of series s (R, G, B), shared by bars and legend.
     static mrpt::img::TColor seriesColour(std::size_t s);
 };
 
 /// Reads "group,series,value[,error]" rows (header line first) into a chart, keeping first-seen
-/// order of groups and series. Throws std::runtime_error on malformed input.
+/// order of groups and series. Throws PlotError on malformed input.
 BarChart readBarChartCsv(const std::string& path);
 
 }  // namespace kfd

@@ -10,14 +10,15 @@
 #include <utility>
 
 #include "kfd/core/clusters.h"
+#include "kfd/core/error.h"
 #include "kfd/core/scan.h"
 
 namespace kfd {
 
 /// No off-screen OpenGL context could be created (e.g. OSMesa missing).
-class RenderError : public std::runtime_error {
+class RenderError : public Error {
   public:
-    using std::runtime_error::runtime_error;
+    using Error::Error;
 };
 
 struct ClusterFigureOptions {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "kfd/eval/trajectory.h"
+#include "kfd/render/bar_chart.h"  // PlotError
 
 namespace kfd {
 
@@ -23,7 +24,7 @@ struct MapFigureInput {
 
 /// Draws with MRPT's 2D canvas (no OpenGL): the grid (+y up), the odometry (grey), the ground
 /// truth (green) and the estimate (blue) with keyframes as small dots, a legend, the title and a
-/// 1 m scale bar. Throws std::invalid_argument without a grid.
+/// 1 m scale bar. Throws PlotError without a grid.
 mrpt::img::CImage renderMapFigure(const MapFigureInput& in);
 
 /// The pixel (column, row from the top) of map point (x, y) in renderMapFigure's image.

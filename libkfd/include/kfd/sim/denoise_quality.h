@@ -42,7 +42,7 @@ struct DenoiseQuality {
 /// Runs every scan of a simulated rawlog through `pipeline` (normally without the keyframe
 /// stage, so every scan is denoised) and scores the removed beams against the labels CSV
 /// written by kfd-simulate. A dropped scan counts as removing nothing. Throws
-/// std::runtime_error on unreadable files or labels that do not fit the rawlog.
+/// SimulationError on unreadable files or labels that do not fit the rawlog.
 DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& labels_csv,
                                  const Pipeline::Params& pipeline);
 

@@ -5,6 +5,7 @@
 #include <random>
 #include <vector>
 
+#include "kfd/core/error.h"
 #include "kfd/core/scan.h"
 
 namespace kfd {
@@ -33,7 +34,7 @@ class NoiseInjector {
 
     NoiseInjector() = default;
     explicit NoiseInjector(const Params& p) { initialize(p); }
-    void initialize(const Params& p);  // std::invalid_argument on bad rates
+    void initialize(const Params& p);  // kfd::ParameterError on bad rates
     const Params& params() const { return params_; }
 
     /// Modifies `scan` ranges (and validity for new returns) and writes one label per beam.

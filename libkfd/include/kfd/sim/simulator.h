@@ -47,12 +47,6 @@ struct SimulationSummary {
     std::string rawlog, ground_truth, odometry, labels;
 };
 
-/// Bad options or unwritable output.
-class SimulationError : public std::runtime_error {
-  public:
-    using std::runtime_error::runtime_error;
-};
-
 /// Simulates the route at the sensor rate: ground-truth poses, ray-cast scans
 /// (COccupancyGridMap2D::laserScanSimulator), labelled outliers (NoiseInjector), and drifting
 /// odometry. Writes an observations-only rawlog (one CObservation2DRangeScan "LASER" and one

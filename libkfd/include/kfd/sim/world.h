@@ -6,7 +6,15 @@
 #include <string>
 #include <vector>
 
+#include "kfd/core/error.h"
+
 namespace kfd {
+
+/// Bad simulation options, an unreadable world or route file, or unwritable output.
+class SimulationError : public Error {
+  public:
+    using Error::Error;
+};
 
 /// A point of the route. The robot turns in place to face the next waypoint, drives there in a
 /// straight line, then stops for stop_s seconds and turns spin_deg in place (both optional).
