@@ -6,17 +6,22 @@
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
+#include <limits>
 #include <map>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "kfd/core/clusters.h"
 #include "kfd/core/error.h"
 #include "kfd/core/scan.h"
 
 namespace kfd {
 namespace test {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 inline double deg2rad(double deg) { return deg * kPi / 180.0; }
 
@@ -78,6 +83,10 @@ inline Scan flatWall(std::size_t beams, double aperture, double d) {
     return s;
 }
 
+/// A scan whose beams all point straight ahead (aperture 0): beam i is the point (range_i, 0)
+/// exactly, so distances between points (and their means) are exact differences of ranges.
+inline Scan line(const std::vector<float>& ranges) { return makeScan(ranges, 0.0); }
+
 /// A scan in which no beam returned anything (all invalid, ranges 0): draw on it with setRange.
 inline Scan emptyScan(std::size_t beams, double aperture) {
     Scan s = arc(beams, aperture, 0.0);
@@ -115,6 +124,52 @@ inline void invalidate(Scan& s, std::size_t first, std::size_t last) {
     for (std::size_t i = first; i <= last; ++i) s.valid[i] = 0;
 }
 
+/// A wall at 3 m over 90 degrees (181 beams, see flatWall) with isolated outliers: beams 20 and
+/// 150 at 8 m (behind the wall) and beam 90 at 1 m (in front of it).
+inline Scan wallWithOutliers() {
+    Scan s = flatWall(181, deg2rad(90.0), 3.0);
+    insertOutliers(s, {20, 150}, 8.0);
+    insertSpike(s, 90, 1.0);
+    return s;
+}
+
+/// A wall 4 m ahead over -60..60 deg (181 beams over 180 deg) with isolated outliers at 1 m on
+/// beams 50, 100 and 130, an out-of-range beam (60, 45 m) and a NaN beam (61), stamped 100 s
+/// and without odometry.
+inline Scan noisyWall() {
+    Scan scan = emptyScan(181, kPi);
+    setWall(scan, 30, 150, 4.0);
+    insertOutliers(scan, {50, 100, 130}, 1.0);
+    scan.range[60] = 45.0f;
+    scan.range[61] = std::numeric_limits<float>::quiet_NaN();
+    scan.timestamp = 100.0;
+    return scan;
+}
+
+/// A 360-degree scan (aperture `aperture`) with one object at 3 m across the seam (the last
+/// ten and the first ten beams) and another at 3 m on beams 100-150.
+inline Scan seamObjectScan(std::size_t beams, double aperture) {
+    Scan scan = emptyScan(beams, aperture);
+    setRange(scan, beams - 10, beams - 1, 3.0);
+    setRange(scan, 0, 9, 3.0);
+    setRange(scan, 100, 150, 3.0);
+    return scan;
+}
+
+/// A 360-degree scanner (see fullCircleAperture) seeing two objects at 3 m on either side of
+/// the seam, beams N-20..N-7 and 6..20: 13 beams apart across the seam.
+inline Scan seamGapScan(std::size_t beams) {
+    Scan scan = emptyScan(beams, fullCircleAperture(beams));
+    setRange(scan, beams - 20, beams - 7, 3.0);
+    setRange(scan, 6, 20, 3.0);
+    return scan;
+}
+
+/// True when beams a and b are in the same cluster (noise is in none).
+inline bool sameCluster(const Clusters& c, std::size_t a, std::size_t b) {
+    return c.label[a] >= 0 && c.label[a] == c.label[b];
+}
+
 /// Random scan made of pieces: runs of invalid beams, smooth surfaces (linear in range),
 /// noisy surfaces and one-beam spikes, ranges in [0.2, 12] m. Deterministic for a seeded rng.
 inline Scan randomScan(std::mt19937& rng, std::size_t beams, double aperture) {
@@ -143,6 +198,74 @@ inline Scan randomScan(std::mt19937& rng, std::size_t beams, double aperture) {
         i += n;
     }
     return s;
+}
+
+/// One of the apertures the random comparisons use (90, 180 or 270 deg, or a full circle of
+/// `beams` beams), drawn from rng.
+inline double randomAperture(std::mt19937& rng, std::size_t beams) {
+    const double apertures[] = {deg2rad(90.0), kPi, deg2rad(270.0), fullCircleAperture(beams)};
+    return apertures[std::uniform_int_distribution<int>(0, 3)(rng)];
+}
+
+/// Two random scans drawn one after the other from an rng seeded 11: a large 360-degree one
+/// (720 beams) and a small 180-degree one (90 beams). For the tests that a filter run on the
+/// large scan leaves nothing behind for the small one.
+struct LargeThenSmall {
+    Scan large, small;
+};
+inline LargeThenSmall largeThenSmallScans() {
+    std::mt19937 rng(11);
+    LargeThenSmall s;
+    s.large = randomScan(rng, 720, fullCircleAperture(720));
+    s.small = randomScan(rng, 90, deg2rad(180.0));
+    return s;
+}
+
+/// Makes two beams valid without a position: beam N/3 NaN and beam N/2 +inf.
+inline void addBeamsWithoutPosition(Scan& s) {
+    s.range[s.size() / 3] = std::numeric_limits<float>::quiet_NaN();
+    s.valid[s.size() / 3] = 1;
+    s.range[s.size() / 2] = std::numeric_limits<float>::infinity();
+    s.valid[s.size() / 2] = 1;
+}
+
+/// The valid beams with a finite range as Cartesian points, converted as the baseline filters
+/// do (double trigonometry, then float), so that distances compare identically.
+struct Points {
+    std::vector<float> x, y;
+    std::vector<std::size_t> beam;
+    std::size_t size() const { return x.size(); }
+};
+
+inline Points cartesian(const Scan& s) {
+    Points p;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        if (!s.valid[i] || !std::isfinite(s.range[i])) continue;
+        const double a = s.geometry.angle(i);
+        p.x.push_back(static_cast<float>(s.range[i] * std::cos(a)));
+        p.y.push_back(static_cast<float>(s.range[i] * std::sin(a)));
+        p.beam.push_back(i);
+    }
+    return p;
+}
+
+/// The valid flags once the valid beams without a finite range (no position) are removed.
+inline std::vector<std::uint8_t> withPosition(const Scan& s) {
+    std::vector<std::uint8_t> v = s.valid;
+    for (std::size_t i = 0; i < s.size(); ++i)
+        if (!std::isfinite(s.range[i])) v[i] = 0;
+    return v;
+}
+
+/// Squared distances (float) from point i to every other point, in index order.
+inline std::vector<float> squaredDistancesFrom(const Points& p, std::size_t i) {
+    std::vector<float> d2;
+    for (std::size_t j = 0; j < p.size(); ++j) {
+        if (j == i) continue;
+        const float dx = p.x[j] - p.x[i], dy = p.y[j] - p.y[i];
+        d2.push_back(dx * dx + dy * dy);
+    }
+    return d2;
 }
 
 /// True when two labellings (-1 = none) describe the same partition, whatever the label values.

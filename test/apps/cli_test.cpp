@@ -8,13 +8,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "common/cli.h"
+#include "test_files.h"
 
 namespace {
 
@@ -161,10 +160,7 @@ struct Result {
     std::string out, err;
 };
 
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p);
-    return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-}
+std::string slurp(const fs::path& p) { return kfd::test::fileBytes(p.string()); }
 
 /// Runs `exe args` through the shell, stdout and stderr kept apart.
 Result runApp(const std::string& exe, const std::string& args) {

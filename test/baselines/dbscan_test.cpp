@@ -19,8 +19,8 @@
 namespace kfd {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using test::kInf;
+using test::kNaN;
 
 DbscanFilter::Params params(double eps_m, std::size_t min_pts) {
     DbscanFilter::Params p;
@@ -89,10 +89,8 @@ TEST(DbscanFilter, DenseWallStays) {
 
 TEST(DbscanFilter, IsolatedOutliersAreRemoved) {
     DbscanFilter f;
-    Scan scan = test::flatWall(181, test::deg2rad(90.0), 3.0);
-    test::insertOutliers(scan, {20, 150}, 8.0);  // behind the wall
-    test::insertSpike(scan, 90, 1.0);            // in front of it
-    test::insertOutliers(scan, {60, 61}, 9.0);   // a pair is still noise
+    Scan scan = test::wallWithOutliers();       // outliers at beams 20, 150 (behind), 90 (in front)
+    test::insertOutliers(scan, {60, 61}, 9.0);  // a pair is still noise
     const Scan input = scan;
     const auto r = f.filter(scan);
     EXPECT_EQ(r.points_in, 181u);
@@ -266,9 +264,7 @@ TEST(DbscanFilter, EmptyScans) {
 
 TEST(DbscanFilter, LabelsDescribeTheLastScan) {
     DbscanFilter f(params(0.5, 4));
-    std::mt19937 rng(11);
-    Scan big = test::randomScan(rng, 720, 2.0 * kPi * 719.0 / 720.0);
-    Scan small = test::randomScan(rng, 90, test::deg2rad(180.0));
+    auto [big, small] = test::largeThenSmallScans();
     Scan smallCopy = small;
     f.filter(big);
     const auto r = f.filter(small);
@@ -284,24 +280,10 @@ TEST(DbscanFilter, LabelsDescribeTheLastScan) {
 
 // --- Against a plain O(n^2) DBSCAN ----------------------------------------------------------
 
-/// The valid beams as Cartesian points, converted exactly as DbscanFilter does (double
-/// trigonometry, then float), so that distances at Eps compare identically.
-struct Points {
-    std::vector<float> x, y;
-    std::vector<std::size_t> beam;
-};
-
-Points cartesian(const Scan& s) {
-    Points p;
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        if (!s.valid[i]) continue;
-        const double a = s.geometry.angle(i);
-        p.x.push_back(static_cast<float>(s.range[i] * std::cos(a)));
-        p.y.push_back(static_cast<float>(s.range[i] * std::sin(a)));
-        p.beam.push_back(i);
-    }
-    return p;
-}
+// The valid beams as Cartesian points, converted exactly as DbscanFilter does, so that
+// distances at Eps compare identically.
+using test::cartesian;
+using test::Points;
 
 /// Textbook DBSCAN by exhaustive search. N(p) = {q : |p - q| <= Eps}, p itself included (in
 /// float, squared distance against Eps^2 as KdTree2D does); p is core when |N(p)| >= minPts;
@@ -441,9 +423,7 @@ TEST(DbscanFilter, MatchesPlainDbscanOnRandomScans) {
     for (int seed = 1; seed <= kScans; ++seed) {
         std::mt19937 rng(static_cast<unsigned>(seed));
         const std::size_t beams = std::uniform_int_distribution<std::size_t>(20, 720)(rng);
-        const double apertures[] = {test::deg2rad(90.0), kPi, test::deg2rad(270.0),
-                                    test::fullCircleAperture(beams)};
-        const double aperture = apertures[std::uniform_int_distribution<int>(0, 3)(rng)];
+        const double aperture = test::randomAperture(rng, beams);
         DbscanFilter::Params p;  // every fourth scan with the paper's parameters
         if (seed % 4 != 0) {
             p.eps_m = std::uniform_real_distribution<double>(0.05, 1.5)(rng);
@@ -475,10 +455,7 @@ TEST(DbscanFilter, ValidBeamsWithoutAFiniteRangeAreNoise) {
     // Without the distance stage in front, a NaN or inf range flagged valid has no position;
     // it is removed instead of entering the k-d tree.
     Scan scan = test::emptyScan(181, kPi);
-    for (std::size_t i = 40; i <= 140; ++i) {
-        scan.range[i] = 2.0f;
-        scan.valid[i] = 1;
-    }
+    test::setRange(scan, 40, 140, 2.0);
     scan.range[90] = std::numeric_limits<float>::quiet_NaN();
     scan.range[91] = std::numeric_limits<float>::infinity();
     DbscanFilter f;

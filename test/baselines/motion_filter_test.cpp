@@ -17,8 +17,8 @@
 namespace kfd {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using test::kInf;
+using test::kNaN;
 
 MotionFilter::Params params(double distance_m, double angle_deg, double interval_s) {
     MotionFilter::Params p;
@@ -258,14 +258,6 @@ TEST(MotionFilter, InvalidParamsThrow) {
 
 // --- The baseline stages in the pipeline -----------------------------------------------------
 
-/// A wall at 3 m over 90 degrees (181 beams) with isolated outliers at beams 20, 90 and 150.
-Scan wallWithOutliers() {
-    Scan s = test::flatWall(181, test::deg2rad(90.0), 3.0);
-    test::insertOutliers(s, {20, 150}, 8.0);
-    test::insertSpike(s, 90, 1.0);
-    return s;
-}
-
 TEST(PipelineBaselineStages, MotionStageDropsScans) {
     Pipeline::Params p;
     p.stages = {"motion"};
@@ -311,14 +303,14 @@ TEST(PipelineBaselineStages, MotionDropStopsTheChain) {
     p.stages = {"motion", "dbscan"};
     Pipeline pipe(p, test::allStages());
 
-    Scan first = wallWithOutliers();
+    Scan first = test::wallWithOutliers();
     first.odometry = Pose2D{0.0, 0.0, 0.0};
     auto r = pipe.process(first);
     EXPECT_TRUE(r.keep);
     EXPECT_EQ(r.findOrDefault<kfd::DbscanFilter::Result>().points_in, 181u);
     EXPECT_EQ(r.findOrDefault<kfd::DbscanFilter::Result>().points_removed, 3u);
 
-    Scan second = wallWithOutliers();
+    Scan second = test::wallWithOutliers();
     second.odometry = Pose2D{0.01, 0.0, 0.0};
     r = pipe.process(second);
     EXPECT_FALSE(r.keep);
@@ -334,7 +326,7 @@ TEST(PipelineBaselineStages, DbscanStageRemovesNoise) {
     Pipeline::Params p;
     p.stages = {"dbscan"};  // the paper's Eps 0.7 m, minPts 10
     Pipeline pipe(p, test::allStages());
-    Scan scan = wallWithOutliers();
+    Scan scan = test::wallWithOutliers();
     const auto r = pipe.process(scan);
     EXPECT_TRUE(r.keep);
     EXPECT_EQ(r.dropped_by, "");

@@ -157,6 +157,26 @@ Cloud randomCloud(std::mt19937& rng, int kind, std::size_t n) {
     return c;
 }
 
+/// A random cloud (see randomCloud), built into the tree.
+Cloud buildRandomCloud(NeighbourSearch2D& t, std::mt19937& rng, int kind, std::size_t n) {
+    Cloud c = randomCloud(rng, kind, n);
+    t.build(c.x.data(), c.y.data(), c.size());
+    return c;
+}
+
+/// Names a random point set in failure messages.
+std::string setName(unsigned seed, int kind, std::size_t n) {
+    return "seed " + std::to_string(seed) + " kind " + std::to_string(kind) + " n " +
+           std::to_string(n);
+}
+
+/// The first n points of a cloud.
+Cloud prefixOf(const Cloud& c, std::size_t n) {
+    Cloud p;
+    for (std::size_t i = 0; i < n; ++i) p.add(c.x[i], c.y[i]);
+    return p;
+}
+
 std::vector<std::vector<float>> randomQueries(std::mt19937& rng, const Cloud& c) {
     std::uniform_real_distribution<float> u(-12.0f, 12.0f);
     std::uniform_real_distribution<float> radius(0.0f, 8.0f);
@@ -186,10 +206,8 @@ TEST(NeighbourSearch2D, MatchesBruteForceOnRandomSets) {
         std::mt19937 rng(seed);
         for (int kind = 0; kind <= 6; ++kind) {
             for (const std::size_t n : sizes) {
-                const Cloud c = randomCloud(rng, kind, n);
-                t.build(c.x.data(), c.y.data(), c.size());
-                const std::string what = "seed " + std::to_string(seed) + " kind " +
-                                         std::to_string(kind) + " n " + std::to_string(n);
+                const Cloud c = buildRandomCloud(t, rng, kind, n);
+                const std::string what = setName(seed, kind, n);
                 nonEmpty += compareQueries(t, c, randomQueries(rng, c), what);
                 ++sets;
                 if (HasFailure()) return;
@@ -246,8 +264,7 @@ TEST(NeighbourSearch2D, RebuildWithFewerPointsReusesObject) {
 
     // Fewer points of the same arrays: no index >= n may come back.
     t.build(big.x.data(), big.y.data(), 10);
-    Cloud prefix;
-    for (std::size_t i = 0; i < 10; ++i) prefix.add(big.x[i], big.y[i]);
+    const Cloud prefix = prefixOf(big, 10);
     ASSERT_EQ(query(t, 0.0f, 0.0f, 100.0f), (Indices{0, 1, 2, 3, 4, 5, 6, 7, 8, 9}));
     compareQueries(t, prefix, randomQueries(rng, prefix), "prefix of the old arrays");
 
@@ -394,10 +411,8 @@ TEST(NeighbourSearch2DKnn, MatchesBruteForceOnRandomSets) {
         std::mt19937 rng(1000 + seed);
         for (int kind = 0; kind <= 6; ++kind) {
             for (const std::size_t n : sizes) {
-                const Cloud c = randomCloud(rng, kind, n);
-                t.build(c.x.data(), c.y.data(), c.size());
-                const std::string what = "seed " + std::to_string(seed) + " kind " +
-                                         std::to_string(kind) + " n " + std::to_string(n);
+                const Cloud c = buildRandomCloud(t, rng, kind, n);
+                const std::string what = setName(seed, kind, n);
                 std::vector<std::size_t> ks{0, 1, 2, 3, 5, 8, 9, 17};
                 if (n <= 64) ks.insert(ks.end(), {n - 1, n, n + 3});  // k near and above n
                 compareKnn(t, c, randomQueries(rng, c), ks, what, ties);
@@ -423,8 +438,7 @@ TEST(NeighbourSearch2DKnn, ReusedOutputAndRebuiltTree) {
     // answer must not leak into the new one.
     t.build(big.x.data(), big.y.data(), 6);
     t.knn(0.0f, 0.0f, 40, idx, d2);
-    Cloud prefix;
-    for (std::size_t i = 0; i < 6; ++i) prefix.add(big.x[i], big.y[i]);
+    const Cloud prefix = prefixOf(big, 6);
     const Knn want = bruteKnn(prefix, 0.0f, 0.0f, 40);
     EXPECT_EQ(idx, want.idx);
     EXPECT_EQ(d2, want.dist2);

@@ -19,8 +19,8 @@
 namespace kfd {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using test::kInf;
+using test::kNaN;
 
 RadiusOutlierFilter::Params params(double radius_m, std::size_t min_neighbors) {
     RadiusOutlierFilter::Params p;
@@ -29,10 +29,8 @@ RadiusOutlierFilter::Params params(double radius_m, std::size_t min_neighbors) {
     return p;
 }
 
-/// A scan whose beams all point straight ahead (aperture 0): beam i is the point (range_i, 0)
-/// exactly, so distances between points are exact differences of ranges. Lets the tests put
-/// points exactly at the radius.
-Scan line(const std::vector<float>& ranges) { return test::makeScan(ranges, 0.0); }
+// test::line: points on one line, so that the tests can put points exactly at the radius.
+using test::line;
 
 std::string whatOf(const RadiusOutlierFilter::Params& p) {
     return test::constructionError<RadiusOutlierFilter>(p);
@@ -80,11 +78,9 @@ TEST(RadiusOutlierFilter, DenseWallStays) {
 
 TEST(RadiusOutlierFilter, IsolatedOutliersAreRemoved) {
     RadiusOutlierFilter f;
-    Scan scan = test::flatWall(181, test::deg2rad(90.0), 3.0);
-    test::insertOutliers(scan, {20, 150}, 8.0);  // behind the wall
-    test::insertSpike(scan, 90, 1.0);            // in front of it
-    test::insertOutliers(scan, {60, 61}, 9.0);   // a pair: one neighbour each
-    test::setRange(scan, 110, 113, 9.0);         // four 7.9 cm apart: 3 others each, kept
+    Scan scan = test::wallWithOutliers();       // outliers at beams 20, 150 (behind), 90 (in front)
+    test::insertOutliers(scan, {60, 61}, 9.0);  // a pair: one neighbour each
+    test::setRange(scan, 110, 113, 9.0);        // four 7.9 cm apart: 3 others each, kept
     const Scan input = scan;
     const auto r = f.filter(scan);
     EXPECT_EQ(r.points_in, 181u);
@@ -175,9 +171,7 @@ TEST(RadiusOutlierFilter, EmptyScans) {
 
 TEST(RadiusOutlierFilter, BuffersFromALargerScanDoNotLeak) {
     RadiusOutlierFilter f(params(0.4, 3));
-    std::mt19937 rng(11);
-    Scan big = test::randomScan(rng, 720, test::fullCircleAperture(720));
-    Scan small = test::randomScan(rng, 90, test::deg2rad(180.0));
+    auto [big, small] = test::largeThenSmallScans();
     Scan smallCopy = small;
     f.filter(big);
     const auto r = f.filter(small);
@@ -190,13 +184,6 @@ TEST(RadiusOutlierFilter, BuffersFromALargerScanDoNotLeak) {
 
 // --- As a pipeline stage --------------------------------------------------------------------
 
-Scan wallWithOutliers() {
-    Scan scan = test::flatWall(181, test::deg2rad(90.0), 3.0);
-    test::insertOutliers(scan, {20, 150}, 8.0);
-    test::insertSpike(scan, 90, 1.0);
-    return scan;
-}
-
 TEST(RadiusOutlierFilter, PipelineStage) {
     Pipeline::Params p;
     p.stages = {"distance", "radius"};
@@ -204,7 +191,7 @@ TEST(RadiusOutlierFilter, PipelineStage) {
     Pipeline pipe(p, test::allStages());
     ASSERT_EQ(pipe.stages().size(), 2u);
     EXPECT_STREQ(pipe.stages()[1]->name(), "radius");
-    Scan scan = wallWithOutliers();
+    Scan scan = test::wallWithOutliers();
     auto r = pipe.process(scan);
     EXPECT_TRUE(r.keep);
     EXPECT_EQ(r.dropped_by, "");
@@ -222,7 +209,7 @@ TEST(RadiusOutlierFilter, PipelineStage) {
     // without neighbours.
     p.get<kfd::RadiusStage>() = params(0.01, 1);
     pipe.initialize(p);
-    scan = wallWithOutliers();
+    scan = test::wallWithOutliers();
     r = pipe.process(scan);
     EXPECT_EQ(r.findOrDefault<kfd::RadiusOutlierFilter::Result>().points_removed, 179u);
     EXPECT_EQ(r.points_out, 0u);
@@ -230,7 +217,7 @@ TEST(RadiusOutlierFilter, PipelineStage) {
     // Without the stage nothing is reported.
     p.stages = {"distance"};
     pipe.initialize(p);
-    scan = wallWithOutliers();
+    scan = test::wallWithOutliers();
     r = pipe.process(scan);
     EXPECT_EQ(r.findOrDefault<kfd::RadiusOutlierFilter::Result>().points_in, 0u);
     EXPECT_EQ(r.points_out, 179u);
@@ -265,30 +252,14 @@ TEST(RadiusOutlierFilter, PipelineValidatesTheStageEvenWhenUnlisted) {
 /// valid flags.
 std::vector<std::uint8_t> plainRadiusOutlier(const Scan& s, double radius_m,
                                              std::size_t min_neighbors) {
-    std::vector<float> x, y;
-    std::vector<std::size_t> beam;
-    std::vector<std::uint8_t> out = s.valid;
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        if (!s.valid[i]) continue;
-        if (!std::isfinite(s.range[i])) {
-            out[i] = 0;
-            continue;
-        }
-        const double a = s.geometry.angle(i);
-        x.push_back(static_cast<float>(s.range[i] * std::cos(a)));
-        y.push_back(static_cast<float>(s.range[i] * std::sin(a)));
-        beam.push_back(i);
-    }
+    const test::Points p = test::cartesian(s);
+    std::vector<std::uint8_t> out = test::withPosition(s);
     const float r = static_cast<float>(radius_m);
     const float r2 = r * r;
-    for (std::size_t i = 0; i < x.size(); ++i) {
+    for (std::size_t i = 0; i < p.size(); ++i) {
         std::size_t others = 0;
-        for (std::size_t j = 0; j < x.size(); ++j) {
-            if (j == i) continue;
-            const float dx = x[j] - x[i], dy = y[j] - y[i];
-            others += dx * dx + dy * dy <= r2;
-        }
-        if (others < min_neighbors) out[beam[i]] = 0;
+        for (const float d2 : test::squaredDistancesFrom(p, i)) others += d2 <= r2;
+        if (others < min_neighbors) out[p.beam[i]] = 0;
     }
     return out;
 }
@@ -307,9 +278,7 @@ TEST(RadiusOutlierFilter, MatchesPlainImplementationOnRandomScans) {
     for (int seed = 1; seed <= kScans; ++seed) {
         std::mt19937 rng(static_cast<unsigned>(seed));
         const std::size_t beams = std::uniform_int_distribution<std::size_t>(20, 720)(rng);
-        const double apertures[] = {test::deg2rad(90.0), kPi, test::deg2rad(270.0),
-                                    test::fullCircleAperture(beams)};
-        const double aperture = apertures[std::uniform_int_distribution<int>(0, 3)(rng)];
+        const double aperture = test::randomAperture(rng, beams);
         RadiusOutlierFilter::Params p;  // every fourth scan with the defaults
         if (seed % 4 != 0) {
             p.radius_m = std::uniform_real_distribution<double>(0.02, 1.2)(rng);
@@ -317,12 +286,7 @@ TEST(RadiusOutlierFilter, MatchesPlainImplementationOnRandomScans) {
         }
         f.initialize(p);
         Scan input = test::randomScan(rng, beams, aperture);
-        if (seed % 5 == 0) {  // a few valid beams without a position
-            input.range[beams / 3] = std::numeric_limits<float>::quiet_NaN();
-            input.valid[beams / 3] = 1;
-            input.range[beams / 2] = std::numeric_limits<float>::infinity();
-            input.valid[beams / 2] = 1;
-        }
+        if (seed % 5 == 0) test::addBeamsWithoutPosition(input);  // valid, without a position
         Scan output = input;
         const auto res = f.filter(output);
         const auto expected = plainRadiusOutlier(input, p.radius_m, p.min_neighbors);

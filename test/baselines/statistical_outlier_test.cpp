@@ -21,8 +21,8 @@
 namespace kfd {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using test::kInf;
+using test::kNaN;
 
 StatisticalOutlierFilter::Params params(std::size_t k, double std_mul) {
     StatisticalOutlierFilter::Params p;
@@ -31,9 +31,9 @@ StatisticalOutlierFilter::Params params(std::size_t k, double std_mul) {
     return p;
 }
 
-/// A scan whose beams all point straight ahead (aperture 0): beam i is the point (range_i, 0)
-/// exactly, so distances, their means and the statistics below are exact in binary.
-Scan line(const std::vector<float>& ranges) { return test::makeScan(ranges, 0.0); }
+// test::line: points on one line, so that distances, their means and the statistics below are
+// exact in binary.
+using test::line;
 
 std::string whatOf(const StatisticalOutlierFilter::Params& p) {
     return test::constructionError<StatisticalOutlierFilter>(p);
@@ -71,11 +71,9 @@ TEST(StatisticalOutlierFilter, InvalidParamsThrowNamingTheKey) {
 // --- Hand-made scans ------------------------------------------------------------------------
 
 TEST(StatisticalOutlierFilter, WallKeptIsolatedOutliersRemoved) {
-    StatisticalOutlierFilter f;  // k 8, 1 sigma
-    Scan scan = test::flatWall(181, test::deg2rad(90.0), 3.0);
-    test::insertOutliers(scan, {20, 150}, 8.0);  // behind the wall
-    test::insertSpike(scan, 90, 1.0);            // in front of it
-    test::insertOutliers(scan, {60, 61}, 9.0);   // a pair: one near neighbour of 8
+    StatisticalOutlierFilter f;                 // k 8, 1 sigma
+    Scan scan = test::wallWithOutliers();       // outliers at beams 20, 150 (behind), 90 (in front)
+    test::insertOutliers(scan, {60, 61}, 9.0);  // a pair: one near neighbour of 8
     const Scan input = scan;
     const auto r = f.filter(scan);
     EXPECT_EQ(r.points_in, 181u);
@@ -223,9 +221,7 @@ TEST(StatisticalOutlierFilter, InvalidAndNonFiniteBeams) {
 
 TEST(StatisticalOutlierFilter, BuffersFromALargerScanDoNotLeak) {
     StatisticalOutlierFilter f(params(6, 0.5));
-    std::mt19937 rng(11);
-    Scan big = test::randomScan(rng, 720, test::fullCircleAperture(720));
-    Scan small = test::randomScan(rng, 90, test::deg2rad(180.0));
+    auto [big, small] = test::largeThenSmallScans();
     Scan smallCopy = small;
     f.filter(big);
     const auto r = f.filter(small);
@@ -244,20 +240,13 @@ TEST(StatisticalOutlierFilter, BuffersFromALargerScanDoNotLeak) {
 
 // --- As a pipeline stage --------------------------------------------------------------------
 
-Scan wallWithOutliers() {
-    Scan scan = test::flatWall(181, test::deg2rad(90.0), 3.0);
-    test::insertOutliers(scan, {20, 150}, 8.0);
-    test::insertSpike(scan, 90, 1.0);
-    return scan;
-}
-
 TEST(StatisticalOutlierFilter, PipelineStage) {
     Pipeline::Params p;
     p.stages = {"distance", "sor"};
     Pipeline pipe(p, test::allStages());
     ASSERT_EQ(pipe.stages().size(), 2u);
     EXPECT_STREQ(pipe.stages()[1]->name(), "sor");
-    Scan scan = wallWithOutliers();
+    Scan scan = test::wallWithOutliers();
     auto r = pipe.process(scan);
     EXPECT_TRUE(r.keep);
     EXPECT_EQ(r.dropped_by, "");
@@ -279,13 +268,13 @@ TEST(StatisticalOutlierFilter, PipelineStage) {
     p.get<kfd::DistanceStage>().max_range = 5.0;
     p.get<kfd::SorStage>() = params(8, 20.0);
     pipe.initialize(p);
-    scan = wallWithOutliers();
+    scan = test::wallWithOutliers();
     r = pipe.process(scan);
     EXPECT_EQ(r.findOrDefault<kfd::StatisticalOutlierFilter::Result>().points_in, 179u);
     EXPECT_EQ(r.findOrDefault<kfd::StatisticalOutlierFilter::Result>().points_removed, 0u);
     p.get<kfd::SorStage>() = params(8, 1.0);
     pipe.initialize(p);
-    scan = wallWithOutliers();
+    scan = test::wallWithOutliers();
     r = pipe.process(scan);
     EXPECT_EQ(r.findOrDefault<kfd::StatisticalOutlierFilter::Result>().points_removed, 1u);
     EXPECT_EQ(scan.valid[90], 0);
@@ -293,7 +282,7 @@ TEST(StatisticalOutlierFilter, PipelineStage) {
     // Without the stage nothing is reported.
     p.stages = {"distance"};
     pipe.initialize(p);
-    scan = wallWithOutliers();
+    scan = test::wallWithOutliers();
     r = pipe.process(scan);
     EXPECT_EQ(r.findOrDefault<kfd::StatisticalOutlierFilter::Result>().points_in, 0u);
     EXPECT_EQ(r.points_out, 179u);
@@ -327,32 +316,14 @@ struct Expected {
 /// smallest (in increasing order) over their count, mu and sample sigma in beam order.
 Expected plainStatisticalOutlier(const Scan& s, std::size_t k, double std_mul) {
     Expected e;
-    e.valid = s.valid;
+    e.valid = test::withPosition(s);
     e.mean.assign(s.size(), kNaN);
-    std::vector<float> x, y;
-    std::vector<std::size_t> beam;
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        if (!s.valid[i]) continue;
-        if (!std::isfinite(s.range[i])) {
-            e.valid[i] = 0;
-            continue;
-        }
-        const double a = s.geometry.angle(i);
-        x.push_back(static_cast<float>(s.range[i] * std::cos(a)));
-        y.push_back(static_cast<float>(s.range[i] * std::sin(a)));
-        beam.push_back(i);
-    }
-    const std::size_t m = x.size();
+    const test::Points p = test::cartesian(s);
+    const std::size_t m = p.size();
     if (m < 2) return e;
     std::vector<double> d(m);
-    std::vector<float> d2;
     for (std::size_t i = 0; i < m; ++i) {
-        d2.clear();
-        for (std::size_t j = 0; j < m; ++j) {
-            if (j == i) continue;
-            const float dx = x[j] - x[i], dy = y[j] - y[i];
-            d2.push_back(dx * dx + dy * dy);
-        }
+        std::vector<float> d2 = test::squaredDistancesFrom(p, i);
         const std::size_t used = std::min(k, d2.size());
         std::partial_sort(d2.begin(), d2.begin() + static_cast<std::ptrdiff_t>(used), d2.end());
         double sum = 0.0;
@@ -367,8 +338,8 @@ Expected plainStatisticalOutlier(const Scan& s, std::size_t k, double std_mul) {
     e.sigma = std::sqrt(sq / static_cast<double>(m - 1));
     e.threshold = e.mu + std_mul * e.sigma;
     for (std::size_t i = 0; i < m; ++i) {
-        e.mean[beam[i]] = d[i];
-        if (d[i] > e.threshold) e.valid[beam[i]] = 0;
+        e.mean[p.beam[i]] = d[i];
+        if (d[i] > e.threshold) e.valid[p.beam[i]] = 0;
     }
     return e;
 }
@@ -389,9 +360,7 @@ TEST(StatisticalOutlierFilter, MatchesPlainImplementationOnRandomScans) {
     for (int seed = 1; seed <= kScans; ++seed) {
         std::mt19937 rng(static_cast<unsigned>(seed));
         const std::size_t beams = std::uniform_int_distribution<std::size_t>(2, 720)(rng);
-        const double apertures[] = {test::deg2rad(90.0), kPi, test::deg2rad(270.0),
-                                    test::fullCircleAperture(beams)};
-        const double aperture = apertures[std::uniform_int_distribution<int>(0, 3)(rng)];
+        const double aperture = test::randomAperture(rng, beams);
         StatisticalOutlierFilter::Params p;  // every fourth scan with the defaults
         if (seed % 4 != 0) {
             p.k = std::uniform_int_distribution<std::size_t>(1, 24)(rng);
@@ -399,12 +368,7 @@ TEST(StatisticalOutlierFilter, MatchesPlainImplementationOnRandomScans) {
         }
         f.initialize(p);
         Scan input = test::randomScan(rng, beams, aperture);
-        if (seed % 5 == 0) {  // a few valid beams without a position
-            input.range[beams / 3] = std::numeric_limits<float>::quiet_NaN();
-            input.valid[beams / 3] = 1;
-            input.range[beams / 2] = std::numeric_limits<float>::infinity();
-            input.valid[beams / 2] = 1;
-        }
+        if (seed % 5 == 0) test::addBeamsWithoutPosition(input);  // valid, without a position
         if (seed % 7 == 0)  // all beams on one line: exact ties and duplicates (clamped ranges)
             input.geometry.aperture = 0.0;
         Scan output = input;

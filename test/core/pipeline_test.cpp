@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -14,10 +13,6 @@
 
 namespace kfd {
 namespace {
-
-using test::emptyScan;
-using test::setRange;
-using test::setWall;
 
 std::vector<std::string> stageNames(const Pipeline& p) {
     std::vector<std::string> names;
@@ -31,17 +26,9 @@ Pipeline::Params withStages(std::vector<std::string> stages) {
     return p;
 }
 
-/// A wall 4 m ahead over -60..60 deg (181 beams over 180 deg) with out-of-range, NaN and
-/// isolated outlier beams, stamped and without odometry.
-Scan noisyWall() {
-    Scan scan = emptyScan(181, kPi);
-    setWall(scan, 30, 150, 4.0);
-    test::insertOutliers(scan, {50, 100, 130}, 1.0);  // removed by the denoise stage
-    scan.range[60] = 45.0f;                           // removed by the distance stage
-    scan.range[61] = std::numeric_limits<float>::quiet_NaN();
-    scan.timestamp = 100.0;
-    return scan;
-}
+// test::noisyWall: the distance stage removes beams 60 (45 m) and 61 (NaN), the denoise stage
+// the outliers at beams 50, 100 and 130.
+using test::noisyWall;
 
 /// Records what the chain passes through it.
 class RecordingStage : public Stage {

@@ -18,6 +18,7 @@ namespace {
 using test::deg2rad;
 using test::distinctLabels;
 using test::emptyScan;
+using test::sameCluster;
 using test::setRange;
 using test::setWall;
 
@@ -38,10 +39,6 @@ Clusters run(const RangeAwareClustering::Params& p, const Scan& scan,
 
 Clusters run(const Scan& scan, RangeAwareClustering::Result* result = nullptr) {
     return run(RangeAwareClustering::Params{}, scan, result);
-}
-
-bool sameCluster(const Clusters& c, std::size_t a, std::size_t b) {
-    return c.label[a] >= 0 && c.label[a] == c.label[b];
 }
 
 TEST(RangeAwareClustering, JumpDistanceFormula) {
@@ -214,10 +211,7 @@ TEST(RangeAwareClustering, DepthStepsAtOneDegreeResolution) {
 
 TEST(RangeAwareClustering, ClusterAcrossTheSeamIsOneCluster) {
     for (const double aperture : {test::fullCircleAperture(720), 2.0 * kPi}) {
-        Scan scan = emptyScan(720, aperture);
-        setRange(scan, 710, 719, 3.0);
-        setRange(scan, 0, 9, 3.0);
-        setRange(scan, 100, 150, 3.0);
+        const Scan scan = test::seamObjectScan(720, aperture);  // 710-719 and 0-9, 100-150
         RangeAwareClustering::Result res;
         const Clusters c = run(scan, &res);
         EXPECT_EQ(c.count(), 2u) << aperture;
@@ -236,9 +230,7 @@ TEST(RangeAwareClustering, SeamKeepsDifferentDepthsApart) {
 
 TEST(RangeAwareClustering, SeamRespectsTheAngleGap) {
     // 720 beams: theta = 10 beams. From beam 713 to beam 6 across the seam is 13 beams.
-    Scan scan = emptyScan(720, test::fullCircleAperture(720));
-    setRange(scan, 700, 713, 3.0);
-    setRange(scan, 6, 20, 3.0);
+    Scan scan = test::seamGapScan(720);  // 700-713 and 6-20
     EXPECT_EQ(run(scan).count(), 2u);
     // From beam 713 to beam 3 is exactly 10 beams: joined.
     setRange(scan, 3, 3, 3.0);
@@ -246,9 +238,10 @@ TEST(RangeAwareClustering, SeamRespectsTheAngleGap) {
 }
 
 TEST(RangeAwareClustering, NoSeamOnAHalfCircleScanner) {
+    // 180-degree field of view: the first and the last ten beams are 180 deg apart.
     Scan scan = emptyScan(kBeams, kPi);
     setRange(scan, 0, 9, 3.0);
-    setRange(scan, 171, 180, 3.0);
+    setRange(scan, kBeams - 10, kBeams - 1, 3.0);
     EXPECT_EQ(run(scan).count(), 2u);
 }
 

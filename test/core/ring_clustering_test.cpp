@@ -19,6 +19,7 @@ namespace {
 using test::deg2rad;
 using test::distinctLabels;
 using test::emptyScan;
+using test::sameCluster;
 using test::setRange;
 using test::setWall;
 
@@ -41,10 +42,6 @@ Clusters run(const RingClustering::Params& p, const Scan& scan,
     const auto r = rc.cluster(scan, c);
     if (result) *result = r;
     return c;
-}
-
-bool sameCluster(const Clusters& c, std::size_t a, std::size_t b) {
-    return c.label[a] >= 0 && c.label[a] == c.label[b];
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -277,10 +274,7 @@ TEST(RingClustering, OnlyClosestEndpointsAreCompared) {
 
 TEST(RingClustering, ClusterAcrossTheSeamIsOneCluster) {
     for (const double aperture : {test::fullCircleAperture(360), 2.0 * kPi}) {
-        Scan scan = emptyScan(360, aperture);
-        setRange(scan, 350, 359, 3.0);
-        setRange(scan, 0, 9, 3.0);
-        setRange(scan, 100, 150, 3.0);
+        const Scan scan = test::seamObjectScan(360, aperture);  // 350-359 and 0-9, 100-150
         RingClustering::Result res;
         const Clusters c = run(fixedRings(), scan, &res);
         EXPECT_EQ(c.count(), 2u) << "aperture " << aperture;
@@ -308,9 +302,7 @@ TEST(RingClustering, SeamMergeAcrossRings) {
 
 TEST(RingClustering, SeamRespectsTheAngleGap) {
     // 360 beams, theta = 10 deg: from beam 353 to beam 6 across the seam is 13 deg.
-    Scan scan = emptyScan(360, test::fullCircleAperture(360));
-    setRange(scan, 340, 353, 3.0);
-    setRange(scan, 6, 20, 3.0);
+    const Scan scan = test::seamGapScan(360);  // 340-353 and 6-20
     EXPECT_EQ(run(fixedRings(), scan).count(), 2u);
 }
 

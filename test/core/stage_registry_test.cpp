@@ -2,7 +2,6 @@
 #include "kfd/core/stage_registry.h"
 
 #include <cmath>
-#include <limits>
 #include <string>
 #include <vector>
 
@@ -20,15 +19,8 @@ std::vector<std::string> keyNames(const StageInfo& s) {
     return v;
 }
 
-Scan wallWithOutliers() {
-    Scan scan = test::emptyScan(181, kPi);
-    test::setWall(scan, 30, 150, 4.0);
-    test::insertOutliers(scan, {50, 100, 130}, 1.0);
-    scan.range[60] = 45.0f;  // out of range
-    scan.range[61] = std::numeric_limits<float>::quiet_NaN();
-    scan.timestamp = 100.0;
-    return scan;
-}
+// test::noisyWall: outliers at beams 50, 100 and 130, beam 60 out of range and beam 61 NaN.
+using test::noisyWall;
 
 TEST(StageRegistry, CoreRegistryHoldsThePapersStagesInOrder) {
     const auto& r = coreStageRegistry();
@@ -128,7 +120,7 @@ TEST(PipelineParams, WrongTypeUnderAStageNameThrows) {
 
 TEST(ScanReport, OneStageReportPerStageWithTypedDiagnostics) {
     Pipeline pipe;
-    Scan scan = wallWithOutliers();
+    Scan scan = noisyWall();
     const ScanReport r = pipe.process(scan);
     ASSERT_EQ(r.stage_count, 3u);
     EXPECT_STREQ(r.stage_reports[0].name, "distance");
@@ -158,9 +150,9 @@ TEST(ScanReport, OneStageReportPerStageWithTypedDiagnostics) {
 
 TEST(ScanReport, TheDroppingStageIsMarkedAndLaterStagesAreAbsent) {
     Pipeline pipe;
-    Scan a = wallWithOutliers();
+    Scan a = noisyWall();
     pipe.process(a);
-    Scan b = wallWithOutliers();
+    Scan b = noisyWall();
     const ScanReport r = pipe.process(b);
     ASSERT_FALSE(r.keep);
     ASSERT_EQ(r.stage_count, 2u);
@@ -169,7 +161,7 @@ TEST(ScanReport, TheDroppingStageIsMarkedAndLaterStagesAreAbsent) {
     EXPECT_EQ(r.find<Denoiser::Result>(), nullptr);
     EXPECT_EQ(r.findOrDefault<Denoiser::Result>().points_removed, 0u);
     const ScanReport copy = r;  // a plain value: diagnostics are copied, not referenced
-    Scan c = wallWithOutliers();
+    Scan c = noisyWall();
     pipe.reset();
     pipe.process(c);
     EXPECT_EQ(copy.find<KeyframeDecision>()->reason, KeyframeReason::Similar);

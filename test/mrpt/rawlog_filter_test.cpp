@@ -16,6 +16,7 @@
 
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/rawlog_filter.h"
+#include "test_files.h"
 
 namespace fs = std::filesystem;
 using mrpt::obs::CObservation2DRangeScan;
@@ -56,24 +57,13 @@ mrpt::poses::CPose2D integratedOdometry(
     return p;
 }
 
-std::string fileBytes(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
+using kfd::test::fileBytes;
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        path = fs::temp_directory_path() /
-               ("kfd_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-    std::string operator/(const std::string& f) const { return (path / f).string(); }
+struct TempDir : kfd::test::TempDir {
+    TempDir()
+        : kfd::test::TempDir("kfd_test_" +
+                             std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                             "_") {}
 };
 
 // Checks what every filtered rawlog must satisfy against its input.

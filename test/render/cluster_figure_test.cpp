@@ -7,15 +7,13 @@
 
 #include "kfd/core/denoiser.h"
 #include "kfd/render/cluster_figure.h"
+#include "test_scans.h"
 
 namespace {
 
 // A wall at x = +2 m in front of the sensor, |y| <= 1.5 m.
 kfd::Scan wallAhead() {
-    kfd::Scan s;
-    s.geometry = kfd::ScanGeometry{721, kfd::kPi, true};
-    s.range.assign(721, 0.0f);
-    s.valid.assign(721, 0);
+    kfd::Scan s = kfd::test::emptyScan(721, kfd::kPi);
     for (std::size_t i = 0; i < 721; ++i) {
         const double c = std::cos(s.geometry.angle(i));
         if (c < 0.8) continue;

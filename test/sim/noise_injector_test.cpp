@@ -4,19 +4,15 @@
 #include <random>
 
 #include "kfd/sim/noise_injector.h"
+#include "test_scans.h"
 
 using kfd::NoiseInjector;
 using kfd::NoiseKind;
 
 namespace {
 
-kfd::Scan wall(std::size_t beams, double r) {
-    kfd::Scan s;
-    s.geometry = kfd::ScanGeometry{beams, 1.5 * kfd::kPi, true};
-    s.range.assign(beams, static_cast<float>(r));
-    s.valid.assign(beams, 1);
-    return s;
-}
+// All beams at range r over 270 degrees.
+kfd::Scan wall(std::size_t beams, double r) { return kfd::test::arc(beams, 1.5 * kfd::kPi, r); }
 
 NoiseInjector::Params none() {
     NoiseInjector::Params p;

@@ -5,36 +5,22 @@
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "kfd/eval/trajectory.h"
 #include "kfd/mrpt/rawlog_source.h"
 #include "kfd/sim/denoise_quality.h"
 #include "kfd/sim/simulator.h"
+#include "test_files.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        path = fs::temp_directory_path() /
-               (std::string("kfd_sim_") +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-    std::string operator/(const std::string& f) const { return (path / f).string(); }
+struct TempDir : kfd::test::TempDir {
+    TempDir() : kfd::test::TempDir("kfd_sim_") {}
 };
 
-std::string bytes(const std::string& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
+std::string bytes(const std::string& p) { return kfd::test::fileBytes(p); }
 
 kfd::SimulationOptions shortRun(const std::string& out) {
     kfd::SimulationOptions o;

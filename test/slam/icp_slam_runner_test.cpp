@@ -4,8 +4,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
-#include <sstream>
 
 #include "kfd/eval/trajectory.h"
 #include "kfd/mrpt/config.h"
@@ -13,6 +11,7 @@
 #include "kfd/report/slam_report.h"
 #include "kfd/sim/simulator.h"
 #include "kfd/slam/icp_slam_runner.h"
+#include "test_files.h"
 
 namespace fs = std::filesystem;
 
@@ -24,25 +23,11 @@ const std::string kMitCsail = std::string(KFD_DATASETS_DIR) + "/mit-csail/mit-cs
 const std::string kMitCsailRel = std::string(KFD_DATASETS_DIR) + "/mit-csail/mit-csail.relations";
 const std::string kConfig = std::string(KFD_SOURCE_DIR) + "/share/kfd-icp-slam/sick-180-5hz.ini";
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        path = fs::temp_directory_path() /
-               (std::string("kfd_slam_") +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-    std::string operator/(const std::string& f) const { return (path / f).string(); }
+struct TempDir : kfd::test::TempDir {
+    TempDir() : kfd::test::TempDir("kfd_slam_") {}
 };
 
-std::string text(const std::string& path) {
-    std::ifstream f(path);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
+std::string text(const std::string& path) { return kfd::test::fileBytes(path); }
 
 std::size_t lines(const std::string& path) {
     std::ifstream f(path);
@@ -322,8 +307,7 @@ TEST(IcpSlamRunner, TruncatedRawlogIsAnErrorNotAShortRun) {
     if (!fs::exists(real)) GTEST_SKIP() << "missing " << real;
     TempDir dir;
     {
-        std::ifstream in(real, std::ios::binary);
-        std::string data((std::istreambuf_iterator<char>(in)), {});
+        const std::string data = kfd::test::fileBytes(real);
         std::ofstream(dir / "cut.rawlog", std::ios::binary) << data.substr(0, data.size() / 2);
     }
     auto o = options(dir / "cut.rawlog", dir / "out", kfd::PrefilterMode::None);

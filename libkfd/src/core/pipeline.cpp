@@ -82,8 +82,7 @@ ScanReport Pipeline::process(Scan& scan) {
     if (scan.valid.size() != scan.range.size())
         throw ScanError("scan: range and valid sizes differ");
     report.points_in = scan.countValid();
-    // One clock read per stage: each stage's end is the next one's start, and the last one's
-    // end closes the chain's time.
+    // One clock read per stage: each stage's end is the next one's start.
     auto t = t0;
     for (auto& stage : stages_) {
         StageReport& sr = report.stage_reports[report.stage_count++];
@@ -99,8 +98,12 @@ ScanReport Pipeline::process(Scan& scan) {
             break;
         }
     }
-    if (stages_.empty()) t = Clock::now();
-    report.microseconds = std::chrono::duration<double, std::micro>(t - t0).count();
+    if (stages_.empty()) {
+        report.microseconds = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
+    } else {  // the sum of the stages' times, so that they add up exactly to the chain's time
+        for (std::size_t i = 0; i < report.stage_count; ++i)
+            report.microseconds += report.stage_reports[i].microseconds;
+    }
     report.points_out = scan.countValid();
     return report;
 }
