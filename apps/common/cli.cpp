@@ -2,9 +2,13 @@
 
 #include <unistd.h>
 
+#include <csignal>
+
 #include <algorithm>
 #include <cstdio>
 #include <memory>
+
+#include "kfd/core/cancel.h"
 
 namespace kfd::app {
 
@@ -101,6 +105,28 @@ int Cli::usageError(const std::string& message) const {
     return 2;
 }
 
+namespace {
+
+// SIGINT / SIGTERM: ask the running library loop to stop (it unwinds and its temporary outputs
+// are removed); SA_RESETHAND makes a second signal end the process at once.
+extern "C" void onSignal(int sig) { kfd::requestCancel(sig); }
+
+void installSignalHandlers() {
+    struct sigaction sa {};
+    sa.sa_handler = onSignal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND;
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+}
+
+}  // namespace
+
+void checkOutputPaths(const std::vector<kfd::NamedPath>& inputs,
+                      const std::vector<kfd::NamedPath>& outputs) {
+    kfd::checkOutputPaths(inputs, outputs);
+}
+
 int Cli::run(int argc, char** argv, const std::function<void()>& body) {
     try {
         app_.parse(argc, argv);
@@ -120,9 +146,15 @@ int Cli::run(int argc, char** argv, const std::function<void()>& body) {
     } catch (const CLI::ParseError& e) {
         return usageError(e.what());
     }
+    installSignalHandlers();
     try {
         body();
+        kfd::throwIfCancelled();  // a signal during the last step still fails the run
         return 0;
+    } catch (const kfd::Cancelled& e) {
+        if (progress_) progress_->abort();
+        std::fprintf(stderr, "%s: %s\n", name_.c_str(), e.what());
+        return 128 + e.signal();
     } catch (const UsageError& e) {
         if (progress_) progress_->abort();
         return usageError(e.what());

@@ -1,6 +1,8 @@
 // The command-line layer of kfd's apps, over CLI11: typed options whose errors name the flag and
 // the bad value, generated help, the exit-code contract (0 success, 1 bad input or
-// configuration, 2 bad usage) and the shared progress printer.
+// configuration, 2 bad usage, 128 + N when stopped by signal N), the shared progress printer and
+// the SIGINT/SIGTERM handling (a cancellation request the libraries' loops honour, so that no
+// temporary or partial output remains).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -14,6 +16,7 @@
 #include <vector>
 
 #include "kfd/core/error.h"
+#include "kfd/core/output_paths.h"
 
 namespace kfd::app {
 
@@ -22,6 +25,11 @@ class UsageError : public kfd::Error {
   public:
     using Error::Error;
 };
+
+/// kfd::checkOutputPaths for what only the app knows (a configuration file, several outputs of
+/// a library that checks its own): throws kfd::PathError (exit status 1) naming both paths.
+void checkOutputPaths(const std::vector<kfd::NamedPath>& inputs,
+                      const std::vector<kfd::NamedPath>& outputs);
 
 /// Progress lines on stderr: an updating line on a terminal, one line per 10 % otherwise (logs
 /// stay short).
@@ -149,7 +157,9 @@ class Cli {
 
     /// Parses argv, then runs `body`. Returns the exit status: 0 on success, help or version;
     /// 2 on bad usage from the parser or a UsageError ("NAME: message" and "Try 'NAME --help'."
-    /// on stderr); 1 on any other exception ("NAME: what").
+    /// on stderr); 1 on any other exception ("NAME: what"), an output that aliases an input
+    /// included; 128 + N when signal N (SIGINT, SIGTERM) stopped the run (kfd::Cancelled).
+    /// While `body` runs, SIGINT and SIGTERM call kfd::requestCancel() (a second one kills).
     int run(int argc, char** argv, const std::function<void()>& body);
 
   private:

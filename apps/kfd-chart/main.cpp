@@ -19,12 +19,16 @@ int main(int argc, char** argv) {
     cli.option("--size", size, "image width and height in pixels (default 1000 500)", 2, 2)
         ->option_text("W H");
     return cli.run(argc, argv, [&] {
+        kfd::app::checkOutputPaths({{"input CSV", csv}}, {{"output image", out}});
         auto c = kfd::readBarChartCsv(csv);
         c.title = title;
         c.y_label = ylabel;
         c.log_y = log_y;
         c.width = size[0];
         c.height = size[1];
-        if (!c.render().saveToFile(out)) throw std::runtime_error("cannot write " + out);
+        kfd::TempOutputFile tmp(out);  // written under a temporary name, renamed when complete
+        if (!c.render().saveToFile(tmp.path().string()))
+            throw std::runtime_error("cannot write " + out);
+        tmp.commit();
     });
 }

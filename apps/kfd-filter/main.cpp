@@ -53,7 +53,8 @@ int main(int argc, char** argv) {
         "and removes noise points from the kept scans (clustering denoise). Every other object is\n"
         "copied unchanged and in order; odometry of dropped frames is composed into the next kept\n"
         "action. Removed points are marked invalid (beam count and angles are kept).",
-        "Exit status: 0 on success, 1 on bad input or configuration, 2 on bad usage.");
+        "Exit status: 0 on success, 1 on bad input or configuration (an output that is an input\n"
+        "included), 2 on bad usage, 130/143 when interrupted (no output is left).");
     kfd::RawlogFilterOptions opts;
     std::string config;
     bool print_config = false, list_keys = false;
@@ -98,6 +99,9 @@ int main(int argc, char** argv) {
         }
         if (opts.input.empty()) throw kfd::app::UsageError("no input rawlog (-i)");
         if (opts.output.empty()) throw kfd::app::UsageError("no output rawlog (-o)");
+        kfd::app::checkOutputPaths(
+            {{"input rawlog", opts.input}, {"configuration", config}},
+            {{"output rawlog", opts.output}, {"stats file", opts.stats_csv}});
         if (auto* progress = cli.progress())
             opts.on_progress = [progress](const kfd::RawlogProgress& p) {
                 progress->update(

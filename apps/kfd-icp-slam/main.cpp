@@ -15,8 +15,10 @@ int main(int argc, char** argv) {
         "matching configured by an optional [KFD] section (see kfd-filter --list-keys).",
         "Writes trajectory.tum (a pose for every input scan), log_estimated_path.txt (icp-slam's\n"
         "format), scans.csv, summary.json, final_map.simplemap, map.png, map_figure.png and\n"
-        "report.md into the output folder.\n"
-        "Exit status: 0 on success, 1 on bad input or configuration, 2 on bad usage.");
+        "report.md into the output folder (staged in a temporary folder and moved in at the end;\n"
+        "the folder's other files are kept).\n"
+        "Exit status: 0 on success, 1 on bad input or configuration (an output that is an input\n"
+        "included), 2 on bad usage, 130/143 when interrupted (no output is left).");
     kfd::IcpSlamOptions o;
     std::string rawlog_arg;
     cli.option("CONFIG.ini", o.config_file, "ICP-SLAM configuration (and optional [KFD])")

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "common/cli.h"
+#include "kfd/core/cancel.h"
 #include "kfd/core/denoiser.h"
 #include "kfd/core/distance_filter.h"
 #include "kfd/mrpt/config.h"
@@ -36,6 +37,8 @@ int main(int argc, char** argv) {
     return cli.run(argc, argv, [&] {
         if ((index < 0) == std::isnan(stamp))
             throw kfd::app::UsageError("give exactly one of --index and --time");
+        kfd::app::checkOutputPaths({{"input rawlog", in}, {"configuration", cfg}},
+                                   {{"output image", out}});
         const kfd::Pipeline::Params p =
             cfg.empty() ? kfd::Pipeline::Params{} : kfd::loadConfigFile(cfg);
         const auto source = kfd::openSource(in);
@@ -44,6 +47,7 @@ int main(int argc, char** argv) {
         long n = 0;
         kfd::SourceEntry entry;
         while (!(index >= 0 && chosen) && source->next(entry)) {
+            kfd::throwIfCancelled();
             entry.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
                 if (index >= 0 && n++ == index) chosen = s;
                 if (index < 0) {
@@ -70,7 +74,9 @@ int main(int argc, char** argv) {
         o.rings = p.get<kfd::DenoiseStage>().reference.rings.rings;
         kfd::ClusterFigure fig(o);
         auto img = fig.render(scan, den.clusters());
-        if (!img.saveToFile(out)) throw std::runtime_error("cannot write " + out);
+        kfd::TempOutputFile tmp(out);  // written under a temporary name, renamed when complete
+        if (!img.saveToFile(tmp.path().string())) throw std::runtime_error("cannot write " + out);
+        tmp.commit();
         std::printf("kfd-render: scan at %.6f, %zu clusters, %zu noise points -> %s\n",
                     kfd::stampOf(*chosen), r.clusters, r.points_removed, out.c_str());
     });

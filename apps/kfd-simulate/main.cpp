@@ -13,7 +13,8 @@ int main(int argc, char** argv) {
         "simulator), adds labelled outliers and drifting odometry. Writes OUT.rawlog\n"
         "(observations: LASER scans + ODOMETRY), OUT.gt.tum (ground truth), OUT.odom.tum and\n"
         "OUT.labels.csv (scan,timestamp,beam,kind for every outlier beam).",
-        "Same options + seed = same files. Exit 1 on bad input, 2 on bad usage.");
+        "Same options + seed = same files. Exit 1 on bad input (an output that is an input\n"
+        "included), 2 on bad usage, 130/143 when interrupted (no output is left).");
     kfd::SimulationOptions o;
     cli.option("-o,--output", o.output, "output rawlog")->type_name("FILE")->required();
     cli.option("-w,--world", o.world, "built-in world: office or corridor")

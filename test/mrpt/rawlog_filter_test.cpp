@@ -255,6 +255,9 @@ TEST(RawlogFilter, NonRawlogInputLeavesNoOutput) {
     for (const auto& e : fs::directory_iterator(dir.path))
         EXPECT_EQ(e.path().filename().string().find("out.rawlog"), std::string::npos)
             << "temporary file left behind: " << e.path();
+    for (const auto& e : fs::directory_iterator(dir.path))  // the temporary names: .out.kfd-tmp-*
+        EXPECT_EQ(e.path().filename().string().find("kfd-tmp"), std::string::npos)
+            << "temporary file left behind: " << e.path();
 }
 
 TEST(RawlogFilter, TruncatedInputIsAnErrorAndLeavesNoOutput) {

@@ -270,6 +270,38 @@ TEST(RawlogSource, TruncatedGzipThrowsEvenWhenItsDataEndsAtABoundary) {
     }
 }
 
+// The gzip trailer is verified at the end of the stream: a wrong CRC-32 or length, or bytes
+// after the stream that are not another gzip member, are errors; a second member is read on.
+TEST(RawlogSource, GzipTrailerAndTrailingBytesAreChecked) {
+    TempDir dir;
+    write(dir / "full.rawlog", actionsLog(), true);
+    const std::string full = bytes(dir / "full.rawlog");
+    auto expectError = [&](const std::string& data, const std::string& reason) {
+        SCOPED_TRACE(reason);
+        std::ofstream(dir / "bad.rawlog", std::ios::binary) << data;
+        try {
+            readAll(dir / "bad.rawlog");
+            ADD_FAILURE() << "no error";
+        } catch (const kfd::RawlogError& e) {
+            EXPECT_NE(std::string(e.what()).find(reason), std::string::npos) << e.what();
+        }
+    };
+    std::string crc = full;
+    crc[crc.size() - 8] = static_cast<char>(crc[crc.size() - 8] ^ 0x10);
+    expectError(crc, "incorrect data check");
+    std::string isize = full;
+    isize[isize.size() - 2] = static_cast<char>(isize[isize.size() - 2] ^ 0x01);
+    expectError(isize, "incorrect length check");
+    expectError(full.substr(0, full.size() - 8), "the gzip stream ends early");
+    expectError(full.substr(0, full.size() - 3), "the gzip stream ends early");
+    expectError(full + "garbage", "garbage after the gzip stream");
+    expectError(full + std::string(1, '\0'), "garbage after the gzip stream");
+    // Two members (as `cat a.gz b.gz` makes): one stream of both logs.
+    std::ofstream(dir / "two.rawlog", std::ios::binary) << full << full;
+    EXPECT_EQ(readAll(dir / "two.rawlog").size(), 10u);
+    EXPECT_EQ(readAll(dir / "full.rawlog").size(), 5u);
+}
+
 TEST(RawlogSource, TruncatedRealRawlogThrowsAndTheFullOneEndsCleanly) {
     const std::string real = std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog";
     if (!fs::exists(real)) GTEST_SKIP() << "missing " << real;

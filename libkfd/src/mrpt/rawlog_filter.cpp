@@ -13,7 +13,9 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
-#include <random>
+
+#include "kfd/core/cancel.h"
+#include "kfd/core/output_paths.h"
 
 namespace kfd {
 namespace {
@@ -25,23 +27,11 @@ using mrpt::obs::CObservation2DRangeScan;
 using mrpt::obs::CSensoryFrame;
 using mrpt::poses::CPose2D;
 
-// Removes the temporary output unless released.
-struct TempFile {
-    fs::path path;
-    bool keep = false;
-    ~TempFile() {
-        if (!keep && !path.empty()) {
-            std::error_code ec;
-            fs::remove(path, ec);
-        }
-    }
-};
-
 class CsvWriter {
   public:
-    void open(const std::string& path) {
+    void open(const fs::path& path, const std::string& final_path) {
         out_.open(path);
-        if (!out_) throw RawlogError("cannot write the stats file " + path);
+        if (!out_) throw RawlogError("cannot write the stats file " + final_path, final_path);
         out_ << "index,timestamp,sensor,keyframe,reason,p_common,p_threshold,references,"
                 "points_in,removed_range,clusters,noise_clusters,removed_noise,points_out,"
                 "microseconds\n";
@@ -214,29 +204,35 @@ void Run::execute() {
     if (!fs::is_regular_file(opts_.input, ec))
         throw RawlogError("input rawlog not found: " + opts_.input);
     if (opts_.output.empty()) throw RawlogError("no output file given");
-    if (fs::exists(opts_.output, ec) && fs::equivalent(opts_.input, opts_.output, ec))
-        throw RawlogError("the output must not be the input file: " + opts_.output);
+    // Before anything is opened for writing: no output may be an input or the other output.
+    try {
+        checkOutputPaths({{"input rawlog", opts_.input}},
+                         {{"output rawlog", opts_.output}, {"stats file", opts_.stats_csv}});
+    } catch (const PathError& e) {  // reported like every other output problem of this class
+        throw RawlogError(e.what(), e.field());
+    }
 
     const auto source = openSource(opts_.input);
     const std::uint64_t total = source->bytesTotal();
 
-    TempFile tmp;
-    {
-        std::random_device rd;
-        const fs::path outp(opts_.output);
-        tmp.path = outp.parent_path() /
-                   (outp.filename().string() + ".tmp-" + std::to_string(rd() % 1000000));
-    }
-    if (!out_.open(tmp.path.string(), opts_.compress_level))
-        throw RawlogError("cannot write the output next to " + opts_.output);
+    // Both outputs are written under temporary names beside them and renamed at the end; on
+    // any failure or cancellation the destructors remove them.
+    TempOutputFile tmp(opts_.output);
+    std::optional<TempOutputFile> tmp_csv;
+    if (!out_.open(tmp.path().string(), opts_.compress_level))
+        throw RawlogError("cannot write the output next to " + opts_.output, opts_.output);
     arch_.emplace(out_);
-    if (!opts_.stats_csv.empty()) csv_.open(opts_.stats_csv);
+    if (!opts_.stats_csv.empty()) {
+        tmp_csv.emplace(opts_.stats_csv);
+        csv_.open(tmp_csv->path(), opts_.stats_csv);
+    }
 
     RawlogProgress progress;
     progress.bytes_total = total;
     const std::size_t every = std::max<std::size_t>(1, opts_.progress_every);
     SourceEntry e;
     while (source->next(e)) {
+        throwIfCancelled();
         const std::size_t before = sum_.objects_in;
         sum_.objects_in = e.objects_read;
         odometry_ = e.odometry;
@@ -289,10 +285,9 @@ void Run::execute() {
     arch_.reset();
     out_.close();
     csv_.close();
-    std::error_code rec;
-    fs::rename(tmp.path, opts_.output, rec);
-    if (rec) throw RawlogError("cannot move the output into place: " + rec.message());
-    tmp.keep = true;
+    throwIfCancelled();
+    tmp.commit();
+    if (tmp_csv) tmp_csv->commit();
 
     sum_.layout = saw_frames_ && saw_observations_ ? "mixed"
                   : saw_frames_                    ? "actions+sensory-frames"

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "kfd/baselines/motion_stage.h"
+#include "kfd/core/cancel.h"
 #include "kfd/render/map_figure.h"
 
 namespace kfd {
@@ -65,7 +66,8 @@ void writeMap(const IcpSlamResult& res, const fs::path& out) {
     }
     mrpt::maps::COccupancyGridMap2D grid(-10, 10, -10, 10, 0.05f);
     grid.loadFromSimpleMap(*res.map);
-    grid.saveAsBitmapFile((out / "map.png").string());
+    if (!grid.saveAsBitmapFile((out / "map.png").string()))
+        throw SlamError("cannot write " + (out / "map.png").string());
     MapFigureInput fig;
     fig.grid = &grid;
     fig.estimate = res.trajectory;
@@ -73,7 +75,8 @@ void writeMap(const IcpSlamResult& res, const fs::path& out) {
     fig.odometry = res.odometry;
     fig.keyframes = res.keyframes;
     fig.title = fs::path(sum.rawlog).filename().string() + "  mode " + toString(sum.mode);
-    renderMapFigure(fig).saveToFile((out / "map_figure.png").string());
+    if (!renderMapFigure(fig).saveToFile((out / "map_figure.png").string()))
+        throw SlamError("cannot write " + (out / "map_figure.png").string());
 }
 
 }  // namespace
@@ -117,10 +120,15 @@ std::string toJson(const IcpSlamSummary& s) {
 }
 
 void writeIcpSlamReport(const IcpSlamResult& result) {
-    const fs::path out(result.summary.output_dir);
+    if (!result.output) throw SlamError("no staged output folder in the result");
+    if (result.output->committed()) throw SlamError("the output was already committed");
+    const fs::path out = result.output->path();
     if (result.map) writeMap(result, out);
+    throwIfCancelled();
     writeText(out / "summary.json", toJson(result.summary));
     if (result.map) writeText(out / "report.md", reportMarkdown(result.summary));
+    throwIfCancelled();
+    result.output->commit();
 }
 
 }  // namespace kfd

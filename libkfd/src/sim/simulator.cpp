@@ -12,6 +12,8 @@
 #include <fstream>
 #include <random>
 
+#include "kfd/core/cancel.h"
+#include "kfd/core/output_paths.h"
 #include "kfd/eval/trajectory.h"
 #include "kfd/mrpt/scan_adapter.h"
 
@@ -90,6 +92,19 @@ SensorModel sensorModel(const std::string& name) {
 
 SimulationSummary Simulator::run(const SimulationOptions& o) {
     SimulationSummary sum;
+    const fs::path out(o.output);
+    const std::string stem = (out.parent_path() / out.stem()).string();
+    sum.rawlog = o.output;
+    sum.ground_truth = stem + ".gt.tum";
+    sum.odometry = stem + ".odom.tum";
+    sum.labels = stem + ".labels.csv";
+    // Before anything is written: no output is an input or another output. Each output is
+    // written under a temporary name beside it and renamed once all four are complete.
+    checkOutputPaths({{"gridmap", o.gridmap}, {"route", o.route}},
+                     {{"output rawlog", sum.rawlog},
+                      {"ground truth", sum.ground_truth},
+                      {"odometry", sum.odometry},
+                      {"labels", sum.labels}});
     World world;
     SensorModel sensor;
     NoiseInjector noise;
@@ -109,19 +124,14 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
     std::mt19937 rng(o.seed);
     std::normal_distribution<double> gauss(0.0, 1.0);
 
-    const fs::path out(o.output);
-    const std::string stem = (out.parent_path() / out.stem()).string();
-    sum.rawlog = o.output;
-    sum.ground_truth = stem + ".gt.tum";
-    sum.odometry = stem + ".odom.tum";
-    sum.labels = stem + ".labels.csv";
     std::error_code mk;
     if (!out.parent_path().empty()) fs::create_directories(out.parent_path(), mk);
-    const std::string tmp = o.output + ".tmp";
+    TempOutputFile tmp(sum.rawlog), tmp_gt(sum.ground_truth), tmp_odo(sum.odometry),
+        tmp_labels(sum.labels);
     mrpt::io::CFileGZOutputStream f;
-    if (!f.open(tmp, 1)) throw SimulationError("cannot write " + o.output);
+    if (!f.open(tmp.path().string(), 1)) throw SimulationError("cannot write " + o.output);
     auto arch = mrpt::serialization::archiveFrom(f);
-    std::ofstream labels(sum.labels);
+    std::ofstream labels(tmp_labels.path());
     if (!labels) throw SimulationError("cannot write " + sum.labels);
     labels << "scan,timestamp,beam,kind\n";
 
@@ -138,6 +148,7 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
     scan.stdError = static_cast<float>(sensor.range_sigma);
 
     for (std::size_t k = 0; k < gt.size(); ++k) {
+        throwIfCancelled();
         const double t = t0 + static_cast<double>(k) / sensor.rate_hz;
         const auto stamp = mrpt::Clock::fromDouble(t);
         if (k > 0) {  // odometry: the true increment, corrupted
@@ -184,11 +195,13 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
     f.close();
     labels.close();
     if (!labels) throw SimulationError("failed writing " + sum.labels);
-    writeTum(sum.ground_truth, gt_traj);
-    writeTum(sum.odometry, odo_traj);
-    std::error_code ec;
-    fs::rename(tmp, o.output, ec);
-    if (ec) throw SimulationError("cannot move the rawlog into place: " + ec.message());
+    writeTum(tmp_gt.path().string(), gt_traj);
+    writeTum(tmp_odo.path().string(), odo_traj);
+    throwIfCancelled();
+    tmp.commit();
+    tmp_gt.commit();
+    tmp_odo.commit();
+    tmp_labels.commit();
     sum.scans = gt.size();
     sum.duration_s = static_cast<double>(gt.size()) / sensor.rate_hz;
     if (o.on_progress) o.on_progress(1.0);

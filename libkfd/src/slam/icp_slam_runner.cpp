@@ -15,6 +15,7 @@
 #include <fstream>
 
 #include "kfd/baselines/motion_stage.h"
+#include "kfd/core/cancel.h"
 #include "kfd/eval/ate.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/source.h"
@@ -84,6 +85,14 @@ bool nextEntry(Source& source, SourceEntry& e) {
     }
 }
 
+void checkReadable(const std::string& role, const std::string& path) {
+    if (path.empty()) return;
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) throw SlamError(role + " not found: " + path, path);
+    if (!std::ifstream(path, std::ios::binary))
+        throw SlamError("cannot read the " + role + " " + path, path);
+}
+
 struct ScanStamp {
     double t;
     std::optional<Pose2D> odometry;
@@ -98,6 +107,7 @@ std::vector<ScanStamp> scanOdometry(const std::string& rawlog) {
     IcpSlamStep step;
     SourceEntry e;
     while (nextEntry(*source, e)) {
+        throwIfCancelled();
         if (!steps.feed(e, step)) continue;
         auto add = [&](const mrpt::obs::CObservation& o) {
             if (IS_CLASS(o, CObservation2DRangeScan)) out.push_back({stampOf(o), e.odometry});
@@ -155,6 +165,26 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
     if (sum.rawlog.empty()) throw SlamError("no rawlog given (option or rawlog_file)");
     if (!fs::is_regular_file(sum.rawlog, ec)) throw SlamError("rawlog not found: " + sum.rawlog);
     if (sum.output_dir.empty()) throw SlamError("no output folder given (option or logOutput_dir)");
+    // Every input readable before the run starts, and no output file is (or aliases) one.
+    checkReadable("rawlog", sum.rawlog);
+    checkReadable("relations file", opts.relations);
+    checkReadable("ground-truth trajectory", opts.ground_truth_tum);
+    {
+        const std::vector<NamedPath> inputs = {{"configuration", opts.config_file},
+                                               {"rawlog", sum.rawlog},
+                                               {"relations file", opts.relations},
+                                               {"ground-truth trajectory", opts.ground_truth_tum}};
+        std::vector<NamedPath> outputs;
+        for (const char* name : kIcpSlamOutputFiles)
+            outputs.push_back(
+                {std::string("output ") + name, (fs::path(sum.output_dir) / name).string()});
+        checkOutputPaths(inputs, outputs);
+        for (const NamedPath& in : inputs)
+            if (samePath(sum.output_dir, in.path))
+                throw PathError(
+                    "the output folder " + sum.output_dir + " is the " + in.role + " " + in.path,
+                    sum.output_dir);
+    }
 
     // Pre-filter configuration: [KFD] when present, else the built-in defaults.
     Pipeline::Params kfd_params;
@@ -170,6 +200,10 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
 
     std::vector<Relation> relations;
     if (!opts.relations.empty()) relations = readRelations(opts.relations);  // EvalError
+    if (!opts.ground_truth_tum.empty()) {  // read before the run: a bad file fails at once
+        res.ground_truth = readTum(opts.ground_truth_tum);  // EvalError
+        sortByTime(res.ground_truth);
+    }
 
     // The map builder, configured exactly as icp-slam does.
     mrpt::slam::CMetricMapBuilderICP builder;
@@ -182,9 +216,10 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
     const std::size_t rawlog_offset =
         static_cast<std::size_t>(std::max(0, cfg.read_int(kSect, "rawlog_offset", 0)));
 
-    fs::create_directories(sum.output_dir, ec);
-    if (ec) throw SlamError("cannot create the output folder " + sum.output_dir);
-    const fs::path out(sum.output_dir);
+    // Everything is written into a staging folder; writeIcpSlamReport() (or
+    // result.output->commit()) moves it into place, and on failure it is removed.
+    res.output = std::make_shared<StagedOutputFolder>(sum.output_dir);
+    const fs::path out = res.output->path();
     std::ofstream f_path(out / "log_estimated_path.txt"), f_csv(out / "scans.csv");
     if (!f_path || !f_csv) throw SlamError("cannot write into " + sum.output_dir);
     f_csv << "index,timestamp,sensor,kept,reason,p_common,points_in,points_removed,prefilter_us,"
@@ -225,6 +260,7 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
     };
 
     while (nextEntry(*source, e)) {
+        throwIfCancelled();
         if (!steps.feed(e, step) || e.objects_read < rawlog_offset) continue;
         entry_scans.clear();
         if (step.observation) {
@@ -270,11 +306,10 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
     if (opts.on_progress) opts.on_progress({sum.entries, sum.scans_in, sum.scans_kept, 1.0});
     f_path.close();
     f_csv.close();
+    if (f_path.fail() || f_csv.fail()) throw SlamError("cannot write into " + out.string());
     writeTum((out / "trajectory.tum").string(), traj);
 
     if (!opts.ground_truth_tum.empty()) {
-        res.ground_truth = readTum(opts.ground_truth_tum);  // EvalError
-        sortByTime(res.ground_truth);
         Trajectory sorted = traj;
         sortByTime(sorted);
         sum.ate_rmse = computeAte(sorted, res.ground_truth, opts.relations_max_dt).rmse;

@@ -55,7 +55,12 @@ struct RawlogFilterSummary {
 /// StreamFilter, and writes every other object unchanged and in order. Non-keyframe scans are
 /// removed; a sensory frame left empty is dropped and its odometry action is composed into the
 /// next kept action, so the output's odometry still adds up. The input is never modified; on
-/// any error no output file is left behind. Throws RawlogError or ConfigError.
+/// any error no output file is left behind: the output and the stats CSV are written under
+/// temporary names beside them and renamed at the end. Before anything is written, an output or
+/// stats path that is (or aliases) the input or the other output is refused (a RawlogError
+/// from kfd::checkOutputPaths, kfd/core/output_paths.h). Stops with kfd::Cancelled after
+/// kfd::requestCancel() (kfd/core/cancel.h). Throws RawlogError, ConfigError, PathError (a
+/// temporary file that cannot be moved into place) or Cancelled.
 class RawlogFilter {
   public:
     RawlogFilterSummary run(const RawlogFilterOptions& opts);

@@ -17,7 +17,9 @@ std::string toJson(const IcpSlamSummary& s);
 /// Writes into result.summary.output_dir: summary.json and, when the result holds the built
 /// map (IcpSlamOptions::write_map), final_map.simplemap, map.png (occupancy grid, 5 cm),
 /// map_figure.png (grid + estimate, keyframes, odometry and ground truth) and report.md.
-/// Throws SlamError when a file cannot be written.
+/// Writes into the result's staging folder, then moves everything into output_dir
+/// (IcpSlamResult::output->commit()). Throws SlamError when a file cannot be written, PathError
+/// when the folder cannot be moved into place, Cancelled after kfd::requestCancel().
 void writeIcpSlamReport(const IcpSlamResult& result);
 
 }  // namespace kfd

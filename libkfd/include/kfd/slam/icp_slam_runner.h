@@ -4,12 +4,14 @@
 #include <mrpt/maps/CSimpleMap.h>
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "kfd/core/error.h"
+#include "kfd/core/output_paths.h"
 #include "kfd/core/pipeline.h"
 #include "kfd/eval/relations.h"
 #include "kfd/eval/trajectory.h"
@@ -65,7 +67,16 @@ struct IcpSlamResult {
     std::vector<std::size_t> keyframes;  // indices into `trajectory` of the kept scans
     Trajectory ground_truth;             // ground_truth_tum, sorted by time (empty without it)
     std::optional<mrpt::maps::CSimpleMap> map;  // the built map, with write_map
+    /// The staged output folder holding what run() wrote; writeIcpSlamReport() adds the report
+    /// and commits it (callers without a report call output->commit()). Removed uncommitted
+    /// when the last copy of the result goes.
+    std::shared_ptr<StagedOutputFolder> output;
 };
+
+/// Every file kfd-icp-slam may write into its output folder (checked against the inputs).
+inline constexpr const char* kIcpSlamOutputFiles[] = {
+    "trajectory.tum", "log_estimated_path.txt", "scans.csv", "summary.json", "final_map.simplemap",
+    "map.png",        "map_figure.png",         "report.md"};
 
 /// Bad input, configuration or output (message says which).
 class SlamError : public Error {
@@ -80,7 +91,12 @@ class SlamError : public Error {
 /// observations are still processed. Every input scan gets a pose (the map builder's estimate,
 /// propagated with odometry for dropped scans).
 ///
-/// Writes into the output folder: trajectory.tum (one pose per input scan, TUM format),
+/// Checks first that the configuration, the rawlog, the relations and the ground truth are
+/// readable (the ground truth and relations are parsed before the run) and that no output file
+/// is (or aliases) one of them (PathError). Stops with kfd::Cancelled after
+/// kfd::requestCancel(). Writes into a staging folder (kfd::StagedOutputFolder: beside a new
+/// output folder, inside an existing one, whose other files are left alone), held by
+/// IcpSlamResult::output: trajectory.tum (one pose per input scan, TUM format),
 /// log_estimated_path.txt (icp-slam's "step x y phi", one per rawlog entry) and scans.csv.
 /// summary.json, final_map.simplemap, map.png, map_figure.png and report.md are written from
 /// the result by writeIcpSlamReport() (kfd/report/slam_report.h).

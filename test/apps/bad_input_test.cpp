@@ -1,0 +1,404 @@
+// The bad-input table (issue 9): each row runs a built app on a bad input and asserts the exit
+// status, the first line of the message, that no output (and no temporary file) was left and
+// that every input is byte-for-byte unchanged.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "test_files.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using kfd::test::fileBytes;
+
+// --- Shared helpers: run an app, snapshot files ---------------------------------------------
+
+struct Result {
+    int status = -1;  // exit status, or 128 + signal when killed by one
+    std::string out, err;
+    /// The first line of stderr.
+    std::string first() const { return err.substr(0, err.find('\n')); }
+};
+
+// Starts `exe args...` with stdout and stderr into files under `dir`; returns the pid.
+pid_t spawn(const std::string& exe, const std::vector<std::string>& args, const fs::path& dir) {
+    const std::string out = (dir / ".stdout").string(), err = (dir / ".stderr").string();
+    const pid_t pid = fork();
+    if (pid == 0) {
+        if (!std::freopen(out.c_str(), "w", stdout) || !std::freopen(err.c_str(), "w", stderr))
+            _exit(127);
+        std::vector<char*> argv{const_cast<char*>(exe.c_str())};
+        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(exe.c_str(), argv.data());
+        _exit(127);
+    }
+    return pid;
+}
+
+Result finish(pid_t pid, const fs::path& dir) {
+    int ws = 0;
+    waitpid(pid, &ws, 0);
+    Result r;
+    r.status = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
+    r.out = fileBytes((dir / ".stdout").string());
+    r.err = fileBytes((dir / ".stderr").string());
+    fs::remove(dir / ".stdout");
+    fs::remove(dir / ".stderr");
+    return r;
+}
+
+// Runs an app to its end (its stdout and stderr are kept in hidden files of `dir` meanwhile).
+Result run(const std::string& exe, const std::vector<std::string>& args, const fs::path& dir) {
+    return finish(spawn(exe, args, dir), dir);
+}
+
+// Every file and folder under `dir` (relative paths), hidden ones included.
+std::set<std::string> listing(const fs::path& dir) {
+    std::set<std::string> names;
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+        names.insert(fs::relative(e.path(), dir).string());
+    return names;
+}
+
+// The bytes of some files, to prove a run left them unchanged.
+struct Snapshot {
+    std::map<std::string, std::string> bytes;
+    explicit Snapshot(const std::vector<std::string>& paths) {
+        for (const auto& p : paths) bytes[p] = fileBytes(p);
+    }
+    void expectUnchanged() const {
+        for (const auto& [p, b] : bytes) EXPECT_TRUE(fileBytes(p) == b) << p << " changed";
+    }
+};
+
+struct Dir : kfd::test::TempDir {
+    Dir() : TempDir("kfd_bad_input_") {}
+    // Copies a file into the folder (inputs are copies: a bug must not damage the originals).
+    std::string copy(const std::string& from, const std::string& name) const {
+        fs::copy_file(from, path / name);
+        return (path / name).string();
+    }
+    std::string write(const std::string& name, const std::string& bytes) const {
+        std::ofstream(path / name, std::ios::binary) << bytes;
+        return (path / name).string();
+    }
+};
+
+const std::string kOffice = std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog";
+const std::string kIni = std::string(KFD_SHARE_DIR) + "/default.ini";
+const std::string kSlamIni = std::string(KFD_SOURCE_DIR) + "/share/kfd-icp-slam/sick-180-5hz.ini";
+const std::string kIntel = std::string(KFD_DATASETS_DIR) + "/intel/intel.rawlog";
+
+// --- output paths ----------------------------------------------------------------------------
+
+TEST(BadInputOutputPaths, FilterStatsOnTheInputRawlogIsRefused) {
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const Snapshot snap({in});
+    const Result r = run(KFD_FILTER_EXE, {"-i", in, "-o", d / "out.rawlog", "--stats", in}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-filter: the stats file " + in + " is the input rawlog " + in +
+                             ": refusing to overwrite an input");
+    EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
+    snap.expectUnchanged();
+}
+
+TEST(BadInputOutputPaths, FilterOutputOrStatsOnTheConfigIsRefused) {
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const auto cfg = d.copy(kIni, "kfd.ini");
+    const Snapshot snap({in, cfg});
+    Result r = run(KFD_FILTER_EXE, {"-i", in, "-c", cfg, "-o", cfg}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-filter: the output rawlog " + cfg + " is the configuration " + cfg +
+                             ": refusing to overwrite an input");
+    r = run(KFD_FILTER_EXE, {"-i", in, "-c", cfg, "-o", d / "out.rawlog", "--stats", cfg}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-filter: the stats file " + cfg + " is the configuration " + cfg +
+                             ": refusing to overwrite an input");
+    EXPECT_EQ(listing(d.path), (std::set<std::string>{"in.rawlog", "kfd.ini"}));
+    snap.expectUnchanged();
+}
+
+TEST(BadInputOutputPaths, FilterOutputThroughASymlinkOrHardLinkToTheInputIsRefused) {
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    fs::create_symlink(in, d / "sym.rawlog");
+    fs::create_hard_link(in, d / "hard.rawlog");
+    fs::create_directory(d / "sub");
+    const Snapshot snap({in});
+    for (const std::string out : {d / "sym.rawlog", d / "hard.rawlog", d / "sub/../in.rawlog"}) {
+        const Result r = run(KFD_FILTER_EXE, {"-i", in, "-o", out}, d.path);
+        EXPECT_EQ(r.status, 1) << out;
+        EXPECT_EQ(r.first(), "kfd-filter: the output rawlog " + out + " is the input rawlog " + in +
+                                 ": refusing to overwrite an input");
+    }
+    // The symlink's target counts too, as a stats file.
+    const Result r = run(KFD_FILTER_EXE,
+                         {"-i", in, "-o", d / "out.rawlog", "--stats", d / "sym.rawlog"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(listing(d.path),
+              (std::set<std::string>{"in.rawlog", "sym.rawlog", "hard.rawlog", "sub"}));
+    snap.expectUnchanged();
+}
+
+TEST(BadInputOutputPaths, FilterOutputAndStatsOnTheSameFileAreRefused) {
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const Snapshot snap({in});
+    const std::string out = d / "out.rawlog";
+    const Result r = run(KFD_FILTER_EXE, {"-i", in, "-o", out, "--stats", out}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-filter: the stats file " + out + " is also the output rawlog " + out);
+    EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
+    snap.expectUnchanged();
+}
+
+TEST(BadInputOutputPaths, FilterFailureLeavesNoStatsFileAndNoTemporary) {
+    Dir d;  // a log cut in the middle of an object: the run fails after writing rows
+    const std::string data = fileBytes(kOffice);
+    const auto in = d.write("cut.rawlog", data.substr(0, data.size() / 2));
+    const Snapshot snap({in});
+    const Result r = run(KFD_FILTER_EXE,
+                         {"-q", "-i", in, "-o", d / "out.rawlog", "--stats", d / "s.csv"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first().rfind("kfd-filter: cannot read object #", 0), 0u) << r.err;
+    EXPECT_EQ(listing(d.path), std::set<std::string>{"cut.rawlog"});
+    snap.expectUnchanged();
+}
+
+TEST(BadInputOutputPaths, IcpSlamChecksEveryInputBeforeTheRun) {
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const auto cfg = d.copy(kSlamIni, "slam.ini");
+    const Snapshot snap({in, cfg});
+    const auto t0 = std::chrono::steady_clock::now();
+    Result r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", d / "out", "--gt", d / "missing.tum"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-icp-slam: ground-truth trajectory not found: " + (d / "missing.tum"));
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+    r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", d / "out", "-g", d / "missing.relations"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-icp-slam: relations file not found: " + (d / "missing.relations"));
+    const auto bad_gt = d.write("bad.tum", "1 2 three\n");
+    r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", d / "out", "--gt", bad_gt}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.first().find("bad.tum"), std::string::npos) << r.err;
+    EXPECT_EQ(listing(d.path), (std::set<std::string>{"in.rawlog", "slam.ini", "bad.tum"}));
+    snap.expectUnchanged();
+}
+
+TEST(BadInputOutputPaths, IcpSlamOutputFolderHoldingAnInputIsRefused) {
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const auto cfg = d.copy(kSlamIni, "slam.ini");
+    fs::create_directory(d / "out");
+    const auto gt = d.copy(std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.gt.tum",
+                           "out/trajectory.tum");
+    const Snapshot snap({in, cfg, gt});
+    Result r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", d / "out", "--gt", gt}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-icp-slam: the output trajectory.tum " + (d / "out/trajectory.tum") +
+                             " is the ground-truth trajectory " + gt +
+                             ": refusing to overwrite an input");
+    r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", in}, d.path);  // the rawlog as the output folder
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-icp-slam: the output folder " + in + " is the rawlog " + in);
+    EXPECT_EQ(listing(d.path),
+              (std::set<std::string>{"in.rawlog", "slam.ini", "out", "out/trajectory.tum"}));
+    snap.expectUnchanged();
+}
+
+TEST(BadInputOutputPaths, IcpSlamFailureKeepsTheFolderAndItsOtherFiles) {
+    Dir d;
+    const std::string data = fileBytes(kOffice);
+    const auto in = d.write("cut.rawlog", data.substr(0, data.size() / 2));
+    const auto cfg = d.copy(kSlamIni, "slam.ini");
+    fs::create_directory(d / "out");
+    const auto mine = d.write("out/notes.txt", "mine\n");
+    const auto old = d.write("out/summary.json", "{}\n");  // an earlier run's file
+    const Snapshot snap({in, cfg, mine, old});
+    const Result r = run(KFD_ICP_SLAM_EXE, {"-q", cfg, in, "-o", d / "out", "-m", "none"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first().rfind("kfd-icp-slam: cannot read object #", 0), 0u) << r.err;
+    EXPECT_EQ(listing(d.path), (std::set<std::string>{"cut.rawlog", "slam.ini", "out",
+                                                      "out/notes.txt", "out/summary.json"}));
+    // A new output folder is not created at all.
+    const Result r2 = run(KFD_ICP_SLAM_EXE, {"-q", cfg, in, "-o", d / "new", "-m", "none"}, d.path);
+    EXPECT_EQ(r2.status, 1);
+    EXPECT_FALSE(fs::exists(d / "new"));
+    EXPECT_EQ(listing(d.path).size(), 5u);
+    snap.expectUnchanged();
+}
+
+TEST(BadInputOutputPaths, SimulateOutputOnItsRouteIsRefused) {
+    Dir d;
+    const auto route = d.write("r.gt.tum", "0 0\n5 0\n");
+    const auto grid = d.write("g.gridmap", "not a gridmap");
+    const Snapshot snap({route, grid});
+    const Result r =
+        run(KFD_SIMULATE_EXE, {"--gridmap", grid, "--route", route, "-o", d / "r.rawlog"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-simulate: the ground truth " + (d / "r.gt.tum") + " is the route " +
+                             route + ": refusing to overwrite an input");
+    EXPECT_EQ(listing(d.path), (std::set<std::string>{"r.gt.tum", "g.gridmap"}));
+    snap.expectUnchanged();
+}
+
+TEST(BadInputOutputPaths, ChartAndRenderOutputOnTheirInputIsRefused) {
+    Dir d;
+    const auto csv = d.write("bars.csv", "group,series,value\na,x,1\n");
+    const Snapshot snap({csv});
+    Result r = run(KFD_CHART_EXE, {csv, "-o", csv}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-chart: the output image " + csv + " is the input CSV " + csv +
+                             ": refusing to overwrite an input");
+    r = run(KFD_CHART_EXE, {csv, "-o", d / "bars.png"}, d.path);  // and the good case
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(listing(d.path), (std::set<std::string>{"bars.csv", "bars.png"}));
+    snap.expectUnchanged();
+#ifdef KFD_RENDER_EXE
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const Snapshot snap2({in});
+    r = run(KFD_RENDER_EXE, {"-i", in, "--index", "3", "-o", in}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-render: the output image " + in + " is the input rawlog " + in +
+                             ": refusing to overwrite an input");
+    snap2.expectUnchanged();
+#endif
+}
+
+// Waits until a temporary output (".*kfd-tmp-*") appears in `dir` or the process ended.
+bool waitForTemporary(pid_t pid, const fs::path& dir) {
+    for (int i = 0; i < 3000; ++i) {
+        for (const auto& name : listing(dir))
+            if (name.find("kfd-tmp-") != std::string::npos) return true;
+        int ws = 0;
+        if (waitpid(pid, &ws, WNOHANG) == pid) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return false;
+}
+
+TEST(BadInputOutputPaths, SigintDuringFilterLeavesNothing) {
+    if (!fs::exists(kIntel)) GTEST_SKIP() << "missing " << kIntel;
+    Dir d;
+    const Snapshot snap({kIntel});
+    const pid_t pid = spawn(
+        KFD_FILTER_EXE,
+        {"-i", kIntel, "-o", d / "out.rawlog", "--stats", d / "s.csv", "--compress", "9"}, d.path);
+    ASSERT_TRUE(waitForTemporary(pid, d.path)) << "the run ended before it could be interrupted";
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    kill(pid, SIGINT);
+    const Result r = finish(pid, d.path);
+    EXPECT_EQ(r.status, 130) << r.err;
+    EXPECT_NE(r.err.find("kfd-filter: interrupted by signal 2; no output written"),
+              std::string::npos)
+        << r.err;
+    EXPECT_TRUE(listing(d.path).empty());
+    snap.expectUnchanged();
+}
+
+TEST(BadInputOutputPaths, SigtermDuringIcpSlamLeavesNothing) {
+    if (!fs::exists(kIntel)) GTEST_SKIP() << "missing " << kIntel;
+    Dir d;
+    const auto cfg = d.copy(kSlamIni, "slam.ini");
+    const Snapshot snap({kIntel, cfg});
+    const pid_t pid = spawn(KFD_ICP_SLAM_EXE, {"-q", cfg, kIntel, "-o", d / "out"}, d.path);
+    ASSERT_TRUE(waitForTemporary(pid, d.path)) << "the run ended before it could be interrupted";
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    kill(pid, SIGTERM);
+    const Result r = finish(pid, d.path);
+    EXPECT_EQ(r.status, 128 + SIGTERM) << r.err;
+    EXPECT_EQ(r.first(), "kfd-icp-slam: interrupted by signal 15; no output written");
+    EXPECT_EQ(listing(d.path), std::set<std::string>{"slam.ini"});
+    snap.expectUnchanged();
+}
+
+// --- truncated input -------------------------------------------------------------------------
+
+// kfd-filter on a damaged copy of a gzip rawlog: exit 1, the reason, nothing written.
+void expectFilterRefuses(const std::string& bytes, const std::string& reason) {
+    Dir d;
+    const auto in = d.write("in.rawlog", bytes);
+    const Snapshot snap({in});
+    const Result r = run(KFD_FILTER_EXE,
+                         {"-q", "-i", in, "-o", d / "out.rawlog", "--stats", d / "s.csv"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    const std::string first = r.first();
+    EXPECT_EQ(first.rfind("kfd-filter: cannot read object #", 0), 0u) << r.err;
+    EXPECT_NE(first.find(reason), std::string::npos) << first;
+    EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
+    snap.expectUnchanged();
+}
+
+TEST(BadInputTruncated, GzipWithoutItsTrailerIsAnError) {
+    const std::string data = fileBytes(kOffice);
+    expectFilterRefuses(data.substr(0, data.size() - 8), "the gzip stream ends early");
+}
+
+TEST(BadInputTruncated, GzipWithAWrongCrcIsAnError) {
+    std::string data = fileBytes(kOffice);
+    data[data.size() - 8] = static_cast<char>(data[data.size() - 8] ^ 0x01);
+    expectFilterRefuses(data, "incorrect data check");
+}
+
+TEST(BadInputTruncated, GzipWithAWrongLengthIsAnError) {
+    std::string data = fileBytes(kOffice);
+    data[data.size() - 1] = static_cast<char>(data[data.size() - 1] ^ 0x01);
+    expectFilterRefuses(data, "incorrect length check");
+}
+
+TEST(BadInputTruncated, GarbageAfterTheGzipStreamIsAnError) {
+    expectFilterRefuses(fileBytes(kOffice) + "garbage", "garbage after the gzip stream");
+}
+
+TEST(BadInputTruncated, IcpSlamOnATruncatedGzipFailsWithNoOutput) {
+    Dir d;
+    const std::string data = fileBytes(kOffice);
+    const auto in = d.write("in.rawlog", data.substr(0, data.size() - 8));
+    const auto cfg = d.copy(kSlamIni, "slam.ini");
+    const Snapshot snap({in, cfg});
+    const Result r =
+        run(KFD_ICP_SLAM_EXE, {"-q", cfg, in, "-o", d / "out", "-m", "none", "--no-map"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first().rfind("kfd-icp-slam: cannot read object #", 0), 0u) << r.err;
+    EXPECT_NE(r.first().find("the gzip stream ends early"), std::string::npos) << r.err;
+    EXPECT_EQ(listing(d.path), (std::set<std::string>{"in.rawlog", "slam.ini"}));
+    snap.expectUnchanged();
+}
+
+TEST(BadInputTruncated, DenoiseEvalAndRenderOnATruncatedLogFail) {
+    Dir d;
+    const std::string data = fileBytes(kOffice);
+    const auto in = d.write("in.rawlog", data.substr(0, data.size() / 2));
+    const auto labels =
+        d.copy(std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.labels.csv", "l.csv");
+    const auto cfg = d.copy(kIni, "kfd.ini");
+    const Snapshot snap({in, labels, cfg});
+    Result r = run(KFD_DENOISE_EVAL_EXE, {"-i", in, "-l", labels, "-c", cfg}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.first().find("truncated or corrupt"), std::string::npos) << r.err;
+#ifdef KFD_RENDER_EXE
+    r = run(KFD_RENDER_EXE, {"-i", in, "--index", "1000000", "-o", d / "x.png"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.first().find("truncated or corrupt"), std::string::npos) << r.err;
+#endif
+    EXPECT_EQ(listing(d.path), (std::set<std::string>{"in.rawlog", "l.csv", "kfd.ini"}));
+    snap.expectUnchanged();
+}
+
+}  // namespace
