@@ -152,6 +152,11 @@ class Cli {
     /// checked (like --version), e.g. `kfd-icp-slam --list-modes`.
     void addInfoFlag(const std::string& names, const std::string& help,
                      std::function<std::string()> text);
+    /// For apps that write files: while the body runs, SIGINT and SIGTERM call
+    /// kfd::requestCancel() instead of killing the process, so that the library loops stop and
+    /// remove their temporary outputs (exit status 128 + N); a second signal kills at once.
+    /// Apps that write nothing keep the default (killed at once).
+    void cancelOnSignal() { cancel_on_signal_ = true; }
     /// The progress printer, or null when -q was given.
     ProgressPrinter* progress();
 
@@ -159,7 +164,7 @@ class Cli {
     /// 2 on bad usage from the parser or a UsageError ("NAME: message" and "Try 'NAME --help'."
     /// on stderr); 1 on any other exception ("NAME: what"), an output that aliases an input
     /// included; 128 + N when signal N (SIGINT, SIGTERM) stopped the run (kfd::Cancelled).
-    /// While `body` runs, SIGINT and SIGTERM call kfd::requestCancel() (a second one kills).
+    /// With cancelOnSignal(), SIGINT and SIGTERM call kfd::requestCancel() while `body` runs.
     int run(int argc, char** argv, const std::function<void()>& body);
 
   private:
@@ -178,6 +183,7 @@ class Cli {
     std::string name_;
     CLI::App app_;
     bool quiet_ = false;
+    bool cancel_on_signal_ = false;
     std::optional<ProgressPrinter> progress_;
 };
 

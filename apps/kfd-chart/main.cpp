@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "common/cli.h"
+#include "kfd/core/cancel.h"
 #include "kfd/render/bar_chart.h"
 
 int main(int argc, char** argv) {
@@ -18,6 +19,7 @@ int main(int argc, char** argv) {
     cli.flag("--log", log_y, "logarithmic y axis");
     cli.option("--size", size, "image width and height in pixels (default 1000 500)", 2, 2)
         ->option_text("W H");
+    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM
     return cli.run(argc, argv, [&] {
         kfd::app::checkOutputPaths({{"input CSV", csv}}, {{"output image", out}});
         auto c = kfd::readBarChartCsv(csv);
@@ -29,6 +31,7 @@ int main(int argc, char** argv) {
         kfd::TempOutputFile tmp(out);  // written under a temporary name, renamed when complete
         if (!c.render().saveToFile(tmp.path().string()))
             throw std::runtime_error("cannot write " + out);
+        kfd::throwIfCancelled();  // interrupted while drawing: nothing is moved into place
         tmp.commit();
     });
 }

@@ -85,6 +85,7 @@ int main(int argc, char** argv) {
                2, 3)
         ->option_text("V F [P_PAIR]");
     cli.addVersion(KFD_VERSION);
+    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM
     return cli.run(argc, argv, [&] {
         if (list_keys) {
             for (const auto& k : kfd::configKeys())

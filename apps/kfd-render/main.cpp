@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
     cli.option("--size", size, "image width and height")->type_name("PX")->capture_default_str();
     cli.option("--extent", extent, "half the visible height in metres (default: fit the scan)")
         ->type_name("M");
+    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM
     return cli.run(argc, argv, [&] {
         if ((index < 0) == std::isnan(stamp))
             throw kfd::app::UsageError("give exactly one of --index and --time");
@@ -76,6 +77,7 @@ int main(int argc, char** argv) {
         auto img = fig.render(scan, den.clusters());
         kfd::TempOutputFile tmp(out);  // written under a temporary name, renamed when complete
         if (!img.saveToFile(tmp.path().string())) throw std::runtime_error("cannot write " + out);
+        kfd::throwIfCancelled();  // interrupted while drawing: nothing is moved into place
         tmp.commit();
         std::printf("kfd-render: scan at %.6f, %zu clusters, %zu noise points -> %s\n",
                     kfd::stampOf(*chosen), r.clusters, r.points_removed, out.c_str());

@@ -328,6 +328,19 @@ TEST(BadInputOutputPaths, SigtermDuringIcpSlamLeavesNothing) {
     snap.expectUnchanged();
 }
 
+TEST(BadInputOutputPaths, SigintDuringSimulateLeavesNoneOfItsFourOutputs) {
+    Dir d;
+    const pid_t pid = spawn(KFD_SIMULATE_EXE, {"-o", d / "sim.rawlog", "-d", "600"}, d.path);
+    ASSERT_TRUE(waitForTemporary(pid, d.path)) << "the run ended before it could be interrupted";
+    kill(pid, SIGINT);
+    const Result r = finish(pid, d.path);
+    EXPECT_EQ(r.status, 130) << r.err;
+    EXPECT_NE(r.err.find("kfd-simulate: interrupted by signal 2; no output written"),
+              std::string::npos)
+        << r.err;
+    EXPECT_TRUE(listing(d.path).empty());
+}
+
 // --- truncated input -------------------------------------------------------------------------
 
 // kfd-filter on a damaged copy of a gzip rawlog: exit 1, the reason, nothing written.
