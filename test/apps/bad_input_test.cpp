@@ -414,4 +414,23 @@ TEST(BadInputTruncated, DenoiseEvalAndRenderOnATruncatedLogFail) {
     snap.expectUnchanged();
 }
 
+TEST(BadInputTruncated, SimulateOnAGridmapWithoutItsGzipTrailerFails) {
+    const std::string grid = std::string(KFD_MRPT_DATASETS_DIR) + "/2006-MalagaCampus.gridmap.gz";
+    if (!fs::exists(grid)) GTEST_SKIP() << "MRPT sample gridmap missing: " << grid;
+    Dir d;
+    const std::string data = fileBytes(grid);
+    const auto cut = d.write("g.gridmap.gz", data.substr(0, data.size() - 8));
+    const auto route = d.write("route.txt", "0 0\n3 0\n");
+    const Snapshot snap({cut, route});
+    const Result r =
+        run(KFD_SIMULATE_EXE, {"-q", "--gridmap", cut, "--route", route, "-o", d / "sim.rawlog"},
+            d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(),
+              "kfd-simulate: " + cut +
+                  ": the gzip stream ends early (no trailer) (truncated or corrupt file?)");
+    EXPECT_EQ(listing(d.path), (std::set<std::string>{"g.gridmap.gz", "route.txt"}));
+    snap.expectUnchanged();
+}
+
 }  // namespace

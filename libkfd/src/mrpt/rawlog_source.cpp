@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <vector>
 
 namespace kfd {
 namespace {
@@ -205,6 +206,18 @@ struct RawlogSource::Impl {
             path);
     }
 };
+
+void checkGzipIntegrity(const std::string& path) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) throw RawlogError("file not found: " + path, path);
+    GzReader in(path);
+    if (!in.isOpen()) throw RawlogError("cannot open " + path, path);
+    std::vector<char> buf(1 << 16);
+    while (in.Read(buf.data(), buf.size()) > 0) {
+    }
+    if (const std::string f = in.failure(); !f.empty())
+        throw RawlogError(path + ": " + f + " (truncated or corrupt file?)", path);
+}
 
 RawlogSource::RawlogSource(const std::string& path) {
     std::error_code ec;

@@ -8,6 +8,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "kfd/mrpt/rawlog_source.h"
+
 namespace kfd {
 namespace {
 
@@ -103,6 +105,7 @@ World loadWorld(const std::string& gridmap, const std::string& route_file) {
     World w;
     w.name = gridmap;
     if (!std::ifstream(gridmap)) throw SimulationError("cannot open gridmap " + gridmap);
+    checkGzipIntegrity(gridmap);  // MRPT's reader passes a gzip file with a bad trailer
     mrpt::io::CFileGZInputStream in;
     if (!in.open(gridmap)) throw SimulationError("cannot open gridmap " + gridmap);
     try {

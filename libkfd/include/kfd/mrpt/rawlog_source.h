@@ -15,6 +15,12 @@ class RawlogError : public SourceError {
     using SourceError::SourceError;
 };
 
+/// Reads a whole file through the same gzip checks as RawlogSource (trailer CRC-32 and length,
+/// a stream cut short, bytes after the last member; a plain file is only read), for inputs that
+/// MRPT reads itself (a .gridmap.gz) and that would pass a damaged trailer. Throws RawlogError
+/// naming the file and the reason.
+void checkGzipIntegrity(const std::string& path);
+
 /// Reads an MRPT rawlog object by object: the "actions + sensory frames" layout
 /// (CActionCollection, CSensoryFrame, ...) or the "observations" layout (CObservation...),
 /// or a mix, plain or gzip-compressed (zlib reads both). An action immediately followed by a
