@@ -1,10 +1,12 @@
 // kfd-icp-slam end to end: equality with MRPT's icp-slam, pose error on a real log, every mode.
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
+#include "kfd/core/cancel.h"
 #include "kfd/eval/trajectory.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/default_stages.h"
@@ -300,6 +302,36 @@ TEST(IcpSlamRunner, GroundTruthTrajectoryGivesAteAndAReport) {
     EXPECT_NE(report.find("ATE RMSE"), std::string::npos);
     EXPECT_NE(report.find("map_figure.png"), std::string::npos);
     EXPECT_TRUE(fs::exists(dir / "out/map_figure.png"));
+}
+
+// API users get the same protection as the app: the output folder appears only on commit, a
+// cancelled run leaves nothing, and an input inside the output's names is refused.
+TEST(IcpSlamRunner, OutputIsStagedUntilCommittedAndACancelledRunLeavesNothing) {
+    TempDir dir;
+    kfd::SimulationOptions so;
+    so.duration_s = 2.0;
+    so.output = dir / "sim.rawlog";
+    const auto sim = kfd::Simulator().run(so);
+    auto o = options(sim.rawlog, dir / "out", kfd::PrefilterMode::None);
+    o.write_map = false;
+    {
+        const auto result = kfd::IcpSlamRunner().run(o);
+        EXPECT_FALSE(fs::exists(dir / "out"));
+        ASSERT_TRUE(result.output);
+        EXPECT_TRUE(fs::exists(result.output->path() / "trajectory.tum"));
+    }  // dropped uncommitted: nothing remains
+    std::size_t entries = 0;
+    for (const auto& e : fs::directory_iterator(dir.path)) entries += e.is_directory();
+    EXPECT_EQ(entries, 0u);
+    kfd::requestCancel(SIGINT);
+    EXPECT_THROW(kfd::IcpSlamRunner().run(o), kfd::Cancelled);
+    kfd::resetCancel();
+    EXPECT_FALSE(fs::exists(dir / "out"));
+    const auto result = kfd::IcpSlamRunner().run(o);
+    result.output->commit();
+    EXPECT_TRUE(fs::exists(dir / "out/trajectory.tum"));
+    o.ground_truth_tum = dir / "out/trajectory.tum";
+    EXPECT_THROW(kfd::IcpSlamRunner().run(o), kfd::PathError);
 }
 
 TEST(IcpSlamRunner, TruncatedRawlogIsAnErrorNotAShortRun) {
