@@ -131,8 +131,9 @@ TEST(BadInputScans, IcpSlamInEveryModeSkipsBadScansAndWritesFinitePoses) {
             EXPECT_NE(json.find("\"scans_skipped\": 3"), std::string::npos) << json;
             EXPECT_NE(json.find("\"bad_aperture\": 2"), std::string::npos) << json;
             EXPECT_NE(json.find("\"no_beams\": 1"), std::string::npos) << json;
-            if (observations)
+            if (observations) {
                 EXPECT_NE(json.find("\"odometry_bad\": 1"), std::string::npos) << json;
+            }
             const std::string csv = fileBytes(out + "/scans.csv");
             EXPECT_NE(csv.find(",skipped:bad_aperture,"), std::string::npos);
             // Every pose finite (NaN odometry produced NaN poses with exit 0 before).

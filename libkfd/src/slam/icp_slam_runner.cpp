@@ -103,7 +103,10 @@ std::vector<ScanStamp> scanOdometry(const std::string& rawlog) {
     while (nextEntry(*source, e)) {
         if (!steps.feed(e, step)) continue;
         auto add = [&](const mrpt::obs::CObservation& o) {
-            if (IS_CLASS(o, CObservation2DRangeScan)) out.push_back({stampOf(o), e.odometry});
+            if (!IS_CLASS(o, CObservation2DRangeScan)) return;
+            std::optional<Pose2D> odo = e.odometry;  // non-finite: unknown, as checkScan does
+            if (odo && !finitePose(odo->x, odo->y, odo->phi)) odo.reset();
+            out.push_back({stampOf(o), odo});
         };
         if (step.observation)
             add(*step.observation);
@@ -275,7 +278,7 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
             }
             // odometry kept even if the frame is empty; a non-finite odometry action is left out
             // (the map builder then matches without a motion prior)
-            const mrpt::obs::CActionCollection* action = step.action.get();
+            mrpt::obs::CActionCollection* action = step.action.get();
             mrpt::obs::CActionCollection finite_actions;
             if (auto mv = action->getBestMovementEstimation()) {
                 const auto d = mv->rawOdometryIncrementReading;

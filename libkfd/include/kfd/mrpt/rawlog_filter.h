@@ -61,14 +61,16 @@ struct RawlogFilterSummary {
 /// Reads `input` object by object (never loading it whole), runs every 2D range scan through a
 /// StreamFilter, and writes every other object unchanged and in order. Non-keyframe scans are
 /// removed; a sensory frame left empty is dropped and its odometry action is composed into the
-/// next kept action, so the output's odometry still adds up. A scan that kfd::checkScan rejects
-/// (beam count outside [2, 65 536], aperture not finite, <= 0 or > 2*pi) never reaches a stage:
-/// it is removed from the output exactly like a non-keyframe, counted in scans_skipped and
-/// skipped_by_reason, and its stats row has reason "skipped:<reason>" (points_in = its beam count,
-/// zeros elsewhere); the run goes on. Beams
-/// with a NaN, infinite, negative or huge range are marked invalid in the output (counted in
-/// beams_bad_range). The input is never modified; on
-/// any error no output file is left behind. Throws RawlogError or ConfigError.
+/// next kept action, so the output's odometry still adds up.
+///
+/// A scan that kfd::checkScan rejects (beam count outside [2, 65 536], aperture not finite,
+/// <= 0 or > 2*pi) never reaches a stage: it is removed from the output exactly like a
+/// non-keyframe, counted in scans_skipped and skipped_by_reason, and its stats row has reason
+/// "skipped:<reason>" (points_in = its beam count, zeros elsewhere); the run goes on. Beams with
+/// a NaN, infinite, negative or huge range are marked invalid in the output (beams_bad_range).
+///
+/// The input is never modified; on any error no output file is left behind. Throws RawlogError
+/// or ConfigError.
 class RawlogFilter {
   public:
     RawlogFilterSummary run(const RawlogFilterOptions& opts);
