@@ -1,4 +1,5 @@
 // kfd-eval: trajectory error against ground truth (relations metric, ATE, RPE).
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -30,6 +31,12 @@ int main(int argc, char** argv) {
     return cli.run(argc, argv, [&] {
         if (rel_file.empty() && gt_file.empty())
             throw kfd::app::UsageError("give --relations and/or --gt");
+        if (!(max_dt >= 0.0) || !std::isfinite(max_dt))
+            throw kfd::app::UsageError("--max-dt: must be finite and >= 0 (got " +
+                                       std::to_string(max_dt) + ")");
+        if (!(rpe_delta > 0.0) || !std::isfinite(rpe_delta))
+            throw kfd::app::UsageError("--rpe-delta: must be finite and > 0 (got " +
+                                       std::to_string(rpe_delta) + ")");
         auto est = kfd::readTum(est_file);
         kfd::sortByTime(est);
         std::printf("estimate   %s (%zu poses)\n", est_file.c_str(), est.size());

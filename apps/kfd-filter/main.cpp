@@ -24,6 +24,19 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
                 s.points_in ? 100.0 * removed / static_cast<double>(s.points_in) : 0.0);
     std::printf("  objects  in %zu, out %zu, dropped %zu, odometry actions merged %zu\n",
                 s.objects_in, s.objects_out, s.objects_dropped, s.actions_merged);
+    if (s.scans_skipped) {
+        std::printf("  skipped  %zu (bad geometry, dropped from the output):", s.scans_skipped);
+        for (std::size_t r = 1; r < kfd::kScanSkipReasons; ++r)
+            if (s.skipped_by_reason[r])
+                std::printf(" %s %zu", kfd::toString(static_cast<kfd::ScanSkipReason>(r)),
+                            s.skipped_by_reason[r]);
+        std::printf("\n");
+    }
+    if (s.beams_bad_range || s.odometry_bad || s.stamps_backwards)
+        std::printf(
+            "  repaired %zu beams with a bad range marked invalid, %zu scans with "
+            "non-finite odometry, %zu stamps going backwards\n",
+            s.beams_bad_range, s.odometry_bad, s.stamps_backwards);
     if (s.geometry_resets)
         std::printf("  resets   %zu (scan geometry changed)\n", s.geometry_resets);
     std::printf("  time     wall %.2f s, filter %.3f s (%.1f us per scan)\n", s.wall_seconds,

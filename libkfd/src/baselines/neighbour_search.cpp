@@ -15,7 +15,7 @@ void ScanPoints::assign(const Scan& scan) {
     nonfinite.clear();
     for (std::size_t i = 0; i < scan.range.size(); ++i) {
         if (!scan.valid[i]) continue;
-        if (!std::isfinite(scan.range[i])) {
+        if (!isUsableRange(scan.range[i])) {
             nonfinite.push_back(static_cast<std::uint32_t>(i));
             continue;
         }
@@ -52,16 +52,18 @@ float slack(float bound) {
     return std::nextafter(bound * (1.0f + 1e-5f), std::numeric_limits<float>::max());
 }
 
-// Every index within r2 (inclusive), straight into the caller's vector.
+// Every index within r2 (inclusive), straight into the caller's vector, up to `max` of them:
+// returning false from addPoint() ends nanoflann's search (1.4: searchLevel returns at once).
 struct RadiusSet {
     float r2;
     float worst;
     std::vector<std::uint32_t>* out;
+    std::size_t max;
     bool full() const { return true; }
     float worstDist() const { return worst; }
     bool addPoint(float d2, std::uint32_t i) {
         if (d2 <= r2) out->push_back(i);
-        return true;
+        return out->size() < max;
     }
 };
 
@@ -112,11 +114,12 @@ void NeighbourSearch2D::build(const float* x, const float* y, std::size_t n) {
     impl_->tree.buildIndex();  // reuses the index vector; the node pool is refilled
 }
 
-void NeighbourSearch2D::radius(float qx, float qy, float r, std::vector<std::uint32_t>& out) const {
+void NeighbourSearch2D::radius(float qx, float qy, float r, std::vector<std::uint32_t>& out,
+                               std::size_t max_count) const {
     out.clear();
-    if (impl_->cloud.n == 0) return;
+    if (impl_->cloud.n == 0 || max_count == 0) return;
     const float r2 = r * r;
-    RadiusSet set{r2, slack(r2), &out};
+    RadiusSet set{r2, slack(r2), &out, max_count};
     const float q[2] = {qx, qy};
     impl_->tree.findNeighbors(set, q, nanoflann::SearchParams());
 }

@@ -22,7 +22,8 @@ RadiusOutlierFilter::Result RadiusOutlierFilter::filter(Scan& scan) {
     tree_.build(pts_.x.data(), pts_.y.data(), m);
     const float r = static_cast<float>(params_.radius_m);
     for (std::size_t p = 0; p < m; ++p) {
-        tree_.radius(pts_.x[p], pts_.y[p], r, neighbours_);
+        // Capped at min_neighbors + 1 (p itself and min_neighbors others): enough to decide.
+        tree_.radius(pts_.x[p], pts_.y[p], r, neighbours_, params_.min_neighbors + 1);
         // The answer always holds p itself (distance 0); the others are its neighbours.
         if (neighbours_.size() - 1 < params_.min_neighbors) noise_.push_back(pts_.beam[p]);
     }

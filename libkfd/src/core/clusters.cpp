@@ -36,8 +36,11 @@ void Clusters::finalize(const Scan& scan, std::vector<std::int32_t>& provisional
 }
 
 std::size_t minClusterPoints(const ClusterFilterParams& p, double mean_range, double resolution) {
-    if (p.min_object_size_m <= 0.0 || resolution <= 0.0 || mean_range <= 0.0) return p.m_threshold;
+    // Negated tests: a NaN range or resolution falls back to m_threshold (never cast NaN).
+    if (!(p.min_object_size_m > 0.0) || !(resolution > 0.0) || !(mean_range > 0.0))
+        return p.m_threshold;
     const double beams = std::ceil(p.min_object_size_m / (mean_range * resolution));
+    if (!std::isfinite(beams)) return p.m_threshold;
     const double lo = static_cast<double>(std::min(p.min_points_floor, p.m_threshold));
     const double hi = static_cast<double>(p.m_threshold);
     return static_cast<std::size_t>(std::clamp(beams, lo, hi));

@@ -32,6 +32,14 @@ Denoiser::Result Denoiser::filter(Scan& scan) {
     Result res;
     res.variant = params_.variant;
     res.points_in = scan.countValid();
+    // A beam without a usable range (NaN, +-inf, negative, above kMaxScanRangeM) has no place in
+    // a cluster: removed first (normally the distance stage has already done so).
+    std::size_t unusable = 0;
+    for (std::size_t i = 0; i < scan.range.size(); ++i)
+        if (scan.valid[i] && !isUsableRange(scan.range[i])) {
+            scan.valid[i] = 0;
+            ++unusable;
+        }
     if (params_.variant == DenoiseVariant::Reference) {
         const auto r = reference_.cluster(scan, clusters_);
         res.blocks = r.blocks;
@@ -43,7 +51,7 @@ Denoiser::Result Denoiser::filter(Scan& scan) {
         res.merges = r.merges;
         res.theta_threshold = r.theta_threshold;
     }
-    res.points_removed = filterClusters(filter_, scan, clusters_);
+    res.points_removed = unusable + filterClusters(filter_, scan, clusters_);
     res.clusters = clusters_.count();
     for (const auto f : clusters_.noise) res.noise_clusters += f;
     return res;

@@ -1,6 +1,7 @@
 #include "kfd/core/pipeline.h"
 
 #include <chrono>
+#include <string>
 
 #include "kfd/core/denoise_stage.h"
 
@@ -81,6 +82,13 @@ ScanReport Pipeline::process(Scan& scan) {
     ScanReport report;
     if (scan.valid.size() != scan.range.size())
         throw ScanError("scan: range and valid sizes differ");
+    {
+        ScanGeometry g = scan.geometry;
+        g.beams = scan.range.size();  // the stages follow the data's length
+        const ScanSkipReason why = checkGeometry(g);
+        if (why != ScanSkipReason::None)
+            throw ScanError(std::string("scan: unusable geometry (") + toString(why) + ")");
+    }
     report.points_in = scan.countValid();
     // One clock read per stage: each stage's end is the next one's start.
     auto t = t0;

@@ -2,10 +2,21 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <string>
 
 namespace kfd {
+namespace {
+
+void checkMaxDt(double max_dt) {
+    if (!(max_dt >= 0.0) || !std::isfinite(max_dt))
+        throw EvalError("max_dt must be finite and >= 0 (got " + std::to_string(max_dt) + " s)",
+                        "max_dt");
+}
+
+}  // namespace
 
 AteResult computeAte(const Trajectory& est, const Trajectory& gt, double max_dt) {
+    checkMaxDt(max_dt);
     AteResult res;
     std::vector<Eigen::Vector2d> a, b;  // estimate, ground truth
     for (const auto& p : est) {
@@ -18,7 +29,10 @@ AteResult computeAte(const Trajectory& est, const Trajectory& gt, double max_dt)
         b.emplace_back(gt[*j].pose.x, gt[*j].pose.y);
     }
     res.matched = a.size();
-    if (a.size() < 2) throw EvalError("ATE needs at least 2 matched poses");
+    if (a.size() < 2)
+        throw EvalError("ATE needs at least 2 matched poses (" + std::to_string(a.size()) + " of " +
+                        std::to_string(est.size()) + " matched within " + std::to_string(max_dt) +
+                        " s)");
     // Umeyama without scale: R, t minimising sum |b - (R a + t)|^2.
     Eigen::Vector2d ma = Eigen::Vector2d::Zero(), mb = Eigen::Vector2d::Zero();
     for (std::size_t i = 0; i < a.size(); ++i) {
@@ -47,6 +61,11 @@ AteResult computeAte(const Trajectory& est, const Trajectory& gt, double max_dt)
 }
 
 RpeResult computeRpe(const Trajectory& est, const Trajectory& gt, double delta_s, double max_dt) {
+    checkMaxDt(max_dt);
+    if (!(delta_s > 0.0) || !std::isfinite(delta_s))
+        throw EvalError(
+            "the RPE step must be finite and > 0 (got " + std::to_string(delta_s) + " s)",
+            "delta_s");
     RpeResult res;
     double st = 0, sr = 0;
     std::size_t j = 0;
@@ -68,7 +87,10 @@ RpeResult computeRpe(const Trajectory& est, const Trajectory& gt, double delta_s
         sr += r * r;
         ++res.pairs;
     }
-    if (res.pairs) {
+    if (res.pairs == 0)
+        throw EvalError("RPE: no pose pair " + std::to_string(delta_s) +
+                        " s apart matched the estimate within " + std::to_string(max_dt) + " s");
+    {
         res.trans_rmse = std::sqrt(st / static_cast<double>(res.pairs));
         res.rot_rmse_deg = std::sqrt(sr / static_cast<double>(res.pairs));
     }

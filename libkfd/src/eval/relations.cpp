@@ -34,6 +34,10 @@ std::vector<Relation> readRelations(const std::string& path) {
 
 RelationsError evaluateRelations(const Trajectory& traj, const std::vector<Relation>& relations,
                                  double max_dt) {
+    if (!(max_dt >= 0.0) || !std::isfinite(max_dt))
+        throw EvalError("max_dt must be finite and >= 0 (got " + std::to_string(max_dt) + " s)",
+                        "max_dt");
+    if (relations.empty()) throw EvalError("no relations to evaluate");
     RelationsError e;
     Stats t, r, t2, r2;
     for (const auto& rel : relations) {
@@ -52,6 +56,10 @@ RelationsError evaluateRelations(const Trajectory& traj, const std::vector<Relat
         r2.add(er * er);
     }
     e.used = t.n;
+    if (e.used == 0)
+        throw EvalError("no relation matched the trajectory: " + std::to_string(e.unmatched) +
+                        " relations, none with both stamps within " + std::to_string(max_dt) +
+                        " s of a pose (" + std::to_string(traj.size()) + " poses)");
     e.trans_mean = t.mean();
     e.trans_std = t.stddev();
     e.rot_mean_deg = r.mean();

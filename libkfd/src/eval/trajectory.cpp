@@ -1,6 +1,7 @@
 #include "kfd/eval/trajectory.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -36,19 +37,30 @@ void readNumericRows(const std::string& path, const std::string& what, std::size
         ++lineno;
         const auto b = line.find_first_not_of(" \t\r");
         if (b == std::string::npos || line[b] == '#') continue;
+        const std::string where = path + ":" + std::to_string(lineno);
         std::istringstream ss(line);
-        for (auto& x : v)
-            if (!(ss >> x))
-                throw EvalError(path + ":" + std::to_string(lineno) + ": expected '" + expected +
-                                "'");
-        row(v.data());
+        for (auto& x : v) {
+            // A number must end at a space or the line's end ("1.5abc" is not a number) and be
+            // finite (libstdc++ does not read "nan"/"inf"; an out-of-range value fails too).
+            if (!(ss >> x) || !std::isfinite(x) ||
+                (ss.peek() != std::char_traits<char>::eof() && !std::isspace(ss.peek())))
+                throw EvalError(where + ": expected '" + expected + "' (numbers)", where);
+        }
+        try {
+            row(v.data());
+        } catch (const EvalError& e) {  // a row the caller rejects: name the file and line
+            throw EvalError(where + ": " + e.what(), where);
+        }
     }
 }
 
 Trajectory readTum(const std::string& path) {
     Trajectory traj;
     readNumericRows(path, "trajectory", 8, "t x y z qx qy qz qw", [&](const double* v) {
-        const double qx = v[4], qy = v[5], qz = v[6], qw = v[7];
+        const double norm = std::sqrt(v[4] * v[4] + v[5] * v[5] + v[6] * v[6] + v[7] * v[7]);
+        if (!(norm > 1e-9)) throw EvalError("the quaternion has norm 0");
+        // The yaw formula below needs a unit quaternion.
+        const double qx = v[4] / norm, qy = v[5] / norm, qz = v[6] / norm, qw = v[7] / norm;
         const double yaw = std::atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz));
         traj.push_back(StampedPose{v[0], Pose2D{v[1], v[2], yaw}});
     });

@@ -17,6 +17,8 @@
 #include "kfd/core/cancel.h"
 #include "kfd/core/output_paths.h"
 
+#include "kfd/mrpt/scan_check.h"
+
 namespace kfd {
 namespace {
 
@@ -50,6 +52,13 @@ class CsvWriter {
                       kf ? toString(kf->reason) : "none", k.p_common, k.p_threshold, k.references,
                       s.points_in, d.removed_non_finite + d.removed_out_of_range, n.clusters,
                       n.noise_clusters, s.noiseRemoved(), s.points_out, s.microseconds);
+        out_ << buf;
+    }
+    void skippedRow(std::size_t index, double stamp, const std::string& sensor, ScanSkipReason why,
+                    std::size_t points_in) {
+        char buf[256];
+        std::snprintf(buf, sizeof(buf), "%zu,%.6f,%s,0,skipped:%s,0,0,0,%zu,0,0,0,0,0,0\n", index,
+                      stamp, sensor.c_str(), toString(why), points_in);
         out_ << buf;
     }
     void close() {
@@ -103,12 +112,27 @@ void Run::write(const mrpt::serialization::CSerializable& obj) {
 bool Run::handleScan(CObservation2DRangeScan& scan) {
     ++sum_.scans_in;
     const double stamp = stampForOutput(stampOf(scan));
+    // A scan with a bad geometry is skipped (dropped from the output, counted); bad ranges and
+    // odometry are repaired by checkScan and the scan goes on.
+    std::optional<Pose2D> odometry = odometry_;
+    const ScanCheck check = checkScan(scan, &odometry);
+    sum_.beams_bad_range += check.bad_ranges;
+    sum_.odometry_bad += check.bad_odometry ? 1 : 0;
+    if (!check.ok()) {
+        ++sum_.scans_skipped;
+        ++sum_.skipped_by_reason[static_cast<std::size_t>(check.reject)];
+        if (csv_.isOpen())
+            csv_.skippedRow(scan_index_, stamp, scan.sensorLabel, check.reject, scan.getScanSize());
+        ++scan_index_;
+        return false;
+    }
     StreamResult r;
     try {
-        r = filter_.process(scan, odometry_);
-    } catch (const ScanError& e) {
+        r = filter_.process(scan, odometry);
+    } catch (const ScanError& e) {  // not reached: checkScan passed
         throw RawlogError("scan " + std::to_string(scan_index_) + ": " + e.what());
     }
+    sum_.stamps_backwards += r.stamp_backwards ? 1 : 0;
     sum_.points_in += r.report.points_in;
     sum_.filter_seconds += r.report.microseconds * 1e-6;
     sum_.geometry_resets += r.geometry_reset ? 1 : 0;

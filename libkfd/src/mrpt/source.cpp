@@ -4,11 +4,15 @@
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservationOdometry.h>
 
+#include <cmath>
 #include <limits>
 
 #include "kfd/mrpt/rawlog_source.h"
 
 namespace kfd {
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+}  // namespace
 
 double stampOf(const mrpt::obs::CObservation& obs) {
     return obs.timestamp == mrpt::Clock::time_point() ? std::numeric_limits<double>::quiet_NaN()
@@ -17,7 +21,12 @@ double stampOf(const mrpt::obs::CObservation& obs) {
 
 void OdometryTracker::onAction(const mrpt::obs::CActionCollection& actions) {
     if (auto mv = actions.getBestMovementEstimation()) {
-        accum_ = accum_ + mv->rawOdometryIncrementReading;
+        const auto& d = mv->rawOdometryIncrementReading;
+        if (!finitePose(d.x(), d.y(), d.phi())) {  // this reading only is bad (kfd::checkScan)
+            current_ = Pose2D{kNaN, kNaN, kNaN};
+            return;
+        }
+        accum_ = accum_ + d;
         current_ = Pose2D{accum_.x(), accum_.y(), accum_.phi()};
     }
 }
@@ -25,6 +34,10 @@ void OdometryTracker::onAction(const mrpt::obs::CActionCollection& actions) {
 void OdometryTracker::onObservation(const mrpt::obs::CObservation& obs) {
     if (const auto* odo = dynamic_cast<const mrpt::obs::CObservationOdometry*>(&obs))
         current_ = Pose2D{odo->odometry.x(), odo->odometry.y(), odo->odometry.phi()};
+}
+
+bool finitePose(double x, double y, double phi) {
+    return std::isfinite(x) && std::isfinite(y) && std::isfinite(phi);
 }
 
 std::unique_ptr<Source> openSource(const std::string& path) {

@@ -1,9 +1,11 @@
 #include "kfd/mrpt/stream_filter.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "kfd/mrpt/default_stages.h"
 #include "kfd/mrpt/scan_adapter.h"
+#include "kfd/mrpt/scan_check.h"
 
 namespace kfd {
 
@@ -25,8 +27,13 @@ StreamFilter::Sensor& StreamFilter::sensorFor(const std::string& label) {
 
 StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
                                    const std::optional<Pose2D>& odometry) {
-    if (obs.getScanSize() == 0) throw ScanError("scan has no beams");
+    std::optional<Pose2D> odo = odometry;
+    const ScanCheck check = checkScan(obs, &odo);
+    if (!check.ok())
+        throw ScanError(std::string("scan rejected: ") + toString(check.reject), "scan");
     StreamResult res;
+    res.bad_ranges = check.bad_ranges;
+    res.bad_odometry = check.bad_odometry;
     res.sensor_label = obs.sensorLabel;
     Sensor& s = sensorFor(obs.sensorLabel);
     const ScanGeometry g = geometryOf(obs);
@@ -36,7 +43,11 @@ StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
     }
     s.geometry = g;
     toCore(obs, s.scan);
-    s.scan.odometry = odometry;
+    s.scan.odometry = odo;
+    if (std::isfinite(s.scan.timestamp)) {
+        res.stamp_backwards = std::isfinite(s.last_stamp) && s.scan.timestamp < s.last_stamp;
+        s.last_stamp = s.scan.timestamp;
+    }
     res.report = s.pipeline->process(s.scan);
     res.keep = res.report.keep;
     applyValidity(s.scan, obs);

@@ -90,6 +90,15 @@ std::string toJson(const IcpSlamSummary& s) {
     j["scans_in"] = s.scans_in;
     j["scans_kept"] = s.scans_kept;
     j["dropped_pct"] = s.dropped_pct;
+    j["scans_skipped"] = s.scans_skipped;  // kfd::checkScan: bad geometry, never reached ICP
+    {
+        nlohmann::ordered_json by_reason = nlohmann::ordered_json::object();
+        for (std::size_t r = 1; r < kScanSkipReasons; ++r)
+            by_reason[toString(static_cast<ScanSkipReason>(r))] = s.skipped_by_reason[r];
+        j["scans_skipped_by_reason"] = by_reason;
+    }
+    j["beams_bad_range"] = s.beams_bad_range;
+    j["odometry_bad"] = s.odometry_bad;
     j["points_in"] = s.points_in;
     j["points_removed"] = s.points_removed;
     j["prefilter_us_per_scan"] = s.prefilter_us_per_scan;

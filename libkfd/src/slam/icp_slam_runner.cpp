@@ -2,7 +2,9 @@
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose3DPDF.h>
 #include <mrpt/slam/CMetricMapBuilderICP.h>
@@ -18,6 +20,7 @@
 #include "kfd/core/cancel.h"
 #include "kfd/eval/ate.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/mrpt/scan_check.h"
 #include "kfd/mrpt/source.h"
 #include "kfd/mrpt/stream_filter.h"
 
@@ -110,7 +113,10 @@ std::vector<ScanStamp> scanOdometry(const std::string& rawlog) {
         throwIfCancelled();
         if (!steps.feed(e, step)) continue;
         auto add = [&](const mrpt::obs::CObservation& o) {
-            if (IS_CLASS(o, CObservation2DRangeScan)) out.push_back({stampOf(o), e.odometry});
+            if (!IS_CLASS(o, CObservation2DRangeScan)) return;
+            std::optional<Pose2D> odo = e.odometry;  // non-finite: unknown, as checkScan does
+            if (odo && !finitePose(odo->x, odo->y, odo->phi)) odo.reset();
+            out.push_back({stampOf(o), odo});
         };
         if (step.observation)
             add(*step.observation);
@@ -198,8 +204,15 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
     }
     StreamFilter prefilter(sum.pipeline);
 
+    if (!(opts.relations_max_dt >= 0.0) || !std::isfinite(opts.relations_max_dt))
+        throw SlamError("the stamp matching tolerance must be finite and >= 0 (got " +
+                            std::to_string(opts.relations_max_dt) + " s)",
+                        "relations_max_dt");
     std::vector<Relation> relations;
-    if (!opts.relations.empty()) relations = readRelations(opts.relations);  // EvalError
+    if (!opts.relations.empty()) {
+        relations = readRelations(opts.relations);  // EvalError
+        if (relations.empty()) throw SlamError("no relation in " + opts.relations, opts.relations);
+    }
     if (!opts.ground_truth_tum.empty()) {  // read before the run: a bad file fails at once
         res.ground_truth = readTum(opts.ground_truth_tum);  // EvalError
         sortByTime(res.ground_truth);
@@ -237,20 +250,40 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
         double t;
         std::string sensor;
         StreamResult r;
+        std::optional<Pose2D> odometry;                 // after kfd::checkScan
+        ScanSkipReason skipped = ScanSkipReason::None;  // not None: never reached ICP
     };
     std::vector<Pending> entry_scans;
     SourceEntry e;
     IcpSlamSteps steps;
     IcpSlamStep step;
 
+    // Every scan is checked first, in every mode (`none` included): a bad geometry skips it (it
+    // never reaches a stage nor the map builder), bad ranges are marked invalid, non-finite
+    // odometry becomes unknown.
     auto prefilterScan = [&](CObservation2DRangeScan& scan) {
-        StreamResult r = prefilter.process(scan, e.odometry);
+        std::optional<Pose2D> odo = e.odometry;
+        const ScanCheck check = checkScan(scan, &odo);
+        sum.beams_bad_range += check.bad_ranges;
+        sum.odometry_bad += check.bad_odometry ? 1 : 0;
+        if (!check.ok()) {
+            ++sum.scans_in;
+            ++sum.scans_skipped;
+            ++sum.skipped_by_reason[static_cast<std::size_t>(check.reject)];
+            StreamResult r;
+            r.keep = false;
+            r.sensor_label = scan.sensorLabel;
+            entry_scans.push_back(
+                {stampForOutput(stampOf(scan)), scan.sensorLabel, std::move(r), odo, check.reject});
+            return false;
+        }
+        StreamResult r = prefilter.process(scan, odo);
         ++sum.scans_in;
         sum.scans_kept += r.keep;
         sum.points_in += r.report.points_in;
         if (r.keep) sum.points_removed += r.report.points_in - r.report.points_out;
         prefilter_us += r.report.microseconds;
-        entry_scans.push_back({stampForOutput(stampOf(scan)), scan.sensorLabel, std::move(r)});
+        entry_scans.push_back({stampForOutput(stampOf(scan)), scan.sensorLabel, std::move(r), odo});
         return entry_scans.back().r.keep;
     };
     auto timed = [&](auto&& process) {
@@ -267,6 +300,9 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
             bool process = true;
             if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(step.observation))
                 process = prefilterScan(*scan);
+            else if (const auto* odo = dynamic_cast<const mrpt::obs::CObservationOdometry*>(
+                         step.observation.get()))
+                process = finitePose(odo->odometry.x(), odo->odometry.y(), odo->odometry.phi());
             if (process) timed([&] { builder.processObservation(step.observation); });
         } else {
             for (auto it = step.frame->begin(); it != step.frame->end();) {
@@ -276,8 +312,21 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
                 else
                     ++it;
             }
-            // odometry kept even if the frame is empty
-            timed([&] { builder.processActionObservation(*step.action, *step.frame); });
+            // odometry kept even if the frame is empty; a non-finite odometry action is left out
+            // (the map builder then matches without a motion prior)
+            mrpt::obs::CActionCollection* action = step.action.get();
+            mrpt::obs::CActionCollection finite_actions;
+            if (auto mv = action->getBestMovementEstimation()) {
+                const auto d = mv->rawOdometryIncrementReading;
+                const auto m = mv->poseChange ? mv->poseChange->getMeanVal() : d;
+                if (!finitePose(d.x(), d.y(), d.phi()) || !finitePose(m.x(), m.y(), m.phi())) {
+                    for (std::size_t k = 0; k < action->size(); ++k)
+                        if (action->get(k).get() != mv.get())
+                            finite_actions.insert(*action->get(k));
+                    action = &finite_actions;
+                }
+            }
+            timed([&] { builder.processActionObservation(*action, *step.frame); });
         }
         const auto pose = builder.getCurrentPoseEstimation()->getMeanVal();
         std::snprintf(buf, sizeof(buf), "%i %f %f %f\n", static_cast<int>(step_no), pose.x(),
@@ -285,13 +334,18 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
         f_path << buf;
         for (const auto& s : entry_scans) {
             if (s.r.keep) res.keyframes.push_back(traj.size());
-            if (e.odometry) res.odometry.push_back(StampedPose{s.t, *e.odometry});
+            if (s.odometry) res.odometry.push_back(StampedPose{s.t, *s.odometry});
             traj.push_back(StampedPose{s.t, Pose2D{pose.x(), pose.y(), pose.yaw()}});
             const auto& rep = s.r.report;
             const auto* kf = rep.find<KeyframeDecision>();
+            const std::string skipped = s.skipped != ScanSkipReason::None
+                                            ? std::string("skipped:") + toString(s.skipped)
+                                            : std::string();
             std::snprintf(buf, sizeof(buf), "%zu,%.6f,%s,%d,%s,%.6f,%zu,%zu,%.2f,%.6f,%.6f,%.6f\n",
                           traj.size() - 1, s.t, s.sensor.c_str(), s.r.keep ? 1 : 0,
-                          kf ? toString(kf->reason) : (s.r.keep ? "kept" : rep.dropped_by.c_str()),
+                          !skipped.empty() ? skipped.c_str()
+                          : kf             ? toString(kf->reason)
+                                           : (s.r.keep ? "kept" : rep.dropped_by.c_str()),
                           kf ? kf->p_common : 0.0, rep.points_in, rep.points_in - rep.points_out,
                           rep.microseconds, pose.x(), pose.y(), pose.yaw());
             f_csv << buf;
@@ -329,6 +383,7 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
     if (!relations.empty()) {
         Trajectory sorted = traj;
         sortByTime(sorted);
+        // EvalError when no relation matched (never a perfect 0.0)
         sum.relations = evaluateRelations(sorted, relations, opts.relations_max_dt);
         sum.relations_file = opts.relations;
     }

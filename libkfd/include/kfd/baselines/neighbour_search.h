@@ -14,10 +14,12 @@ namespace kfd {
 /// The Cartesian points of a scan's valid beams, for the neighbour-based denoisers (DBSCAN,
 /// radius and statistical outlier removal). Buffers are reused between scans.
 struct ScanPoints {
-    std::vector<float> x, y;               // m, sensor frame
-    std::vector<std::uint32_t> beam;       // point -> beam index
-    std::vector<std::uint32_t> nonfinite;  // valid beams without a finite range (no position)
-    /// Rebuilds the points from the scan's valid beams with a finite range.
+    std::vector<float> x, y;          // m, sensor frame
+    std::vector<std::uint32_t> beam;  // point -> beam index
+    /// Valid beams without a usable range (no position): NaN, +-inf, negative or above
+    /// kMaxScanRangeM (kfd::isUsableRange); the baselines treat them as noise.
+    std::vector<std::uint32_t> nonfinite;
+    /// Rebuilds the points from the scan's valid beams with a usable range.
     void assign(const Scan& scan);
     std::size_t size() const { return x.size(); }
 };
@@ -42,9 +44,13 @@ class NeighbourSearch2D {
     /// Builds the tree over n points. The arrays must outlive the queries.
     void build(const float* x, const float* y, std::size_t n);
 
-    /// Writes to `out` (cleared first) the indices of all points within `radius` (inclusive)
-    /// of (qx, qy), in no particular order. O(log n + k) on average.
-    void radius(float qx, float qy, float radius, std::vector<std::uint32_t>& out) const;
+    /// Writes to `out` (cleared first) the indices of the points within `radius` (inclusive)
+    /// of (qx, qy), in no particular order, stopping as soon as `max_count` were found (then
+    /// which ones is unspecified; fewer than max_count means all of them). O(log n + k) on
+    /// average, k = min(neighbours, max_count): callers that only need "at least m" pass m, so
+    /// a dense neighbourhood costs O(m), not O(n), and `out` never holds more than max_count.
+    void radius(float qx, float qy, float radius, std::vector<std::uint32_t>& out,
+                std::size_t max_count = static_cast<std::size_t>(-1)) const;
 
     /// Writes to `idx` and `dist2` (both cleared first) the min(k, n) points nearest to
     /// (qx, qy) and their squared distances (float, dx*dx + dy*dy as in radius()), by increasing

@@ -55,6 +55,11 @@ class Denoiser {
     const Params& params() const { return params_; }
 
     /// Clusters the scan and clears the valid flag of every noise point.
+    /// Valid beams without a usable range (kfd::isUsableRange: NaN, +-inf, negative, above
+    /// kMaxScanRangeM = 1e4 m) are invalidated first and counted in points_removed.
+    /// Bounds per scan of n <= kMaxScanBeams beams: O(n) memory (buffers reused); time a few
+    /// passes over the beams plus union-find, each beam compared only with the clusters still
+    /// open within the angle gap.
     Result filter(Scan& scan);
 
     /// Clusters of the last filtered scan (labels per beam, noise flags), e.g. for rendering.

@@ -100,7 +100,11 @@ class Pipeline {
     void add(std::unique_ptr<Stage> stage);
 
     /// Runs the scan through every stage until one drops it. Modifies only valid flags.
-    /// kfd::Error when the scan's range and valid sizes differ.
+    /// kfd::ScanError when the scan's range and valid sizes differ or its geometry is outside
+    /// the limits of kfd/core/scan.h (checkGeometry: 2..65 536 beams, aperture finite, > 0 and
+    /// <= 2*pi); nothing is changed then. Any range is safe: every stage treats a beam flagged
+    /// valid whose range is NaN, infinite or negative as unusable (the distance stage removes
+    /// and counts it; the others skip it or mark it invalid), so no scan content is UB.
     ScanReport process(Scan& scan);
     void reset();
 

@@ -50,6 +50,55 @@ struct ScanGeometry {
     bool operator!=(const ScanGeometry& o) const { return !(*this == o); }
 };
 
+/// Limits of a scan's geometry, checked by checkGeometry() (Pipeline::process throws ScanError
+/// outside them; the MRPT adapter skips such a scan, kfd/mrpt/scan_check.h).
+/// 65 536 beams cover every real 2D lidar (the densest take ~ 10 000 per turn); at least two
+/// beams are needed for an angular resolution aperture / (beams - 1).
+constexpr std::size_t kMinScanBeams = 2;
+constexpr std::size_t kMaxScanBeams = 65536;
+/// Largest aperture (rad): one full turn, with a relative slack of 1e-6 for MRPT's float
+/// aperture (float(2*pi) is a little above 2*pi).
+constexpr double kMaxScanAperture = 2.0 * kPi * (1.0 + 1e-6);
+/// Largest range (m) the adapter accepts as a measurement: no 2D lidar measures 10 km; a
+/// larger value (e.g. 1e30) is marked invalid like NaN, +-inf and negative ranges.
+constexpr float kMaxScanRangeM = 1.0e4f;
+
+/// Why a scan's geometry cannot be used (None: it can).
+enum class ScanSkipReason {
+    None,          // the scan is usable
+    NoBeams,       // fewer than kMinScanBeams beams
+    TooManyBeams,  // more than kMaxScanBeams beams
+    BadAperture,   // aperture not finite, <= 0 or > kMaxScanAperture
+};
+constexpr std::size_t kScanSkipReasons = 4;  // including None
+
+/// "ok", "no_beams", "too_many_beams", "bad_aperture".
+inline const char* toString(ScanSkipReason r) {
+    switch (r) {
+        case ScanSkipReason::None:
+            return "ok";
+        case ScanSkipReason::NoBeams:
+            return "no_beams";
+        case ScanSkipReason::TooManyBeams:
+            return "too_many_beams";
+        case ScanSkipReason::BadAperture:
+            return "bad_aperture";
+    }
+    return "unknown";
+}
+
+/// Checks beam count and aperture against the limits above.
+inline ScanSkipReason checkGeometry(const ScanGeometry& g) {
+    if (g.beams < kMinScanBeams) return ScanSkipReason::NoBeams;
+    if (g.beams > kMaxScanBeams) return ScanSkipReason::TooManyBeams;
+    if (!(g.aperture > 0.0) || !(g.aperture <= kMaxScanAperture))
+        return ScanSkipReason::BadAperture;
+    return ScanSkipReason::None;
+}
+
+/// A range the adapter keeps as a measurement: finite, >= 0 and <= kMaxScanRangeM.
+inline bool isUsableRange(float r) { return r >= 0.0f && r <= kMaxScanRangeM; }
+
 /// One scan as the core sees it. `valid[i] != 0` means beam i holds a usable range.
 /// Stages never delete beams: removing a point clears its valid flag.
 struct Scan {

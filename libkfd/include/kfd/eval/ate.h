@@ -17,7 +17,8 @@ struct AteResult {
 /// Matches each estimated pose to the nearest ground-truth stamp (within max_dt), finds the
 /// rigid SE(2) transform that best aligns the estimated positions to the ground truth in the
 /// least-squares sense (closed form, Umeyama 1991 without scale), and reports the translation
-/// errors. Throws EvalError when fewer than 2 poses match. `gt` must be sorted by time.
+/// errors. Throws EvalError when fewer than 2 poses match or max_dt is negative or not finite
+/// (field "max_dt"). `gt` must be sorted by time.
 AteResult computeAte(const Trajectory& est, const Trajectory& gt, double max_dt);
 
 struct RpeResult {
@@ -29,7 +30,9 @@ struct RpeResult {
 
 /// Relative pose error over a fixed time step: for each ground-truth pose i, the first pose j
 /// with t_j >= t_i + delta_s; the estimate's motion between the matched stamps is compared with
-/// the ground truth's (error = between(d_gt, d_est)). `est` must be sorted by time.
+/// the ground truth's (error = between(d_gt, d_est)). `est` must be sorted by time. Throws
+/// EvalError when no pair matched (never a perfect 0), when delta_s is not finite and > 0
+/// (field "delta_s") or max_dt not finite and >= 0 (field "max_dt").
 RpeResult computeRpe(const Trajectory& est, const Trajectory& gt, double delta_s, double max_dt);
 
 }  // namespace kfd

@@ -32,7 +32,9 @@ struct RelationsError {
 /// |(d_est.x - d_gt.x, d_est.y - d_gt.y)| and the rotation error |wrap(d_est.phi - d_gt.phi)|.
 /// Means and (population) standard deviations of the absolute and squared errors. Stamps are
 /// matched to the nearest pose within max_dt; relations that do not match are counted, never
-/// silently dropped. `traj` must be sorted by time.
+/// silently dropped. `traj` must be sorted by time. Throws EvalError when `relations` is empty,
+/// when none matched (never a perfect 0.0), or when max_dt is negative or not finite (field
+/// "max_dt").
 RelationsError evaluateRelations(const Trajectory& traj, const std::vector<Relation>& relations,
                                  double max_dt);
 

@@ -35,13 +35,16 @@ Pose2D between(const Pose2D& a, const Pose2D& b);
 double wrapAngle(double a);
 
 /// TUM format: one "t x y z qx qy qz qw" line per pose ('#' comments allowed); the yaw is read
-/// from the quaternion. Throws EvalError with the line number on malformed input.
+/// from the quaternion (any non-zero norm). Throws EvalError naming the file and line on
+/// malformed input: missing, unparsable or non-finite numbers, a quaternion of norm 0.
 Trajectory readTum(const std::string& path);
 void writeTum(const std::string& path, const Trajectory& traj);
 
 /// Reads the data lines of a text file (blank lines and '#' comments skipped) as `n` numbers
 /// each and calls `row(values)` for every one. `what` names the file kind in errors; a line with
-/// fewer than n numbers throws EvalError naming path and line ("path:line: expected ...").
+/// fewer than n numbers, a token that is not a number ("1.5abc") or a non-finite value throws
+/// EvalError naming path and line ("path:line: expected ..."); so does an EvalError thrown by
+/// `row` (its message prefixed with "path:line: ").
 void readNumericRows(const std::string& path, const std::string& what, std::size_t n,
                      const std::string& expected, const std::function<void(const double*)>& row);
 

@@ -39,6 +39,13 @@ struct RawlogFilterSummary {
     std::size_t scans_in = 0;
     std::size_t scans_kept = 0;
     std::size_t scans_dropped = 0;
+    /// Scans skipped by kfd::checkScan (bad geometry, kfd/mrpt/scan_check.h): not run through
+    /// the pipeline and dropped from the output like a non-keyframe (not in scans_dropped).
+    std::size_t scans_skipped = 0;
+    std::size_t skipped_by_reason[kScanSkipReasons] = {};  // indexed by ScanSkipReason
+    std::size_t beams_bad_range = 0;   // beams marked invalid: NaN, +-inf, negative, huge range
+    std::size_t odometry_bad = 0;      // scans whose odometry was not finite (used as unknown)
+    std::size_t stamps_backwards = 0;  // scans stamped before their sensor's previous scan
     std::size_t geometry_resets = 0;
     std::size_t sensors = 0;
     std::size_t points_in = 0;             // valid beams in all input scans
@@ -54,8 +61,13 @@ struct RawlogFilterSummary {
 /// Reads `input` object by object (never loading it whole), runs every 2D range scan through a
 /// StreamFilter, and writes every other object unchanged and in order. Non-keyframe scans are
 /// removed; a sensory frame left empty is dropped and its odometry action is composed into the
-/// next kept action, so the output's odometry still adds up. The input is never modified; on
-/// any error no output file is left behind: the output and the stats CSV are written under
+/// next kept action, so the output's odometry still adds up. A scan that kfd::checkScan rejects
+/// (beam count outside [2, 65 536], aperture not finite, <= 0 or > 2*pi) never reaches a stage:
+/// it is removed from the output exactly like a non-keyframe, counted in scans_skipped and
+/// skipped_by_reason, and its stats row has reason "skipped:<reason>" (points_in = its beam
+/// count, zeros elsewhere); the run goes on. Beams with a NaN, infinite, negative or huge range
+/// are marked invalid in the output (counted in beams_bad_range). The input is never modified;
+/// on any error no output file is left behind: the output and the stats CSV are written under
 /// temporary names beside them and renamed at the end. Before anything is written, an output or
 /// stats path that is (or aliases) the input or the other output is refused (a RawlogError
 /// from kfd::checkOutputPaths, kfd/core/output_paths.h). Stops with kfd::Cancelled after

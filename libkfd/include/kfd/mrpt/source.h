@@ -35,12 +35,17 @@ double stampOf(const mrpt::obs::CObservation& obs);
 /// (NaN) time is written as 0.
 inline double stampForOutput(double stamp) { return stamp == stamp ? stamp : 0.0; }
 
+/// True when x, y and phi are all finite.
+bool finitePose(double x, double y, double phi);
+
 /// The one odometry tracker: the robot's absolute odometry along a log, from either layout.
 /// Actions layout: integrates CActionRobotMovement2D::rawOdometryIncrementReading of each
 /// action's best movement estimation (starting at the origin). Observations layout: takes the
 /// absolute pose of each CObservationOdometry. Unknown (nullopt) until the first of either.
 class OdometryTracker {
   public:
+    /// A non-finite increment is not integrated (the sum stays finite): the pose of that one
+    /// entry is NaN, which kfd::checkScan turns into "unknown" and counts.
     void onAction(const mrpt::obs::CActionCollection& actions);
     /// Only CObservationOdometry changes the pose; other observations are ignored.
     void onObservation(const mrpt::obs::CObservation& obs);

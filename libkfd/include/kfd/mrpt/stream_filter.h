@@ -2,6 +2,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -18,7 +19,10 @@ struct StreamResult {
     bool keep = true;             // false: not a keyframe, drop the scan
     bool geometry_reset = false;  // this sensor's geometry changed: its state was reset first
     std::string sensor_label;
-    ScanReport report;  // every stage's diagnostics and the time spent
+    std::size_t bad_ranges = 0;    // beams marked invalid by checkScan (NaN, inf, < 0, huge)
+    bool bad_odometry = false;     // the odometry given was not finite: used as unknown
+    bool stamp_backwards = false;  // this scan's stamp is before the sensor's previous one
+    ScanReport report;             // every stage's diagnostics and the time spent
 };
 
 /// Holds the state of a scan stream: one Pipeline per sensor label, so two lasers on one robot
@@ -40,7 +44,10 @@ class StreamFilter {
 
     /// Runs the pipeline on `scan`. Noise and out-of-range beams are marked invalid in place
     /// (ranges, beam count and angles are kept). `odometry` (absolute, robot frame) feeds the
-    /// motion guards. Throws kfd::ScanError for an empty scan.
+    /// motion guards. The scan is first checked by kfd::checkScan (kfd/mrpt/scan_check.h): bad
+    /// ranges become invalid, non-finite odometry becomes unknown, and a scan with a bad
+    /// geometry (beam count, aperture) throws kfd::ScanError before any stage runs — callers
+    /// that skip such scans call checkScan themselves first (RawlogFilter, IcpSlamRunner).
     StreamResult process(mrpt::obs::CObservation2DRangeScan& scan,
                          const std::optional<Pose2D>& odometry = std::nullopt);
 
@@ -56,6 +63,7 @@ class StreamFilter {
         std::unique_ptr<Pipeline> pipeline;
         ScanGeometry geometry;
         Scan scan;  // reused buffer
+        double last_stamp = std::numeric_limits<double>::quiet_NaN();
     };
     Sensor& sensorFor(const std::string& label);
 

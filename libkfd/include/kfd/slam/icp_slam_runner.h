@@ -46,6 +46,12 @@ struct IcpSlamSummary {
     std::string rawlog, output_dir;
     std::size_t entries = 0;
     std::size_t scans_in = 0, scans_kept = 0;
+    /// Scans skipped by kfd::checkScan (bad geometry): in scans_in, never reached ICP; scans.csv
+    /// reason "skipped:<reason>"; their pose is propagated like a dropped scan's.
+    std::size_t scans_skipped = 0;
+    std::size_t skipped_by_reason[kScanSkipReasons] = {};  // indexed by ScanSkipReason
+    std::size_t beams_bad_range = 0;  // beams marked invalid: NaN, +-inf, negative, huge range
+    std::size_t odometry_bad = 0;     // scans whose odometry was not finite (used as unknown)
     double dropped_pct = 0.0;
     std::size_t points_in = 0, points_removed = 0;
     double prefilter_us_per_scan = 0.0;  // mean over input scans
@@ -89,7 +95,10 @@ class SlamError : public Error {
 /// scan in an actions+sensory-frames log is removed from its frame and the frame's odometry
 /// action is still processed; in an observations log the scan is skipped and odometry
 /// observations are still processed. Every input scan gets a pose (the map builder's estimate,
-/// propagated with odometry for dropped scans).
+/// propagated with odometry for dropped scans). Every scan is checked by kfd::checkScan first,
+/// in every mode (`none` included): a bad geometry skips it (counted, never reaches ICP), bad
+/// ranges are marked invalid, and a non-finite odometry reading is left out of the map builder's
+/// input. Relations given but none matched, or a negative relations_max_dt, are errors.
 ///
 /// Checks first that the configuration, the rawlog, the relations and the ground truth are
 /// readable (the ground truth and relations are parsed before the run) and that no output file
