@@ -1,5 +1,6 @@
 // Configuration loaders: every shipped config, key validation, INI/YAML agreement.
 #include <gtest/gtest.h>
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/containers/yaml.h>
 
@@ -297,18 +298,28 @@ std::string writeFile(const kfd::test::TempDir& dir, const std::string& name,
 
 }  // namespace
 
-TEST(ConfigDuplicates, IniKeySetTwiceIsAnErrorNamingTheKey) {
-    EXPECT_EQ(errorKey("[KFD]\nwindow = 3\nbins = 20\nwindow = 4\n"), "window");
-    EXPECT_EQ(errorKey("[KFD]\nwindow = 3\n[KFD]\nWINDOW = 4\n"), "WINDOW");  // MRPT: no case
+std::string iniTextErrorKey(const std::string& text) {
     try {
-        fromIniText("[KFD]\nwindow = 3\nwindow = 4\n");
+        kfd::checkIniText(text);
+    } catch (const kfd::ConfigError& e) {
+        return e.key();
+    }
+    return "<no error>";
+}
+
+TEST(ConfigDuplicates, IniKeySetTwiceIsAnErrorNamingTheKey) {
+    EXPECT_EQ(iniTextErrorKey("[KFD]\nwindow = 3\nbins = 20\nwindow = 4\n"), "window");
+    EXPECT_EQ(iniTextErrorKey("[KFD]\nwindow = 3\n[kfd]\nWINDOW = 4\n"), "WINDOW");  // no case
+    try {
+        kfd::checkIniText("[KFD]\r\nwindow = 3\r\nwindow=4\r\n");
         FAIL();
     } catch (const kfd::ConfigError& e) {
         EXPECT_NE(std::string(e.what()).find("lines 2 and 3"), std::string::npos) << e.what();
     }
     // The same key in another section, or commented out, is no duplicate.
-    EXPECT_EQ(errorKey("[ICP]\nwindow = 1\n[KFD]\nwindow = 3\n; window = 4\n# window = 5\n"),
+    EXPECT_EQ(iniTextErrorKey("[ICP]\nwindow = 1\n[KFD]\nwindow = 3\n; window = 4\n# window = 5\n"),
               "<no error>");
+    EXPECT_EQ(iniTextErrorKey("[ICP]\nwindow = 1\nwindow = 2\n"), "<no error>");
 }
 
 TEST(ConfigDuplicates, IniFileKeySetTwiceIsAnError) {
@@ -320,6 +331,9 @@ TEST(ConfigDuplicates, IniFileKeySetTwiceIsAnError) {
     } catch (const kfd::ConfigError& e) {
         EXPECT_EQ(e.key(), "rings");
     }
+    // loadIni on a CConfigFile (what kfd-icp-slam reads) checks the file's text too.
+    mrpt::config::CConfigFile cfg(path);
+    EXPECT_THROW(kfd::loadIni(cfg), kfd::ConfigError);
 }
 
 TEST(ConfigDuplicates, YamlKeySetTwiceIsAnErrorNamingTheKey) {

@@ -1,7 +1,6 @@
 #include "kfd/mrpt/config.h"
 
 #include <mrpt/config/CConfigFile.h>
-#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/containers/yaml.h>
 #include <mrpt/system/string_utils.h>
 
@@ -84,10 +83,9 @@ std::string readWholeFile(const std::string& path) {
     return ss.str();
 }
 
-// Where `cfg` got its text, when it can tell (a file or memory); empty otherwise.
+// The text of `cfg` when it was read from a file (CConfigFile); empty otherwise
+// (CConfigFileMemory keeps only the parsed keys, duplicates already merged).
 std::optional<std::string> iniTextOf(const mrpt::config::CConfigFileBase& cfg) {
-    if (const auto* m = dynamic_cast<const mrpt::config::CConfigFileMemory*>(&cfg))
-        return m->getContent();
     if (const auto* f = dynamic_cast<const mrpt::config::CConfigFile*>(&cfg))
         return readWholeFile(f->getAssociatedFile());
     return std::nullopt;

@@ -49,7 +49,8 @@ void applyConfigKey(Pipeline::Params& p, const std::string& key, const std::stri
 void validateConfig(const Pipeline::Params& p, const StageRegistry& registry);
 
 /// Reads the keys of `section` (default "KFD") over the defaults of Pipeline::Params. When
-/// `cfg` is a CConfigFile or CConfigFileMemory its text is checked first (checkIniText).
+/// `cfg` is a CConfigFile its file's text is checked first (checkIniText; a
+/// CConfigFileMemory has already merged duplicate keys: check its text with checkIniText).
 /// Unknown keys and out-of-range values throw ConfigError naming the key. Other sections are
 /// ignored, so the [KFD] section can live inside an icp-slam .ini.
 Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg,
