@@ -22,5 +22,7 @@ if ! cmake --build "$build" -j"$(nproc)" >"$build/build.log" 2>&1; then
   grep -E "error|Error" -A5 "$build/build.log" | head -200
   exit 1
 fi
-cd "$build" && ctest --output-on-failure -j"$(nproc)"
+# package_consumer is left to the normal job: it builds a GCC project against the installed
+# (here instrumented) static libraries, which would need the sanitizer runtimes too.
+cd "$build" && ctest --output-on-failure -j"$(nproc)" -E '^package_consumer$'
 echo "[kfd] sanitizer job: $(( $(date +%s) - start )) s"
