@@ -441,3 +441,17 @@ TEST(ConfigYamlCheck, SubsetRules) {
               "<no error>");
     EXPECT_EQ(yamlError("pipeline: [distance, keyframe]\nwindow: \"3\"\n"), "<no error>");
 }
+
+TEST(ConfigFuzzFindings, MalformedMrptExpansionIsAConfigError) {
+    // fuzz_ini: MRPT's CConfigFile throws its own exception for an unclosed $eval{ (and the
+    // other expansions); it reached the tools as a non-kfd exception.
+    kfd::test::TempDir dir("kfd_config_");
+    const std::string path = writeFile(dir, "eval.ini", "[KFD]\nm_threshold = $eval{3\n");
+    try {
+        kfd::loadConfigFile(path);
+        FAIL();
+    } catch (const kfd::ConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("eval.ini"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("cannot read .ini file"), std::string::npos) << e.what();
+    }
+}

@@ -91,6 +91,14 @@ std::optional<std::string> iniTextOf(const mrpt::config::CConfigFileBase& cfg) {
     return std::nullopt;
 }
 
+// MRPT nests exception texts ("==== MRPT exception ==== ... Message: ..."): the innermost
+// message line says what failed.
+std::string mrptMessage(const std::string& what) {
+    const auto pos = what.rfind("Message:");
+    if (pos == std::string::npos) return what.substr(0, what.find('\n'));
+    return trim(what.substr(pos + 8, what.find('\n', pos) - pos - 8));
+}
+
 // 1-based line of byte `pos` of `text`.
 std::size_t lineOf(const std::string& text, std::size_t pos) {
     std::size_t n = 1;
@@ -329,12 +337,18 @@ Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg, const std::st
     if (!cfg.sectionExists(section))
         throw ConfigError("", "no [" + section + "] section in the configuration");
     if (const auto text = iniTextOf(cfg)) checkIniText(*text, section);
-    std::vector<std::string> names;
-    cfg.getAllKeys(section, names);
+    std::vector<std::pair<std::string, std::string>> values;
+    try {
+        std::vector<std::string> names;
+        cfg.getAllKeys(section, names);
+        for (const auto& name : names)
+            values.emplace_back(name, cfg.read_string(section, name, ""));
+    } catch (const std::exception& e) {
+        throw ConfigError("", "cannot read [" + section + "]: " + mrptMessage(e.what()));
+    }
     const StageRegistry& registry = defaultStageRegistry();
     Pipeline::Params p;
-    for (const auto& name : names)
-        applyConfigKey(p, name, cfg.read_string(section, name, ""), registry);
+    for (const auto& [name, value] : values) applyConfigKey(p, name, value, registry);
     validateConfig(p, registry);
     return p;
 }
@@ -377,8 +391,15 @@ Pipeline::Params loadConfigFile(const std::string& path, const std::string& sect
     }
     if (ext != ".ini" && ext != ".cfg")
         throw ConfigError("", "unknown configuration format '" + ext + "' (use .ini or .yaml)");
-    mrpt::config::CConfigFile cfg(path);
-    return loadIni(cfg, section);
+    // MRPT's CConfigFile expands @define, ${var}, $env{} and $eval{} while reading and throws
+    // its own exceptions for malformed ones (found by test/fuzz/fuzz_ini).
+    std::optional<mrpt::config::CConfigFile> cfg;
+    try {
+        cfg.emplace(path);
+    } catch (const std::exception& e) {
+        throw ConfigError("", "cannot read .ini file " + path + ": " + mrptMessage(e.what()));
+    }
+    return loadIni(*cfg, section);
 }
 
 std::string toIni(const Pipeline::Params& p, const std::string& section) {
