@@ -28,9 +28,10 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 # Full malloc stacks so that the third-party leak suppressions match.
 export ASAN_OPTIONS="fast_unwind_on_malloc=0"
 export LSAN_OPTIONS="suppressions=$root/share/scripts/lsan.supp:print_suppressions=0"
+rc=0
 "$build/test/fuzz/fuzz_$target" -max_total_time=$((minutes * 60)) -timeout=2 -rss_limit_mb=2048 \
   -fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 -print_final_stats=1 \
-  -artifact_prefix="$artifacts/" "$corpus" "$root/test/fuzz/corpus/$target"
+  -artifact_prefix="$artifacts/" "$corpus" "$root/test/fuzz/corpus/$target" || rc=$?
 n=$(find "$artifacts" -type f | wc -l)
-echo "fuzz_$target: $minutes min, $n input(s) kept in $artifacts"
+echo "fuzz_$target: $minutes min, libFuzzer exit status $rc, $n input(s) kept in $artifacts"
 [ "$n" -eq 0 ]
