@@ -452,6 +452,7 @@ TEST(ConfigFuzzFindings, MalformedMrptExpansionIsAConfigError) {
         FAIL();
     } catch (const kfd::ConfigError& e) {
         EXPECT_NE(std::string(e.what()).find("eval.ini"), std::string::npos) << e.what();
-        EXPECT_NE(std::string(e.what()).find("cannot read .ini file"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("cannot read .ini file"), std::string::npos)
+            << e.what();
     }
 }
