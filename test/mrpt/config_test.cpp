@@ -1,5 +1,6 @@
 // Configuration loaders: every shipped config, key validation, INI/YAML agreement.
 #include <gtest/gtest.h>
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/containers/yaml.h>
 
@@ -10,6 +11,7 @@
 
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/default_stages.h"
+#include "test_files.h"
 
 namespace {
 
@@ -264,4 +266,193 @@ TEST(Config, AngleGapFactorReachesBothDenoiseVariants) {
     EXPECT_EQ(p.get<kfd::DenoiseStage>().reference.angle_gap_factor, 30.0);
     EXPECT_EQ(p.get<kfd::DenoiseStage>().range_aware.angle_gap_factor, 30.0);
     EXPECT_NE(kfd::toIni(p).find("angle_gap_factor = 30\n"), std::string::npos);
+}
+
+// Issue 9, item 4: duplicate keys, empty pipelines, YAML text checked before MRPT's parser.
+namespace {
+
+std::string yamlError(const std::string& text) {
+    try {
+        kfd::loadYamlText(text, "test");
+    } catch (const kfd::ConfigError& e) {
+        return e.what();
+    }
+    return "<no error>";
+}
+
+std::string yamlErrorKey(const std::string& text) {
+    try {
+        kfd::loadYamlText(text, "test");
+    } catch (const kfd::ConfigError& e) {
+        return e.key();
+    }
+    return "<no error>";
+}
+
+std::string writeFile(const kfd::test::TempDir& dir, const std::string& name,
+                      const std::string& text) {
+    const std::string path = dir / name;
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+}
+
+}  // namespace
+
+std::string iniTextErrorKey(const std::string& text) {
+    try {
+        kfd::checkIniText(text);
+    } catch (const kfd::ConfigError& e) {
+        return e.key();
+    }
+    return "<no error>";
+}
+
+TEST(ConfigDuplicates, IniKeySetTwiceIsAnErrorNamingTheKey) {
+    EXPECT_EQ(iniTextErrorKey("[KFD]\nwindow = 3\nbins = 20\nwindow = 4\n"), "window");
+    EXPECT_EQ(iniTextErrorKey("[KFD]\nwindow = 3\n[kfd]\nWINDOW = 4\n"), "WINDOW");  // no case
+    try {
+        kfd::checkIniText("[KFD]\r\nwindow = 3\r\nwindow=4\r\n");
+        FAIL();
+    } catch (const kfd::ConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("lines 2 and 3"), std::string::npos) << e.what();
+    }
+    // The same key in another section, or commented out, is no duplicate.
+    EXPECT_EQ(iniTextErrorKey("[ICP]\nwindow = 1\n[KFD]\nwindow = 3\n; window = 4\n# window = 5\n"),
+              "<no error>");
+    EXPECT_EQ(iniTextErrorKey("[ICP]\nwindow = 1\nwindow = 2\n"), "<no error>");
+}
+
+TEST(ConfigDuplicates, IniFileKeySetTwiceIsAnError) {
+    kfd::test::TempDir dir("kfd_config_");
+    const std::string path = writeFile(dir, "dup.ini", "[KFD]\nrings = 4\nrings = 5\n");
+    try {
+        kfd::loadConfigFile(path);
+        FAIL();
+    } catch (const kfd::ConfigError& e) {
+        EXPECT_EQ(e.key(), "rings");
+    }
+    // loadIni on a CConfigFile (what kfd-icp-slam reads) checks the file's text too.
+    mrpt::config::CConfigFile cfg(path);
+    EXPECT_THROW(kfd::loadIni(cfg), kfd::ConfigError);
+}
+
+TEST(ConfigDuplicates, YamlKeySetTwiceIsAnErrorNamingTheKey) {
+    EXPECT_EQ(yamlErrorKey("window: 3\nwindow: 4\n"), "window");
+    EXPECT_EQ(yamlErrorKey("kfd:\n  bins: 10\n  rings: 3\n  bins: 12\n"), "bins");
+    EXPECT_EQ(yamlErrorKey("kfd:\n  bins: 10\nkfd:\n  rings: 3\n"), "kfd");
+    EXPECT_EQ(yamlErrorKey("kfd:\n  bins: 10\n  rings: 3\n"), "<no error>");
+}
+
+TEST(ConfigEmptyPipeline, IsAnErrorNamingPipeline) {
+    EXPECT_EQ(errorKey("[KFD]\npipeline =\n"), "pipeline");
+    EXPECT_EQ(errorKey("[KFD]\npipeline = , ,\n"), "pipeline");
+    EXPECT_EQ(yamlErrorKey("pipeline: []\n"), "pipeline");
+    EXPECT_EQ(yamlErrorKey("pipeline: ''\n"), "pipeline");
+    kfd::Pipeline::Params p;
+    EXPECT_THROW(kfd::applyConfigKey(p, "pipeline", "  ", kfd::defaultStageRegistry()),
+                 kfd::ConfigError);
+    EXPECT_EQ(errorKey("[KFD]\npipeline = denoise\n"), "<no error>");
+}
+
+TEST(ConfigYamlCheck, TheFourByteFileThatHungLibfyamlIsAnError) {
+    // "%\xff\xff\n": a directive with bytes that are not UTF-8 made libfyaml (under MRPT's
+    // YAML parser) loop forever; kfd-filter -c hung. It must be a ConfigError, quickly.
+    const std::string path = std::string(KFD_SOURCE_DIR) + "/test/data/yaml-hang-4byte.yaml";
+    ASSERT_EQ(kfd::test::fileBytes(path), std::string("%\xff\xff\n"));
+    try {
+        kfd::loadConfigFile(path);
+        FAIL();
+    } catch (const kfd::ConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("not UTF-8"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("yaml-hang-4byte.yaml"), std::string::npos);
+    }
+    // The same directive in plain ASCII is refused by the subset rule.
+    EXPECT_NE(yamlError("%YAML 1.2\n").find("'%' is not supported"), std::string::npos);
+}
+
+TEST(ConfigYamlCheck, SizeLimit) {
+    std::string big = "window: 3\n";
+    big += std::string(kfd::kMaxConfigBytes, '#');
+    EXPECT_NE(yamlError(big).find("larger than"), std::string::npos);
+    kfd::test::TempDir dir("kfd_config_");
+    EXPECT_THROW(kfd::loadConfigFile(writeFile(dir, "big.yaml", big)), kfd::ConfigError);
+    // Just under the limit (a long comment) is read.
+    std::string ok = "window: 3\n#";
+    ok += std::string(kfd::kMaxConfigBytes - ok.size(), 'x');
+    EXPECT_EQ(kfd::loadYamlText(ok).get<kfd::KeyframeStage>().window, 3u);
+}
+
+TEST(ConfigYamlCheck, Encoding) {
+    EXPECT_NE(yamlError("window: 3 # \xff\n").find("not UTF-8"), std::string::npos);
+    EXPECT_NE(yamlError("window: 3 # \xc3\n").find("not UTF-8"), std::string::npos);  // cut
+    EXPECT_NE(yamlError("window: 3 # \xc0\xaf\n").find("not UTF-8"), std::string::npos);
+    EXPECT_NE(yamlError("window: 3 # \xe0\x80\xaf\n").find("overlong"), std::string::npos);
+    EXPECT_NE(yamlError("window: 3 # \xed\xa0\x80\n").find("invalid"), std::string::npos);
+    EXPECT_NE(yamlError("window: 3 # \xf4\x90\x80\x80\n").find("invalid"), std::string::npos);
+    // A byte-order mark is fine as the first character only.
+    EXPECT_EQ(yamlError("\xef\xbb\xbfwindow: 3\n"), "<no error>");
+    EXPECT_NE(yamlError("window: 3\n\xef\xbb\xbf").find("byte-order mark"), std::string::npos);
+    // Valid multi-byte UTF-8 in a comment is fine; the error names the line.
+    EXPECT_EQ(yamlError("# fen\xc3\xaatre \xe2\x82\xac \xf0\x9f\x98\x80\nwindow: 3\n"),
+              "<no error>");
+    EXPECT_NE(yamlError("window: 3\nbins: 4 # \xff\n").find("line 2"), std::string::npos);
+}
+
+TEST(ConfigYamlCheck, ControlCharacters) {
+    EXPECT_NE(yamlError(std::string("window: 3\0\n", 11)).find("control character 0"),
+              std::string::npos);
+    EXPECT_NE(yamlError("window: 3\x07\n").find("control character 7"), std::string::npos);
+    EXPECT_NE(yamlError("window: 3\x7f\n").find("control character"), std::string::npos);
+    EXPECT_NE(yamlError("window: 3 # \xc2\x85\n").find("control character"), std::string::npos);
+    // Tab (not in indentation), CR and LF are fine.
+    EXPECT_EQ(yamlError("window:\t3\r\nbins: 4\r\n"), "<no error>");
+}
+
+TEST(ConfigYamlCheck, SubsetRules) {
+    const char* refused[][2] = {
+        {"{window: 3}\n", "'{'"},
+        {"kfd: {window: 3}\n", "'{'"},
+        {"window: &a 3\n", "'&'"},
+        {"window: *a\n", "'*'"},
+        {"window: !!int 3\n", "'!'"},
+        {"%TAG ! tag:x\nwindow: 3\n", "'%'"},
+        {"? window\n: 3\n", "'?'"},
+        {"variant: |\n  range_aware\n", "'|'"},
+        {"variant: >\n  range_aware\n", "'>'"},
+        {"window: 3\n---\nwindow: 4\n", "document markers"},
+        {"window: 3\n...\n", "document markers"},
+        {"pipeline: [[distance]]\n", "nested list"},
+        {"pipeline: [distance\n", "unterminated list"},
+        {"pipeline: distance]\n", "unbalanced"},
+        {"kfd:\n\twindow: 3\n", "tab in indentation"},
+        {"variant: 'range_aware\n", "unterminated quote"},
+        {"kfd:\n  a:\n    window: 3\n", "more than two levels"},
+        {"  window: 3\n", "indented key without a map"},
+    };
+    for (const auto& r : refused) {
+        const std::string msg = yamlError(r[0]);
+        EXPECT_NE(msg.find(r[1]), std::string::npos) << r[0] << " -> " << msg;
+    }
+    // What kfd's keys need is accepted: comments with any character, quoted values with '#',
+    // flow and block lists, the kfd: map.
+    EXPECT_EQ(yamlError("# {}&*!%?|>@` ---\nwindow: 3 # {&*}\nvariant: 'range_aware'\n"),
+              "<no error>");
+    EXPECT_EQ(yamlError("kfd:\n  pipeline:\n    - distance\n    - denoise\n  rings: 4\n"),
+              "<no error>");
+    EXPECT_EQ(yamlError("pipeline: [distance, keyframe]\nwindow: \"3\"\n"), "<no error>");
+}
+
+TEST(ConfigFuzzFindings, MalformedMrptExpansionIsAConfigError) {
+    // fuzz_ini: MRPT's CConfigFile throws its own exception for an unclosed $eval{ (and the
+    // other expansions); it reached the tools as a non-kfd exception.
+    kfd::test::TempDir dir("kfd_config_");
+    const std::string path = writeFile(dir, "eval.ini", "[KFD]\nm_threshold = $eval{3\n");
+    try {
+        kfd::loadConfigFile(path);
+        FAIL();
+    } catch (const kfd::ConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("eval.ini"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("cannot read .ini file"), std::string::npos)
+            << e.what();
+    }
 }

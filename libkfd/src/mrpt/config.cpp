@@ -6,6 +6,9 @@
 
 #include <cctype>
 #include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
 #include <sstream>
 
 #include "kfd/core/stage_keys.h"
@@ -47,8 +50,219 @@ std::vector<std::string> parseStageList(const std::string& text, const StageRegi
             if (s == item) throw ConfigError("pipeline", "stage '" + item + "' repeated");
         stages.push_back(item);
     }
+    if (stages.empty())
+        throw ConfigError("pipeline", "no stage listed (known: " + registry.names() + ")");
     return stages;
 }
+
+std::string lower(std::string s) {
+    for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+// The lines of `text` (LF or CRLF), numbered from 1.
+std::vector<std::string> splitLines(const std::string& text) {
+    std::vector<std::string> lines;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        std::size_t end = text.find('\n', start);
+        if (end == std::string::npos) end = text.size();
+        std::string line = text.substr(start, end - start);
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        lines.push_back(line);
+        start = end + 1;
+    }
+    return lines;
+}
+
+std::string readWholeFile(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) throw ConfigError("", "cannot read configuration file " + path);
+    std::ostringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+// The text of `cfg` when it was read from a file (CConfigFile); empty otherwise
+// (CConfigFileMemory keeps only the parsed keys, duplicates already merged).
+std::optional<std::string> iniTextOf(const mrpt::config::CConfigFileBase& cfg) {
+    if (const auto* f = dynamic_cast<const mrpt::config::CConfigFile*>(&cfg))
+        return readWholeFile(f->getAssociatedFile());
+    return std::nullopt;
+}
+
+// MRPT nests exception texts ("==== MRPT exception ==== ... Message: ..."): the innermost
+// message line says what failed.
+std::string mrptMessage(const std::string& what) {
+    const auto pos = what.rfind("Message:");
+    if (pos == std::string::npos) return what.substr(0, what.find('\n'));
+    return trim(what.substr(pos + 8, what.find('\n', pos) - pos - 8));
+}
+
+// 1-based line of byte `pos` of `text`.
+std::size_t lineOf(const std::string& text, std::size_t pos) {
+    std::size_t n = 1;
+    for (std::size_t i = 0; i < pos && i < text.size(); ++i) n += (text[i] == '\n');
+    return n;
+}
+
+}  // namespace
+
+void checkIniText(const std::string& text, const std::string& section) {
+    // MRPT's CConfigFile keeps the last of two equal keys (compared without case): find them
+    // in the text first. Sections compare without case too, as in MRPT.
+    std::map<std::string, std::size_t> seen;  // lower-case key -> line
+    bool in_section = false;
+    const auto lines = splitLines(text);
+    for (std::size_t n = 0; n < lines.size(); ++n) {
+        const std::string line = trim(lines[n]);
+        if (line.empty() || line[0] == ';' || line[0] == '#') continue;
+        if (line[0] == '[') {
+            const auto close = line.find(']');
+            in_section = close != std::string::npos &&
+                         lower(trim(line.substr(1, close - 1))) == lower(section);
+            continue;
+        }
+        if (!in_section) continue;
+        const auto eq = line.find('=');
+        if (eq == std::string::npos) continue;
+        const std::string key = trim(line.substr(0, eq));
+        const auto [it, inserted] = seen.emplace(lower(key), n + 1);
+        if (!inserted)
+            throw ConfigError(key, "set twice in [" + section + "] (lines " +
+                                       std::to_string(it->second) + " and " +
+                                       std::to_string(n + 1) + ")");
+    }
+}
+
+void checkYamlText(const std::string& text) {
+    if (text.size() > kMaxConfigBytes)
+        throw ConfigError("",
+                          "YAML file larger than " + std::to_string(kMaxConfigBytes) + " bytes");
+    // 1. Encoding: UTF-8 (RFC 3629: no overlong forms, no surrogates, at most U+10FFFF), an
+    //    optional byte-order mark at the very start only. 2. Characters: no control character
+    //    but tab, CR and LF (C0, DEL, C1).
+    const auto* b = reinterpret_cast<const unsigned char*>(text.data());
+    const std::size_t n = text.size();
+    std::size_t i = (n >= 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF) ? 3 : 0;
+    const std::size_t body = i;
+    while (i < n) {
+        const unsigned c = b[i];
+        const auto where = [&] { return " at line " + std::to_string(lineOf(text, i)); };
+        if (c < 0x80) {
+            if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7F)
+                throw ConfigError("", "YAML: control character " + std::to_string(c) + where());
+            ++i;
+            continue;
+        }
+        std::size_t len = 0;
+        unsigned cp = 0;
+        if (c >= 0xC2 && c <= 0xDF)
+            len = 2, cp = c & 0x1F;
+        else if (c >= 0xE0 && c <= 0xEF)
+            len = 3, cp = c & 0x0F;
+        else if (c >= 0xF0 && c <= 0xF4)
+            len = 4, cp = c & 0x07;
+        else
+            throw ConfigError("", "YAML: not UTF-8" + where());
+        if (i + len > n) throw ConfigError("", "YAML: not UTF-8 (cut sequence)" + where());
+        for (std::size_t k = 1; k < len; ++k) {
+            if ((b[i + k] & 0xC0) != 0x80) throw ConfigError("", "YAML: not UTF-8" + where());
+            cp = (cp << 6) | (b[i + k] & 0x3F);
+        }
+        if ((len == 3 && cp < 0x800) || (len == 4 && (cp < 0x10000 || cp > 0x10FFFF)) ||
+            (cp >= 0xD800 && cp <= 0xDFFF))
+            throw ConfigError("", "YAML: not UTF-8 (overlong or invalid code point)" + where());
+        if ((cp >= 0x80 && cp <= 0x9F) || cp == 0xFEFF)
+            throw ConfigError("", "YAML: control character or byte-order mark" + where());
+        i += len;
+    }
+    // 3. The subset kfd's keys need: a map of scalars (or the same under one `kfd:` key),
+    //    values plain or quoted scalars, flow lists [a, b] or block lists (- a). Outside
+    //    comments none of { } & * ! % ? | > @ ` (flow maps, anchors, aliases, tags,
+    //    directives, complex keys, block scalars, reserved), no document markers (--- ...),
+    //    no nested lists, no tab in indentation, at most two levels; no key twice in a map.
+    const auto lines = splitLines(text.substr(body));
+    std::map<std::string, std::size_t> seen;  // "parent/key" -> line
+    std::string parent;                       // the last top-level key
+    std::size_t child_indent = 0;             // indentation of its keys (0: none yet)
+    for (std::size_t ln = 0; ln < lines.size(); ++ln) {
+        const std::string& raw = lines[ln];
+        const std::string at = " at line " + std::to_string(ln + 1);
+        // Strip a comment: '#' at the start or after a blank, outside quotes.
+        std::string line;
+        char quote = 0;
+        for (std::size_t k = 0; k < raw.size(); ++k) {
+            const char c = raw[k];
+            if (quote) {
+                if (c == quote) quote = 0;
+            } else if (c == '\'' || c == '"') {
+                quote = c;
+            } else if (c == '#' && (k == 0 || raw[k - 1] == ' ' || raw[k - 1] == '\t')) {
+                break;
+            }
+            line += c;
+        }
+        if (quote) throw ConfigError("", "YAML: unterminated quote" + at);
+        std::size_t indent = 0;
+        while (indent < line.size() && (line[indent] == ' ' || line[indent] == '\t')) {
+            if (line[indent] == '\t') throw ConfigError("", "YAML: tab in indentation" + at);
+            ++indent;
+        }
+        const std::string content = trim(line);
+        if (content.empty()) continue;
+        if (content.rfind("---", 0) == 0 || content.rfind("...", 0) == 0)
+            throw ConfigError("", "YAML: document markers (---, ...) are not supported" + at);
+        int depth = 0;
+        for (const char c : content) {
+            if (std::string("{}&*!%?|>@`").find(c) != std::string::npos)
+                throw ConfigError("", std::string("YAML: '") + c +
+                                          "' is not supported (kfd reads a map of plain "
+                                          "values and lists)" +
+                                          at);
+            if (c == '[' && ++depth > 1) throw ConfigError("", "YAML: nested list" + at);
+            if (c == ']' && --depth < 0) throw ConfigError("", "YAML: unbalanced ']'" + at);
+        }
+        if (depth != 0) throw ConfigError("", "YAML: unterminated list" + at);
+        if (content[0] == '-') {  // block list item of the key above
+            if (indent == 0 && parent.empty())
+                throw ConfigError("", "YAML: a list is not a map" + at);
+            continue;
+        }
+        const auto colon = content.find(':');
+        if (colon == std::string::npos) continue;  // a continued plain scalar: the parser decides
+        std::string key = trim(content.substr(0, colon));
+        if (key.size() >= 2 && (key[0] == '\'' || key[0] == '"') && key.back() == key[0])
+            key = key.substr(1, key.size() - 2);
+        if (indent > 0 && parent.empty())
+            throw ConfigError(key, "YAML: indented key without a map above it" + at);
+        if (indent > 0 && child_indent == 0) child_indent = indent;
+        if (indent > child_indent && child_indent > 0)
+            throw ConfigError(key, "YAML: more than two levels of maps" + at);
+        const std::string path = indent == 0 ? key : parent + "/" + key;
+        const auto [it, inserted] = seen.emplace(path, ln + 1);
+        if (!inserted)
+            throw ConfigError(key, "set twice (lines " + std::to_string(it->second) + " and " +
+                                       std::to_string(ln + 1) + ")");
+        if (indent == 0) {
+            parent = key;
+            child_indent = 0;
+        }
+    }
+}
+
+Pipeline::Params loadYamlText(const std::string& text, const std::string& origin) {
+    checkYamlText(text);
+    mrpt::containers::yaml doc;
+    try {
+        doc = mrpt::containers::yaml::FromText(text);
+    } catch (const std::exception& e) {
+        throw ConfigError("", "cannot parse YAML " + origin + ": " + e.what());
+    }
+    return loadYaml(doc);
+}
+
+namespace {
 
 std::string scalarText(const mrpt::containers::yaml& node, const std::string& key) {
     if (node.isSequence()) {
@@ -122,12 +336,19 @@ void validateConfig(const Pipeline::Params& p, const StageRegistry& registry) {
 Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg, const std::string& section) {
     if (!cfg.sectionExists(section))
         throw ConfigError("", "no [" + section + "] section in the configuration");
-    std::vector<std::string> names;
-    cfg.getAllKeys(section, names);
+    if (const auto text = iniTextOf(cfg)) checkIniText(*text, section);
+    std::vector<std::pair<std::string, std::string>> values;
+    try {
+        std::vector<std::string> names;
+        cfg.getAllKeys(section, names);
+        for (const auto& name : names)
+            values.emplace_back(name, cfg.read_string(section, name, ""));
+    } catch (const std::exception& e) {
+        throw ConfigError("", "cannot read [" + section + "]: " + mrptMessage(e.what()));
+    }
     const StageRegistry& registry = defaultStageRegistry();
     Pipeline::Params p;
-    for (const auto& name : names)
-        applyConfigKey(p, name, cfg.read_string(section, name, ""), registry);
+    for (const auto& [name, value] : values) applyConfigKey(p, name, value, registry);
     validateConfig(p, registry);
     return p;
 }
@@ -154,18 +375,31 @@ Pipeline::Params loadConfigFile(const std::string& path, const std::string& sect
     std::string ext = fs::path(path).extension().string();
     for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (ext == ".yaml" || ext == ".yml") {
-        mrpt::containers::yaml doc;
+        std::error_code size_ec;
+        const auto bytes = fs::file_size(path, size_ec);
+        if (!size_ec && bytes > kMaxConfigBytes)
+            throw ConfigError("", "YAML file " + path + " larger than " +
+                                      std::to_string(kMaxConfigBytes) + " bytes");
+        const std::string text = readWholeFile(path);
         try {
-            doc = mrpt::containers::yaml::FromFile(path);
-        } catch (const std::exception& e) {
-            throw ConfigError("", "cannot parse YAML file " + path + ": " + e.what());
+            checkYamlText(text);
+        } catch (const ConfigError& e) {
+            if (!e.key().empty()) throw;
+            throw ConfigError("", path + ": " + e.what());
         }
-        return loadYaml(doc);
+        return loadYamlText(text, "file " + path);
     }
     if (ext != ".ini" && ext != ".cfg")
         throw ConfigError("", "unknown configuration format '" + ext + "' (use .ini or .yaml)");
-    mrpt::config::CConfigFile cfg(path);
-    return loadIni(cfg, section);
+    // MRPT's CConfigFile expands @define, ${var}, $env{} and $eval{} while reading and throws
+    // its own exceptions for malformed ones (found by test/fuzz/fuzz_ini).
+    std::optional<mrpt::config::CConfigFile> cfg;
+    try {
+        cfg.emplace(path);
+    } catch (const std::exception& e) {
+        throw ConfigError("", "cannot read .ini file " + path + ": " + mrptMessage(e.what()));
+    }
+    return loadIni(*cfg, section);
 }
 
 std::string toIni(const Pipeline::Params& p, const std::string& section) {

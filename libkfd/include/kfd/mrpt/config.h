@@ -1,6 +1,7 @@
 // Configuration of the kfd pipeline from an MRPT-style .ini section or from YAML.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -47,17 +48,49 @@ void applyConfigKey(Pipeline::Params& p, const std::string& key, const std::stri
 /// naming the user's key for the stage's kfd::ParameterError.
 void validateConfig(const Pipeline::Params& p, const StageRegistry& registry);
 
-/// Reads the keys of `section` (default "KFD") over the defaults of Pipeline::Params.
+/// Reads the keys of `section` (default "KFD") over the defaults of Pipeline::Params. When
+/// `cfg` is a CConfigFile its file's text is checked first (checkIniText; a
+/// CConfigFileMemory has already merged duplicate keys: check its text with checkIniText).
 /// Unknown keys and out-of-range values throw ConfigError naming the key. Other sections are
 /// ignored, so the [KFD] section can live inside an icp-slam .ini.
 Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg,
                          const std::string& section = "KFD");
 
+/// Largest configuration text the YAML loader reads (1 MiB); kfd's keys need a few hundred
+/// bytes.
+constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;
+
+/// Checks the text of an .ini file before MRPT reads it (MRPT keeps the last of two equal
+/// keys silently): ConfigError naming the key when a key of `section` appears twice (keys and
+/// sections compared without case, as MRPT does).
+void checkIniText(const std::string& text, const std::string& section = "KFD");
+
+/// Checks YAML text before it reaches MRPT's YAML parser (libfyaml, which can loop forever on
+/// malformed text, e.g. the 4 bytes "%\xff\xff\n"), so that no file can hang a tool.
+/// ConfigError (file level, or naming the key) unless:
+///  - size: at most kMaxConfigBytes;
+///  - encoding: valid UTF-8 (no overlong forms, surrogates or code points above U+10FFFF);
+///    a byte-order mark only as the very first character;
+///  - characters: no control character other than tab, CR and LF (C0, DEL, C1);
+///  - the subset kfd's keys need: a map of scalars, or the same map under one top-level
+///    key (`kfd:`), at most two levels; values plain or quoted scalars, flow lists [a, b]
+///    (not nested) or block lists (- a). Outside comments none of { } & * ! % ? | > @ `
+///    (flow maps, anchors, aliases, tags, directives, complex keys, block scalars), no
+///    document markers (--- or ...), no tab in indentation, no unterminated quote or list;
+///  - no key twice in the same map (ConfigError naming the key).
+void checkYamlText(const std::string& text);
+
+/// checkYamlText(text), then MRPT's YAML parser, then loadYaml. `origin` names the text in
+/// messages (e.g. "file x.yaml").
+Pipeline::Params loadYamlText(const std::string& text, const std::string& origin = "");
+
 /// Reads a YAML map of the same keys. If the document has a top-level `kfd:` map, that map is
 /// used; otherwise the top level itself.
 Pipeline::Params loadYaml(const mrpt::containers::yaml& doc);
 
-/// Loads a .ini/.cfg (section [KFD]) or .yaml/.yml file by extension. Throws ConfigError when the
+/// Loads a .ini/.cfg (section [KFD]) or .yaml/.yml file by extension (YAML through
+/// loadYamlText; .ini keys set twice are a ConfigError, see checkIniText; so is
+/// `pipeline =` with no stage). Throws ConfigError when the
 /// file is missing, unreadable, or has no [KFD] section / kfd keys.
 Pipeline::Params loadConfigFile(const std::string& path, const std::string& section = "KFD");
 
