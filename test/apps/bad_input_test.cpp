@@ -16,6 +16,8 @@
 #include <thread>
 #include <vector>
 
+#include <mrpt/io/CFileGZInputStream.h>
+
 #include "test_files.h"
 
 namespace {
@@ -102,6 +104,23 @@ const std::string kIni = std::string(KFD_SHARE_DIR) + "/default.ini";
 const std::string kSlamIni = std::string(KFD_SOURCE_DIR) + "/share/kfd-icp-slam/sick-180-5hz.ini";
 const std::string kIntel = std::string(KFD_DATASETS_DIR) + "/intel/intel.rawlog";
 
+// The bundled office log decoded to a plain rawlog (a gzip file is checked whole before any
+// object is read, so only a plain file can fail in the middle of the run).
+std::string plainOffice() {
+    mrpt::io::CFileGZInputStream in(kOffice);
+    std::string out, buf(1 << 16, '\0');
+    while (const std::size_t n = in.Read(buf.data(), buf.size())) out.append(buf.data(), n);
+    return out;
+}
+
+// The first line of a refused gzip input: the file, the reason, the hint.
+void expectGzipRefusal(const std::string& first, const std::string& app, const std::string& in,
+                       const std::string& reason) {
+    EXPECT_EQ(first.rfind(app + ": " + in + ": ", 0), 0u) << first;
+    EXPECT_NE(first.find(reason), std::string::npos) << first;
+    EXPECT_NE(first.find("(truncated or corrupt file?)"), std::string::npos) << first;
+}
+
 // --- output paths ----------------------------------------------------------------------------
 
 TEST(BadInputOutputPaths, FilterStatsOnTheInputRawlogIsRefused) {
@@ -168,9 +187,10 @@ TEST(BadInputOutputPaths, FilterOutputAndStatsOnTheSameFileAreRefused) {
 }
 
 TEST(BadInputOutputPaths, FilterFailureLeavesNoStatsFileAndNoTemporary) {
-    Dir d;  // a log cut in the middle of an object: the run fails after writing rows
-    const std::string data = fileBytes(kOffice);
-    const auto in = d.write("cut.rawlog", data.substr(0, data.size() / 2));
+    Dir d;  // a plain log cut inside an object (its objects are all the same size, so not at
+            // half): the run fails after writing rows
+    const std::string data = plainOffice();
+    const auto in = d.write("cut.rawlog", data.substr(0, data.size() / 2 + 100));
     const Snapshot snap({in});
     const Result r = run(KFD_FILTER_EXE,
                          {"-q", "-i", in, "-o", d / "out.rawlog", "--stats", d / "s.csv"}, d.path);
@@ -224,8 +244,8 @@ TEST(BadInputOutputPaths, IcpSlamOutputFolderHoldingAnInputIsRefused) {
 
 TEST(BadInputOutputPaths, IcpSlamFailureKeepsTheFolderAndItsOtherFiles) {
     Dir d;
-    const std::string data = fileBytes(kOffice);
-    const auto in = d.write("cut.rawlog", data.substr(0, data.size() / 2));
+    const std::string data = plainOffice();
+    const auto in = d.write("cut.rawlog", data.substr(0, data.size() / 2 + 100));
     const auto cfg = d.copy(kSlamIni, "slam.ini");
     fs::create_directory(d / "out");
     const auto mine = d.write("out/notes.txt", "mine\n");
@@ -351,9 +371,7 @@ void expectFilterRefuses(const std::string& bytes, const std::string& reason) {
     const Result r = run(KFD_FILTER_EXE,
                          {"-q", "-i", in, "-o", d / "out.rawlog", "--stats", d / "s.csv"}, d.path);
     EXPECT_EQ(r.status, 1);
-    const std::string first = r.first();
-    EXPECT_EQ(first.rfind("kfd-filter: cannot read object #", 0), 0u) << r.err;
-    EXPECT_NE(first.find(reason), std::string::npos) << first;
+    expectGzipRefusal(r.first(), "kfd-filter", in, reason);
     EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
     snap.expectUnchanged();
 }
@@ -379,6 +397,26 @@ TEST(BadInputTruncated, GarbageAfterTheGzipStreamIsAnError) {
     expectFilterRefuses(fileBytes(kOffice) + "garbage", "garbage after the gzip stream");
 }
 
+TEST(BadInputTruncated, ACorruptLengthFieldIsAnErrorNotGigabytes) {
+    // The first scan's sensor label length claims 4 GiB (MRPT alone zero-fills a 4 GiB string
+    // first: 4.2 GB resident). kfd-filter refuses the object, names the cause, writes nothing.
+    std::string data = plainOffice();
+    const std::size_t at = data.find("LASER");
+    ASSERT_NE(at, std::string::npos);
+    ASSERT_EQ(data.substr(at - 4, 4), std::string("\x05\0\0\0", 4));
+    data.replace(at - 4, 4, std::string("\xf0\xff\xff\xff", 4));
+    Dir d;
+    const auto in = d.write("in.rawlog", data);
+    const Snapshot snap({in});
+    const Result r = run(KFD_FILTER_EXE,
+                         {"-q", "-i", in, "-o", d / "out.rawlog", "--stats", d / "s.csv"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first().rfind("kfd-filter: cannot read object #0 of " + in, 0), 0u) << r.err;
+    EXPECT_NE(r.first().find("(a corrupt length field)"), std::string::npos) << r.err;
+    EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
+    snap.expectUnchanged();
+}
+
 TEST(BadInputTruncated, IcpSlamOnATruncatedGzipFailsWithNoOutput) {
     Dir d;
     const std::string data = fileBytes(kOffice);
@@ -388,8 +426,7 @@ TEST(BadInputTruncated, IcpSlamOnATruncatedGzipFailsWithNoOutput) {
     const Result r =
         run(KFD_ICP_SLAM_EXE, {"-q", cfg, in, "-o", d / "out", "-m", "none", "--no-map"}, d.path);
     EXPECT_EQ(r.status, 1);
-    EXPECT_EQ(r.first().rfind("kfd-icp-slam: cannot read object #", 0), 0u) << r.err;
-    EXPECT_NE(r.first().find("the gzip stream ends early"), std::string::npos) << r.err;
+    expectGzipRefusal(r.first(), "kfd-icp-slam", in, "the gzip stream ends early");
     EXPECT_EQ(listing(d.path), (std::set<std::string>{"in.rawlog", "slam.ini"}));
     snap.expectUnchanged();
 }
@@ -431,6 +468,37 @@ TEST(BadInputTruncated, SimulateOnAGridmapWithoutItsGzipTrailerFails) {
                   ": the gzip stream ends early (no trailer) (truncated or corrupt file?)");
     EXPECT_EQ(listing(d.path), (std::set<std::string>{"g.gridmap.gz", "route.txt"}));
     snap.expectUnchanged();
+}
+
+// --- configuration ---------------------------------------------------------------------------
+
+// kfd-filter with a bad configuration: exit 1, the first line, nothing written, inputs kept.
+void expectConfigRefused(const std::string& name, const std::string& text,
+                         const std::string& message) {
+    SCOPED_TRACE(name);
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const auto cfg = d.write(name, text);
+    const Snapshot snap({in, cfg});
+    const Result r =
+        run(KFD_FILTER_EXE,
+            {"-q", "-i", in, "-c", cfg, "-o", d / "out.rawlog", "--stats", d / "s.csv"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first().rfind("kfd-filter: ", 0), 0u) << r.err;
+    EXPECT_NE(r.first().find(message), std::string::npos) << r.err;
+    EXPECT_EQ(listing(d.path), (std::set<std::string>{"in.rawlog", name}));
+    snap.expectUnchanged();
+}
+
+TEST(BadInputConfiguration, DuplicateKeysEmptyPipelinesAndHangingYamlAreErrors) {
+    expectConfigRefused("dup.ini", "[KFD]\nwindow = 3\nwindow = 4\n", "window");
+    expectConfigRefused("dup.yaml", "window: 3\nwindow: 4\n", "window");
+    expectConfigRefused("empty.ini", "[KFD]\npipeline =\n", "pipeline");
+    expectConfigRefused("range.ini", "[KFD]\nwindow = 0\n", "window");
+    // The 4 bytes that made MRPT's YAML parser (libfyaml) loop forever: refused at once.
+    expectConfigRefused("hang.yaml",
+                        fileBytes(std::string(KFD_SOURCE_DIR) + "/test/data/yaml-hang-4byte.yaml"),
+                        "hang.yaml");
 }
 
 }  // namespace

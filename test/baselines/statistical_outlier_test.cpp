@@ -55,6 +55,10 @@ TEST(StatisticalOutlierFilter, Defaults) {
 
 TEST(StatisticalOutlierFilter, InvalidParamsThrowNamingTheKey) {
     EXPECT_THROW(StatisticalOutlierFilter{params(0, 1.0)}, kfd::ParameterError);
+    // k is bounded (the per-scan work is O(n (log n + k))).
+    EXPECT_NO_THROW(StatisticalOutlierFilter{params(kfd::kMaxSorNeighbours, 1.0)});
+    EXPECT_THROW(StatisticalOutlierFilter{params(kfd::kMaxSorNeighbours + 1, 1.0)},
+                 kfd::ParameterError);
     EXPECT_NE(whatOf(params(0, 1.0)).find("sor_k"), std::string::npos);
     for (const double m : {-0.5, -1e-9, kNaN, kInf, -kInf}) {
         SCOPED_TRACE(m);

@@ -1,6 +1,7 @@
 // The input layer: RawlogSource on tiny hand-made rawlogs (both layouts, plain and gzip), clean
 // end of file against truncated files, the stamp rule and the odometry tracker.
 #include <gtest/gtest.h>
+#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CFileOutputStream.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
@@ -8,12 +9,14 @@
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/poses/CPoint2D.h>
 #include <mrpt/serialization/CArchive.h>
+#include <sys/resource.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <vector>
 
+#include "kfd/mrpt/allocation_limit.h"
 #include "kfd/mrpt/rawlog_source.h"
 #include "kfd/mrpt/scan_adapter.h"
 #include "test_files.h"
@@ -317,10 +320,28 @@ TEST(RawlogSource, TruncatedRealRawlogThrowsAndTheFullOneEndsCleanly) {
     EXPECT_EQ(objects, 1200u);  // a scan and an odometry observation per step
     EXPECT_EQ(entries, 1200u);
     EXPECT_EQ(scans, 600u);
-    EXPECT_EQ(full.bytesTotal(), fs::file_size(real));
-    EXPECT_GT(full.bytesRead(), full.bytesTotal());  // decoded bytes of a gzip file
+    // Progress counts decoded bytes of the gzip file, and the total is its decoded size.
+    EXPECT_GT(full.bytesTotal(), fs::file_size(real));
+    EXPECT_EQ(full.bytesRead(), full.bytesTotal());
+    // A cut gzip file fails when it is opened, before any object is read.
     cut(real, dir / "cut.rawlog", fs::file_size(real) / 2);
-    kfd::RawlogSource cutSource(dir / "cut.rawlog");
+    try {
+        kfd::RawlogSource cutSource(dir / "cut.rawlog");
+        ADD_FAILURE() << "a truncated gzip rawlog opened without an error";
+    } catch (const kfd::RawlogError& err) {
+        EXPECT_NE(std::string(err.what()).find("truncated or corrupt"), std::string::npos);
+    }
+    // The same log decoded, then cut inside an object (half is a boundary: 600 equal pairs):
+    // read up to the cut, then an error.
+    {
+        mrpt::io::CFileGZInputStream in(real);
+        std::ofstream out(dir / "plain.rawlog", std::ios::binary);
+        std::string buf(1 << 16, '\0');
+        while (const std::size_t n = in.Read(buf.data(), buf.size())) out.write(buf.data(), n);
+    }
+    cut(dir / "plain.rawlog", dir / "cut-plain.rawlog",
+        fs::file_size(dir / "plain.rawlog") / 2 + 100);
+    kfd::RawlogSource cutSource(dir / "cut-plain.rawlog");
     std::size_t before_error = 0;
     try {
         while (cutSource.next(e)) ++before_error;
@@ -330,6 +351,58 @@ TEST(RawlogSource, TruncatedRealRawlogThrowsAndTheFullOneEndsCleanly) {
     }
     EXPECT_GT(before_error, 100u);
     EXPECT_LT(before_error, 1200u);
+}
+
+// Regression (fuzz_rawlog): damaged compressed data decodes to garbage whose length fields
+// MRPT's deserialisers trust; these 12 kB inputs made them allocate 1.3-2.7 GB before failing.
+// The whole gzip stream is now checked first: each is refused when opened, and the process's
+// peak memory stays far below what one such allocation took.
+TEST(RawlogSource, DamagedGzipIsRefusedBeforeMrptDecodesAnyObject) {
+    const fs::path corpus = fs::path(KFD_SOURCE_DIR) / "test/fuzz/corpus/rawlog";
+    std::size_t n = 0;
+    for (const auto& f : fs::directory_iterator(corpus)) {
+        if (f.path().filename().string().rfind("finding-gzip-", 0) != 0) continue;
+        SCOPED_TRACE(f.path().string());
+        ++n;
+        EXPECT_THROW(kfd::RawlogSource{f.path().string()}, kfd::RawlogError);
+    }
+    EXPECT_EQ(n, 4u);
+    struct rusage u {};
+    getrusage(RUSAGE_SELF, &u);
+    EXPECT_LT(u.ru_maxrss, 1024L * 1024L);  // KiB: below 1 GiB
+}
+
+// A plain rawlog whose first scan's sensor label claims 4 GiB: MRPT would zero-fill a 4 GiB
+// string before its read fails (4.2 GB resident, 6 s). With kfd::alloc_limit linked (as this
+// test and every app are) the allocation is refused: a RawlogError naming the cause, the scans
+// before it read, and peak memory far below the claim.
+TEST(RawlogSource, ALengthFieldBeyondTheFileIsRefusedNotAllocated) {
+    TempDir dir;
+    write(dir / "log.rawlog", observationsLog(), false);
+    std::string data = bytes(dir / "log.rawlog");
+    const std::size_t first = data.find("LASER");
+    ASSERT_NE(first, std::string::npos);
+    const std::size_t at = data.find("LASER", first + 5);  // the second scan's label
+    ASSERT_NE(at, std::string::npos);
+    ASSERT_EQ(data.substr(at - 4, 4), std::string("\x05\0\0\0", 4));  // its length, 5
+    data.replace(at - 4, 4, std::string("\xf0\xff\xff\xff", 4));
+    std::ofstream(dir / "bad.rawlog", std::ios::binary) << data;
+    kfd::RawlogSource src(dir / "bad.rawlog");
+    SourceEntry e;
+    std::size_t read = 0;
+    try {
+        while (src.next(e)) ++read;
+        ADD_FAILURE() << "no error";
+    } catch (const kfd::RawlogError& err) {
+        EXPECT_NE(std::string(err.what()).find("a corrupt length field"), std::string::npos)
+            << err.what();
+    }
+    EXPECT_EQ(read, 2u);  // the first scan and the odometry observation
+    struct rusage u {};
+    getrusage(RUSAGE_SELF, &u);
+    EXPECT_LT(u.ru_maxrss, 1024L * 1024L);  // KiB: below 1 GiB
+    // The bound is lifted after each object.
+    EXPECT_EQ(kfd::allocationLimit(), SIZE_MAX);
 }
 
 TEST(RawlogSource, MissingEmptyOrForeignFilesAreRawlogErrors) {

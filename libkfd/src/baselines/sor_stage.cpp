@@ -7,7 +7,7 @@ namespace kfd {
 std::vector<StageKey> SorStage::keys() {
     using P = Params;
     return {keys::count<P>("sor_k", "k", "sor stage: nearest neighbours per point (points)", 1,
-                           1000, [](P& p) -> std::size_t& { return p.k; }),
+                           kMaxSorNeighbours, [](P& p) -> std::size_t& { return p.k; }),
             keys::real<P>("sor_std_mul", "std_mul",
                           "sor stage: noise above mean + sor_std_mul x stddev of the mean "
                           "neighbour distance (standard deviations)",

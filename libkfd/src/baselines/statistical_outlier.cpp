@@ -2,12 +2,16 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
+
 #include "kfd/core/error.h"
 
 namespace kfd {
 
 void StatisticalOutlierFilter::initialize(const Params& p) {
-    if (p.k < 1) throw ParameterError("k", "sor_k must be >= 1");
+    if (p.k < 1 || p.k > kMaxSorNeighbours)
+        throw ParameterError("k",
+                             "sor_k must be in [1, " + std::to_string(kMaxSorNeighbours) + "]");
     if (!(p.std_mul >= 0.0) || !std::isfinite(p.std_mul))
         throw ParameterError("std_mul", "sor_std_mul must be finite and >= 0");
     params_ = p;

@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <vector>
 
+#include "kfd/mrpt/allocation_limit.h"
+
 namespace kfd {
 namespace {
 
@@ -51,6 +53,9 @@ class GzReader : public mrpt::io::CStream {
     GzReader(const GzReader&) = delete;
     GzReader& operator=(const GzReader&) = delete;
     bool isOpen() const { return file_ != nullptr; }
+    bool isGzip() const { return gzip_; }
+    // The size getTotalBytesCount() reports: the decoded size once it is known.
+    void setTotal(std::uint64_t decoded) { size_ = decoded; }
 
     size_t Read(void* buf, size_t count) override {
         if (error_.size() || count == 0) return 0;
@@ -184,10 +189,18 @@ struct RawlogSource::Impl {
         mrpt::serialization::CSerializable::Ptr obj;
         while (!obj && !ended) {
             try {
+                // No allocation larger than the data left (allocation_limit.h).
+                const ScopedAllocationLimit limit(static_cast<std::size_t>(std::min<std::uint64_t>(
+                                                      bytesLeft(), SIZE_MAX - kAllocationSlack)) +
+                                                  kAllocationSlack);
                 obj = arch.ReadObject();
             } catch (const mrpt::serialization::CExceptionEOF&) {
                 ended = true;
                 if (const std::string f = in.failure(); !f.empty()) throw error(f);
+            } catch (const std::bad_alloc&) {
+                ended = true;
+                throw error("an object claims more memory than the " + std::to_string(bytesLeft()) +
+                            " bytes left in the file (a corrupt length field)");
             } catch (const std::exception& e) {
                 ended = true;
                 if (!in.error().empty()) throw error(in.error());  // the gzip layer knows why
@@ -196,6 +209,11 @@ struct RawlogSource::Impl {
         }
         if (obj) ++objects;
         return obj;
+    }
+
+    // Decoded bytes not read yet.
+    std::uint64_t bytesLeft() const {
+        return in.getTotalBytesCount() - std::min(in.getPosition(), in.getTotalBytesCount());
     }
 
     RawlogError error(const std::string& what) const {
@@ -207,16 +225,25 @@ struct RawlogSource::Impl {
     }
 };
 
-void checkGzipIntegrity(const std::string& path) {
-    std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) throw RawlogError("file not found: " + path, path);
+namespace {
+// Decodes the whole file once; returns its decoded size, or throws RawlogError naming the
+// file and the reason.
+std::uint64_t decodeAll(const std::string& path) {
     GzReader in(path);
     if (!in.isOpen()) throw RawlogError("cannot open " + path, path);
     std::vector<char> buf(1 << 16);
-    while (in.Read(buf.data(), buf.size()) > 0) {
-    }
+    std::uint64_t total = 0;
+    while (const std::size_t n = in.Read(buf.data(), buf.size())) total += n;
     if (const std::string f = in.failure(); !f.empty())
         throw RawlogError(path + ": " + f + " (truncated or corrupt file?)", path);
+    return total;
+}
+}  // namespace
+
+void checkGzipIntegrity(const std::string& path) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) throw RawlogError("file not found: " + path, path);
+    decodeAll(path);
 }
 
 RawlogSource::RawlogSource(const std::string& path) {
@@ -225,6 +252,11 @@ RawlogSource::RawlogSource(const std::string& path) {
     impl_ = std::make_unique<Impl>(path);
     if (!impl_->in.isOpen()) throw RawlogError("cannot open the input rawlog: " + path, path);
     if (impl_->in.getTotalBytesCount() == 0) throw RawlogError("the input is empty: " + path, path);
+    // A gzip file is decoded once before any object is read: damaged compressed data decodes
+    // to garbage whose length fields MRPT's deserialisers trust (a 12 kB file found by
+    // fuzz_rawlog made them allocate 2.7 GB), and a cut or corrupt file then fails before
+    // anything is written. It also gives the decoded size, which bytesRead() counts in.
+    if (impl_->in.isGzip()) impl_->in.setTotal(decodeAll(path));
 }
 
 RawlogSource::~RawlogSource() = default;

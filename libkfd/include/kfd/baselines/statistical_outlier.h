@@ -26,7 +26,8 @@ namespace kfd {
 ///
 /// A valid beam with a non-finite range has no position (an infinite d_i): it is removed and
 /// left out of the statistics (run the distance stage first to account for it there).
-/// Neighbour queries use NeighbourSearch2D::knn: O(n (log n + k)) per scan.
+/// Neighbour queries use NeighbourSearch2D::knn: O(n (log n + k)) time and O(n + k) memory
+/// per scan, bounded by n <= kMaxScanBeams and k <= kMaxSorNeighbours.
 ///
 /// The defaults (k = 8, std_mul = 1) are kfd's own choice for 2D scans, not from the paper
 /// (which compares with DBSCAN only) nor from PCL's tutorial (k = 50 on dense 3D clouds):
@@ -35,6 +36,9 @@ namespace kfd {
 /// r * resolution apart), so far points sit above mu + sigma even on solid walls. Measured after
 /// the default distance stage on MRPT's SENA sample (361 beams over 180 deg) it removes under
 /// 1 % of the points within 10 m, 23 % at 15-20 m and about half beyond 20 m (9 % overall).
+/// The largest k (sor_k) accepted: 1000 neighbours.
+inline constexpr std::size_t kMaxSorNeighbours = 1000;
+
 class StatisticalOutlierFilter {
   public:
     struct Params {
@@ -51,8 +55,8 @@ class StatisticalOutlierFilter {
 
     StatisticalOutlierFilter() = default;
     explicit StatisticalOutlierFilter(const Params& p) { initialize(p); }
-    /// kfd::ParameterError (naming the config key) unless k >= 1 and std_mul is finite and
-    /// >= 0.
+    /// kfd::ParameterError (naming the config key) unless 1 <= k <= kMaxSorNeighbours and
+    /// std_mul is finite and >= 0.
     void initialize(const Params& p);
     const Params& params() const { return params_; }
 

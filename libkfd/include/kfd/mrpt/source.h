@@ -123,7 +123,8 @@ class Source {
     virtual bool next(SourceEntry& e) = 0;
     /// The log's path, for messages.
     virtual const std::string& path() const = 0;
-    /// Progress: position in the decoded input stream (bytes) and the file's size (bytes).
+    /// Progress: position in the decoded input stream and its total size (bytes; for a
+    /// compressed file the decoded size).
     virtual std::uint64_t bytesRead() const = 0;
     virtual std::uint64_t bytesTotal() const = 0;
 };
