@@ -1,7 +1,9 @@
 // kfd-eval: trajectory error against ground truth (relations metric, ATE, RPE).
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "common/cli.h"
 #include "kfd/eval/ate.h"
@@ -28,6 +30,12 @@ int main(int argc, char** argv) {
     cli.option("--rpe-delta", rpe_delta, "RPE time step (s)")
         ->type_name("S")
         ->capture_default_str();
+    std::optional<double> split_s;
+    cli.option("--split-seconds", split_s,
+               "also the relations error of local relations (stamps at most S s\n"
+               "apart) and of the long ones",
+               kfd::app::toNumber<double>)
+        ->type_name("S");
     return cli.run(argc, argv, [&] {
         if (rel_file.empty() && gt_file.empty())
             throw kfd::app::UsageError("give --relations and/or --gt");
@@ -40,14 +48,38 @@ int main(int argc, char** argv) {
         auto est = kfd::readTum(est_file);
         kfd::sortByTime(est);
         std::printf("estimate   %s (%zu poses)\n", est_file.c_str(), est.size());
+        if (split_s && rel_file.empty())
+            throw kfd::app::UsageError("--split-seconds needs --relations");
+        if (split_s && (!(*split_s >= 0.0) || !std::isfinite(*split_s)))
+            throw kfd::app::UsageError("--split-seconds: must be finite and >= 0 (got " +
+                                       std::to_string(*split_s) + ")");
         if (!rel_file.empty()) {
-            const auto r = kfd::evaluateRelations(est, kfd::readRelations(rel_file), max_dt);
+            const auto relations = kfd::readRelations(rel_file);
+            const auto r = kfd::evaluateRelations(est, relations, max_dt);
             std::printf("relations  %s: %zu used, %zu unmatched (max dt %.3g s)\n",
                         rel_file.c_str(), r.used, r.unmatched, max_dt);
             std::printf("  trans abs  %.4f +- %.4f m    | trans sq %.5f +- %.5f m^2\n",
                         r.trans_mean, r.trans_std, r.trans2_mean, r.trans2_std);
             std::printf("  rot   abs  %.3f +- %.3f deg  | rot sq %.3f +- %.3f deg^2\n",
                         r.rot_mean_deg, r.rot_std_deg, r.rot2_mean, r.rot2_std);
+            if (split_s) {
+                const auto split = kfd::splitRelations(relations, *split_s);
+                for (const auto& [name, sub] :
+                     {std::pair{"local", &split.local}, std::pair{"long", &split.far}}) {
+                    const char* cmp = sub == &split.local ? "<=" : "> ";
+                    if (sub->empty()) {
+                        std::printf("  %-5s (%s %g s): no relation\n", name, cmp, *split_s);
+                        continue;
+                    }
+                    // A subset that matched nothing is an error, like the whole set.
+                    const auto e = kfd::evaluateRelations(est, *sub, max_dt);
+                    std::printf(
+                        "  %-5s (%s %g s): %zu used, %zu unmatched: trans %.4f +- %.4f m, rot "
+                        "%.3f +- %.3f deg\n",
+                        name, cmp, *split_s, e.used, e.unmatched, e.trans_mean, e.trans_std,
+                        e.rot_mean_deg, e.rot_std_deg);
+                }
+            }
         }
         if (!gt_file.empty()) {
             auto gt = kfd::readTum(gt_file);

@@ -2,6 +2,7 @@
 // All logic lives in kfd::IcpSlamRunner; this file parses arguments and reports.
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include "common/cli.h"
 #include "kfd/report/slam_report.h"
@@ -45,10 +46,25 @@ int main(int argc, char** argv) {
         return text;
     });
     cli.option("--match-drop", o.odometry_target_drop_pct,
-               "odometry mode: pick the motion thresholds that drop PCT %\n"
-               "of the scans (e.g. kfd's drop rate on the same log)",
+               "odometry or decimate mode: drop PCT % of the scans (odometry:\n"
+               "the motion thresholds that do; decimate: keep 1 - PCT/100)",
                kfd::app::toNumber<double>)
         ->type_name("PCT");
+    cli.option("--match-drop-of", o.match_drop_of,
+               "odometry or decimate mode: drop as many scans as MODE does\n"
+               "on this log with these options (a pre-pass of the pre-filter)",
+               kfd::parsePrefilterMode)
+        ->type_name("MODE");
+    cli.option("--skip-scans", o.skip_scans,
+               "skip the first K scans of the log (repeats that start later)")
+        ->type_name("K");
+    cli.flag("--laser-only", o.laser_only,
+             "ignore odometry: neither the pre-filter nor ICP-SLAM gets any\n"
+             "(what a robot without wheel odometry sees)");
+    cli.option("--split-seconds", o.split_seconds,
+               "relations over at most S s are local, the others long")
+        ->type_name("S")
+        ->capture_default_str();
     cli.option("-g,--relations", o.relations, "ground-truth .relations: report the relations error")
         ->type_name("FILE");
     cli.option("--gt", o.ground_truth_tum,
@@ -66,8 +82,13 @@ int main(int argc, char** argv) {
             if (!o.rawlog.empty()) throw kfd::app::UsageError("rawlog given twice");
             o.rawlog = rawlog_arg;
         }
-        if (o.odometry_target_drop_pct && o.mode != kfd::PrefilterMode::Odometry)
-            throw kfd::app::UsageError("--match-drop applies to --mode odometry only");
+        const bool matchable =
+            o.mode == kfd::PrefilterMode::Odometry || o.mode == kfd::PrefilterMode::Decimate;
+        if ((o.odometry_target_drop_pct || o.match_drop_of) && !matchable)
+            throw kfd::app::UsageError(
+                "--match-drop and --match-drop-of apply to --mode odometry or decimate only");
+        if (o.odometry_target_drop_pct && o.match_drop_of)
+            throw kfd::app::UsageError("give --match-drop or --match-drop-of, not both");
         if (no_map) o.write_map = false;
         if (auto* progress = cli.progress())
             o.on_progress = [progress](const kfd::IcpSlamProgress& p) {
@@ -92,6 +113,14 @@ int main(int argc, char** argv) {
                 "  relations  %zu used, %zu unmatched: trans %.4f +- %.4f m, rot %.3f +- "
                 "%.3f deg\n",
                 r.used, r.unmatched, r.trans_mean, r.trans_std, r.rot_mean_deg, r.rot_std_deg);
+            for (const auto& [name, sub] :
+                 {std::pair{"local", &s.relations_local}, std::pair{"long ", &s.relations_long}})
+                if (*sub)
+                    std::printf("    %s    (%s %g s) %zu used: trans %.4f +- %.4f m\n", name,
+                                sub == &s.relations_local ? "<=" : ">", s.split_seconds,
+                                (*sub)->used, (*sub)->trans_mean, (*sub)->trans_std);
         }
+        if (s.target_drop_pct)
+            std::printf("  matched    drop target %.2f %%\n", *s.target_drop_pct);
     });
 }

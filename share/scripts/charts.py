@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Renders the charts of docs/RESULTS.md into docs/figures/ from the experiment outputs
-(out/slam/results.json of slam_experiment.py; out/sim-slam/results.json of
-sim_slam_experiment.py), with kfd-chart (MRPT's 2D canvas: no display, no extra package).
+"""Renders the benchmark chart of docs/RESULTS.md (docs/figures/time-per-stage.png) from
+out/bench/stages.json (share/scripts/bench.sh), with kfd-chart (MRPT's 2D canvas: no display).
+The SLAM comparisons draw their own box plots (kfd-compare).
 Usage: python3 share/scripts/charts.py
 """
 import json
@@ -27,21 +27,6 @@ def chart(rows, out, title, ylabel, log=False):
 
 def main():
     os.makedirs(FIG, exist_ok=True)
-    real = os.path.join(ROOT, "out", "slam", "results.json")
-    if os.path.exists(real):
-        res = json.load(open(real))
-        err, time, drop = [], [], []
-        for d, modes in res.items():
-            for m, s in modes.items():
-                r = s["relations"]
-                err.append((d, m, r["trans_mean_m"], r["trans_std_m"]))
-                time.append((d, m, s["prefilter_us_per_scan"] / 1000.0 + s["icp_ms_per_scan"], 0))
-                drop.append((d, m, s["dropped_pct"], 0))
-        chart(err, "relations-error.png",
-              "Relations translation error per dataset and mode (mean +- std)", "m, log", True)
-        chart(time, "time-per-scan.png",
-              "Pre-filter + ICP-SLAM time per input scan", "ms per scan")
-        chart(drop, "dropped.png", "Scans dropped by the pre-filter", "% of scans")
     bench = os.path.join(ROOT, "out", "bench", "stages.json")  # from share/scripts/bench.sh
     if os.path.exists(bench):
         names = {"BM_DistanceFilter": "distance", "BM_Histogram": "histogram",
@@ -56,11 +41,6 @@ def main():
                 rows.append((names[b["run_name"]], "median CPU time", us, 0))
         chart(rows, "time-per-stage.png",
               "Time per 1081-beam scan by stage (Google Benchmark medians)", "us, log", True)
-    sim = os.path.join(ROOT, "out", "sim-slam", "results.json")
-    if os.path.exists(sim):
-        res = json.load(open(sim))
-        rows = [(t, m, s["ate_rmse"], 0) for t, modes in res.items() for m, s in modes.items()]
-        chart(rows, "sim-ate.png", "ATE RMSE on simulated 40 Hz logs", "m, log", True)
 
 
 if __name__ == "__main__":

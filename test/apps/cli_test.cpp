@@ -272,7 +272,8 @@ TEST(CliApps, BadUsageExitsTwoAndSaysWhatIsWrong) {
         {"kfd-eval", "est.tum -r", "--relations"},
         {"kfd-eval", "est.tum", "give --relations and/or --gt"},
         {"kfd-icp-slam", "x.ini a.rawlog -i b.rawlog", "rawlog given twice"},
-        {"kfd-icp-slam", "x.ini --match-drop 10", "--match-drop applies to --mode odometry only"},
+        {"kfd-icp-slam", "x.ini --match-drop 10",
+         "--match-drop and --match-drop-of apply to --mode odometry or decimate only"},
         {"kfd-icp-slam", "x.ini --mode fast", "--mode: unknown pre-filter mode"},
         {"kfd-simulate", "-o x.rawlog --gridmap g", "--gridmap and --route"},
         {"kfd-chart", "in.csv -o out.png --size 640", "--size"},
@@ -308,7 +309,7 @@ TEST(CliApps, FilterVersionAndEarlyExits) {
     EXPECT_EQ(r.out.rfind("[KFD]", 0), 0u) << r.out;
 }
 
-// The experiment scripts read the mode list from here (share/scripts/kfd_modes.py): one line a
+// kfd-compare reads the mode list from here (share/scripts/kfd_compare.py): one line a
 // mode, "name<TAB>stages<TAB>description", before the required CONFIG.ini is asked for.
 TEST(CliApps, IcpSlamListsEveryModeWithItsStages) {
     const Result r = runApp(KFD_ICP_SLAM_EXE, "--list-modes");
@@ -320,7 +321,7 @@ TEST(CliApps, IcpSlamListsEveryModeWithItsStages) {
         names.push_back(line.substr(0, line.find('\t')));
     }
     EXPECT_EQ(names, (std::vector<std::string>{"none", "odometry", "keyframe", "kfd", "dbscan",
-                                               "radius", "sor"}));
+                                               "radius", "sor", "decimate"}));
     EXPECT_NE(r.out.find("none\t-\t"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("odometry\tmotion\t"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("radius\tdistance,radius\t"), std::string::npos) << r.out;

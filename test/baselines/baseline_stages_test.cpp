@@ -14,10 +14,10 @@ namespace {
 
 TEST(BaselineStages, RegisteredAfterTheCoreStages) {
     EXPECT_EQ(test::allStages().names(),
-              "distance, keyframe, denoise, motion, dbscan, radius, sor");
+              "distance, keyframe, denoise, motion, dbscan, radius, sor, decimate");
     StageRegistry only;
     registerBaselineStages(only);  // works without the core stages too
-    EXPECT_EQ(only.names(), "motion, dbscan, radius, sor");
+    EXPECT_EQ(only.names(), "motion, dbscan, radius, sor, decimate");
     EXPECT_THROW(registerBaselineStages(only), Error);  // twice: names are taken
 }
 

@@ -82,6 +82,19 @@ TEST(Relations, ReadsTheBenchmarkFormat) {
     std::filesystem::remove(f);
 }
 
+TEST(Relations, SplitByTimeSpanKeepsOrderAndTheBoundaryIsLocal) {
+    std::vector<kfd::Relation> rel{{0, 5, {}}, {0, 10, {}}, {3, 14, {}}, {20, 19, {}}, {1, 40, {}}};
+    const auto s = kfd::splitRelations(rel, 10.0);
+    ASSERT_EQ(s.local.size(), 3u);  // 5 s, exactly 10 s, and |19 - 20| = 1 s
+    EXPECT_EQ(s.local[1].t2, 10.0);
+    EXPECT_EQ(s.local[2].t1, 20.0);
+    ASSERT_EQ(s.far.size(), 2u);  // 11 s and 39 s
+    EXPECT_EQ(s.far[0].t2, 14.0);
+    EXPECT_EQ(kfd::splitRelations(rel, 0.0).local.size(), 0u);
+    EXPECT_THROW(kfd::splitRelations(rel, -1.0), kfd::EvalError);
+    EXPECT_THROW(kfd::splitRelations(rel, std::nan("")), kfd::EvalError);
+}
+
 TEST(KfdEvalCli, PrintsTheRelationsErrorAndFailsOnBadInput) {
     namespace fs = std::filesystem;
     const auto dir = fs::temp_directory_path() / "kfd_eval_cli";
@@ -102,6 +115,23 @@ TEST(KfdEvalCli, PrintsTheRelationsErrorAndFailsOnBadInput) {
     const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
     EXPECT_NE(text.find("1 used, 1 unmatched"), std::string::npos) << text;
     EXPECT_NE(text.find("trans abs  0.1000"), std::string::npos) << text;
+    // --split-seconds: local (<= 1 s: the matched 10-11 relation) and long (10-12: unmatched,
+    // so an error, not a perfect score).
+    std::ofstream(dir / "two.relations") << "10 11 1 0 0 0 0 0\n10 11 1 0 0 0 0 0\n";
+    ASSERT_EQ(run("'" + (dir / "est.tum").string() + "' -r '" + (dir / "two.relations").string() +
+                  "' --split-seconds 1"),
+              0);
+    std::ifstream f2(out);
+    const std::string split((std::istreambuf_iterator<char>(f2)), std::istreambuf_iterator<char>());
+    EXPECT_NE(split.find("local (<= 1 s): 2 used, 0 unmatched: trans 0.1000"), std::string::npos)
+        << split;
+    EXPECT_NE(split.find("long  (>  1 s): no relation"), std::string::npos) << split;
+    EXPECT_EQ(run("'" + (dir / "est.tum").string() + "' -r '" + (dir / "gt.relations").string() +
+                  "' --split-seconds 1.5"),
+              1);  // the long subset (10-12) matched nothing
+    EXPECT_EQ(run("'" + (dir / "est.tum").string() + "' -r '" + (dir / "gt.relations").string() +
+                  "' --split-seconds -2"),
+              2);
     EXPECT_EQ(run("'" + (dir / "missing.tum").string() + "' -r '" +
                   (dir / "gt.relations").string() + "'"),
               1);

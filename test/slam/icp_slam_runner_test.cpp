@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "kfd/baselines/decimate_stage.h"
 #include "kfd/core/cancel.h"
 #include "kfd/eval/trajectory.h"
 #include "kfd/mrpt/config.h"
@@ -154,6 +155,106 @@ TEST(IcpSlamRunner, OdometryModeMatchesATargetDropRate) {
     }
 }
 
+// kfd-compare's repeats: skip the first K scans; the same log, K scans fewer, no pose for them.
+TEST(IcpSlamRunner, SkipScansStartsTheRunKScansLater) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    auto o = options(kSena, dir / "k0", kfd::PrefilterMode::None);
+    o.write_map = false;
+    const auto all = runAndReport(o);
+    o.output_dir = dir / "k3";
+    o.skip_scans = 3;
+    const auto later = runAndReport(o);
+    EXPECT_EQ(later.scans_skipped_start, 3u);
+    EXPECT_EQ(later.scans_in, all.scans_in - 3);
+    const auto a = kfd::readTum(dir / "k0/trajectory.tum");
+    const auto b = kfd::readTum(dir / "k3/trajectory.tum");
+    ASSERT_EQ(b.size(), a.size() - 3);
+    EXPECT_EQ(b.front().t, a[3].t);  // the first pose is the fourth scan's
+    EXPECT_NE(text(dir / "k0/summary.json").find("\"scans_skipped_start\": 0"), std::string::npos);
+}
+
+// Laser-only: neither the pre-filter nor the map builder sees odometry. The motion stage then
+// keeps every scan (nothing to measure), and the estimate differs from a run with odometry.
+TEST(IcpSlamRunner, LaserOnlyGivesNoOdometryToThePrefilterOrToIcp) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    auto o = options(kSena, dir / "odo", kfd::PrefilterMode::Odometry);
+    o.write_map = false;
+    const auto with = runAndReport(o);
+    EXPECT_LT(with.scans_kept, with.scans_in);
+    o.output_dir = dir / "lo";
+    o.laser_only = true;
+    const auto without = runAndReport(o);
+    EXPECT_TRUE(without.laser_only);
+    EXPECT_EQ(without.scans_kept, without.scans_in);
+    auto none = options(kSena, dir / "none", kfd::PrefilterMode::None);
+    none.write_map = false;
+    runAndReport(none);
+    none.output_dir = dir / "none-lo";
+    none.laser_only = true;
+    runAndReport(none);
+    EXPECT_NE(text(dir / "none/trajectory.tum"), text(dir / "none-lo/trajectory.tum"));
+}
+
+// Decimation keeps a fixed share evenly; matched to another mode, it drops what that mode drops
+// on the same run (a pre-pass of the pre-filter alone), and so does the odometry baseline.
+TEST(IcpSlamRunner, DecimateAndOdometryMatchTheDropRateOfAnotherMode) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    auto k = options(kSena, dir / "kfd", kfd::PrefilterMode::Kfd);
+    k.write_map = false;
+    k.skip_scans = 2;
+    const auto kfd_run = runAndReport(k);
+    ASSERT_GT(kfd_run.dropped_pct, 5.0);
+    for (auto mode : {kfd::PrefilterMode::Decimate, kfd::PrefilterMode::Odometry}) {
+        SCOPED_TRACE(kfd::toString(mode));
+        auto o = options(kSena, dir / kfd::toString(mode), mode);
+        o.write_map = false;
+        o.skip_scans = 2;
+        o.match_drop_of = kfd::PrefilterMode::Kfd;
+        const auto s = runAndReport(o);
+        ASSERT_TRUE(s.target_drop_pct.has_value());
+        EXPECT_DOUBLE_EQ(*s.target_drop_pct, kfd_run.dropped_pct);
+        EXPECT_NEAR(s.dropped_pct, kfd_run.dropped_pct, 1.0);  // 222 scans: 0.45 % a scan
+        EXPECT_GE(s.cpu_s_match, 0.0);
+    }
+    auto d = options(kSena, dir / "dec", kfd::PrefilterMode::Decimate);
+    d.write_map = false;
+    d.odometry_target_drop_pct = 75.0;
+    const auto s = runAndReport(d);
+    EXPECT_EQ(s.scans_kept, 56u);  // every 4th of 224
+    EXPECT_DOUBLE_EQ(s.pipeline.get<kfd::DecimateStage>().keep_fraction, 0.25);
+    // Matching needs a mode that can match, and one target only.
+    auto bad = options(kSena, dir / "bad", kfd::PrefilterMode::Kfd);
+    bad.match_drop_of = kfd::PrefilterMode::Keyframe;
+    EXPECT_THROW(runAndReport(bad), kfd::SlamError);
+    bad.mode = kfd::PrefilterMode::Decimate;
+    bad.odometry_target_drop_pct = 10.0;
+    EXPECT_THROW(runAndReport(bad), kfd::SlamError);
+}
+
+// Relations over at most split_seconds are local, the others long; both are in the summary.
+TEST(IcpSlamRunner, RelationsAreSplitIntoLocalAndLong) {
+    if (!fs::exists(kMitCsail)) GTEST_SKIP() << "dataset missing: " << kMitCsail;
+    TempDir dir;
+    auto o = options(kMitCsail, dir / "out", kfd::PrefilterMode::None);
+    o.write_map = false;
+    o.relations = kMitCsailRel;
+    const auto s = runAndReport(o);
+    ASSERT_TRUE(s.relations_local && s.relations_long);
+    EXPECT_EQ(s.relations_local_count + s.relations_long_count, 1172u);
+    EXPECT_EQ(s.relations_local->used + s.relations_long->used, s.relations->used);
+    EXPECT_GT(s.relations_local_count, s.relations_long_count);
+    // Long relations carry the drift: their mean error is the larger.
+    EXPECT_GT(s.relations_long->trans_mean, s.relations_local->trans_mean);
+    const std::string json = text(dir / "out/summary.json");
+    for (const char* key : {"\"split_seconds\": 10", "\"relations_local\"", "\"relations_long\""})
+        EXPECT_NE(json.find(key), std::string::npos) << key;
+    o.split_seconds = -1.0;
+    EXPECT_THROW(runAndReport(o), kfd::SlamError);
+}
+
 TEST(IcpSlamRunner, BadInputIsAClearError) {
     TempDir dir;
     auto o = options(dir / "missing.rawlog", dir / "out", kfd::PrefilterMode::Kfd);
@@ -185,7 +286,8 @@ TEST(IcpSlamRunner, ModesAreNamedStageListsOfTheRegistry) {
         EXPECT_EQ(p.stages, m.uses_kfd_stages ? kfd_params.stages : m.stages) << m.name;
     }
     EXPECT_EQ(names, (std::vector<std::string>{"none", "odometry", "keyframe", "kfd", "dbscan",
-                                               "radius", "sor"}));
+                                               "radius", "sor", "decimate"}));
+    EXPECT_EQ(modes[7].stages, (std::vector<std::string>{"decimate"}));
     // The baseline modes run "distance" and then the baseline, described by its stage's help.
     EXPECT_EQ(modes[6].stages, (std::vector<std::string>{"distance", "sor"}));
     EXPECT_NE(modes[6].description.find(kfd::defaultStageRegistry().find("sor")->help),

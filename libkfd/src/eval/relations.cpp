@@ -71,4 +71,14 @@ RelationsError evaluateRelations(const Trajectory& traj, const std::vector<Relat
     return e;
 }
 
+RelationsByLength splitRelations(const std::vector<Relation>& relations, double split_s) {
+    if (!(split_s >= 0.0) || !std::isfinite(split_s))
+        throw EvalError("split_s must be finite and >= 0 (got " + std::to_string(split_s) + " s)",
+                        "split_s");
+    RelationsByLength out;
+    for (const auto& rel : relations)
+        (std::abs(rel.t2 - rel.t1) <= split_s ? out.local : out.far).push_back(rel);
+    return out;
+}
+
 }  // namespace kfd

@@ -9,7 +9,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <tuple>
 
+#include "kfd/baselines/decimate_stage.h"
 #include "kfd/baselines/motion_stage.h"
 #include "kfd/core/cancel.h"
 #include "kfd/render/map_figure.h"
@@ -79,6 +81,20 @@ void writeMap(const IcpSlamResult& res, const fs::path& out) {
         throw SlamError("cannot write " + (out / "map_figure.png").string());
 }
 
+// A relations error's fields (used, unmatched, means and deviations) into `o`.
+void relationsJson(nlohmann::ordered_json& o, const RelationsError& r) {
+    o["used"] = r.used;
+    o["unmatched"] = r.unmatched;
+    o["trans_mean_m"] = r.trans_mean;
+    o["trans_std_m"] = r.trans_std;
+    o["rot_mean_deg"] = r.rot_mean_deg;
+    o["rot_std_deg"] = r.rot_std_deg;
+    o["trans2_mean_m2"] = r.trans2_mean;
+    o["trans2_std_m2"] = r.trans2_std;
+    o["rot2_mean_deg2"] = r.rot2_mean;
+    o["rot2_std_deg2"] = r.rot2_std;
+}
+
 }  // namespace
 
 std::string toJson(const IcpSlamSummary& s) {
@@ -108,22 +124,27 @@ std::string toJson(const IcpSlamSummary& s) {
     j["wall_s_total"] = s.wall_s_total;
     j["motion_distance_m"] = s.pipeline.get<MotionStage>().max_distance_m;
     j["motion_angle_deg"] = s.pipeline.get<MotionStage>().max_angle_deg;
+    j["decimate_keep"] = s.pipeline.get<DecimateStage>().keep_fraction;
+    if (s.target_drop_pct) j["target_drop_pct"] = *s.target_drop_pct;
+    j["cpu_s_match"] = s.cpu_s_match;
+    j["scans_skipped_start"] = s.scans_skipped_start;
+    j["laser_only"] = s.laser_only;
     if (s.ate_rmse) j["ate_rmse_m"] = *s.ate_rmse;
     if (s.relations) {
         const auto& r = *s.relations;
         nlohmann::ordered_json rel;
         rel["file"] = s.relations_file;
-        rel["used"] = r.used;
-        rel["unmatched"] = r.unmatched;
-        rel["trans_mean_m"] = r.trans_mean;
-        rel["trans_std_m"] = r.trans_std;
-        rel["rot_mean_deg"] = r.rot_mean_deg;
-        rel["rot_std_deg"] = r.rot_std_deg;
-        rel["trans2_mean_m2"] = r.trans2_mean;
-        rel["trans2_std_m2"] = r.trans2_std;
-        rel["rot2_mean_deg2"] = r.rot2_mean;
-        rel["rot2_std_deg2"] = r.rot2_std;
+        relationsJson(rel, r);
         j["relations"] = std::move(rel);
+        j["split_seconds"] = s.split_seconds;
+        for (const auto& [key, sub, n] :
+             {std::tuple{"relations_local", &s.relations_local, s.relations_local_count},
+              std::tuple{"relations_long", &s.relations_long, s.relations_long_count}}) {
+            nlohmann::ordered_json o;
+            o["count"] = n;
+            if (*sub) relationsJson(o, **sub);
+            j[key] = std::move(o);
+        }
     }
     return j.dump(2) + "\n";
 }

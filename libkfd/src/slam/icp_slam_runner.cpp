@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "kfd/baselines/decimate_stage.h"
 #include "kfd/baselines/motion_stage.h"
 #include "kfd/core/cancel.h"
 #include "kfd/eval/ate.h"
@@ -101,21 +102,49 @@ struct ScanStamp {
     std::optional<Pose2D> odometry;
 };
 
-// Reads only timestamps and odometry of every scan (for matching the odometry baseline's drop
-// rate to a target before the real run).
-std::vector<ScanStamp> scanOdometry(const std::string& rawlog) {
+// The 2D scans of one step.
+std::size_t scanCount(const IcpSlamStep& step) {
+    if (step.observation) return IS_CLASS(*step.observation, CObservation2DRangeScan) ? 1 : 0;
+    std::size_t n = 0;
+    for (const auto& o : *step.frame) n += IS_CLASS(*o, CObservation2DRangeScan) ? 1 : 0;
+    return n;
+}
+
+// IcpSlamOptions::skip_scans: true for every step until the first K scans have gone by.
+class StartSkipper {
+  public:
+    explicit StartSkipper(std::size_t k) : left_(k) {}
+    bool skip(const IcpSlamStep& step) {
+        if (left_ == 0) return false;
+        const std::size_t n = scanCount(step);
+        skipped_ += n;
+        left_ -= std::min(left_, n);
+        return true;
+    }
+    std::size_t skipped() const { return skipped_; }
+
+  private:
+    std::size_t left_, skipped_ = 0;
+};
+
+// Reads only timestamps and odometry of every scan after the skipped start (for matching the
+// odometry baseline's drop rate to a target before the real run).
+std::vector<ScanStamp> scanOdometry(const std::string& rawlog, std::size_t skip_scans,
+                                    bool laser_only) {
     auto source = openLog(rawlog);
     std::vector<ScanStamp> out;
     IcpSlamSteps steps;
     IcpSlamStep step;
+    StartSkipper skipper(skip_scans);
     SourceEntry e;
     while (nextEntry(*source, e)) {
         throwIfCancelled();
-        if (!steps.feed(e, step)) continue;
+        if (!steps.feed(e, step) || skipper.skip(step)) continue;
         auto add = [&](const mrpt::obs::CObservation& o) {
             if (!IS_CLASS(o, CObservation2DRangeScan)) return;
             std::optional<Pose2D> odo = e.odometry;  // non-finite: unknown, as checkScan does
             if (odo && !finitePose(odo->x, odo->y, odo->phi)) odo.reset();
+            if (laser_only) odo.reset();
             out.push_back({stampOf(o), odo});
         };
         if (step.observation)
@@ -124,6 +153,36 @@ std::vector<ScanStamp> scanOdometry(const std::string& rawlog) {
             for (const auto& o : *step.frame) add(*o);
     }
     return out;
+}
+
+// The drop rate (%) of a pre-filter over the log, as the real run would see it (the same
+// skipped start, the same checks, odometry or none): the pre-filter alone, no ICP.
+double pipelineDropPct(const std::string& rawlog, const Pipeline::Params& pipeline,
+                       std::size_t skip_scans, bool laser_only) {
+    StreamFilter filter(pipeline);
+    auto source = openLog(rawlog);
+    IcpSlamSteps steps;
+    IcpSlamStep step;
+    StartSkipper skipper(skip_scans);
+    SourceEntry e;
+    std::size_t in = 0, kept = 0;
+    while (nextEntry(*source, e)) {
+        throwIfCancelled();
+        if (!steps.feed(e, step) || skipper.skip(step)) continue;
+        auto add = [&](mrpt::obs::CObservation& o) {
+            auto* scan = dynamic_cast<CObservation2DRangeScan*>(&o);
+            if (!scan) return;
+            std::optional<Pose2D> odo = laser_only ? std::nullopt : e.odometry;
+            ++in;
+            if (!checkScan(*scan, &odo).ok()) return;
+            kept += filter.process(*scan, odo).keep ? 1 : 0;
+        };
+        if (step.observation)
+            add(*step.observation);
+        else
+            for (const auto& o : *step.frame) add(*o);
+    }
+    return in ? 100.0 * static_cast<double>(in - kept) / static_cast<double>(in) : 0.0;
 }
 
 double dropPct(const std::vector<ScanStamp>& scans, const MotionFilter::Params& p) {
@@ -196,11 +255,39 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
     Pipeline::Params kfd_params;
     if (cfg.sectionExists("KFD")) kfd_params = loadIni(cfg, "KFD");
     sum.pipeline = pipelineForMode(opts.mode, kfd_params);
-    if (opts.mode == PrefilterMode::Odometry && opts.odometry_target_drop_pct) {
-        const double target = *opts.odometry_target_drop_pct;
+    sum.laser_only = opts.laser_only;
+    if (!(opts.split_seconds >= 0.0) || !std::isfinite(opts.split_seconds))
+        throw SlamError("the local/long split must be finite and >= 0 s (got " +
+                            std::to_string(opts.split_seconds) + ")",
+                        "split_seconds");
+    sum.split_seconds = opts.split_seconds;
+    const bool matchable =
+        opts.mode == PrefilterMode::Odometry || opts.mode == PrefilterMode::Decimate;
+    if ((opts.odometry_target_drop_pct || opts.match_drop_of) && !matchable)
+        throw SlamError(
+            std::string("a matched drop rate needs the odometry or decimate mode (not ") +
+                toString(opts.mode) + ")",
+            "mode");
+    if (opts.odometry_target_drop_pct && opts.match_drop_of)
+        throw SlamError("give a drop rate or a mode to match, not both", "match_drop_of");
+    if (opts.match_drop_of) {
+        const std::clock_t m0 = std::clock();
+        sum.target_drop_pct =
+            pipelineDropPct(sum.rawlog, pipelineForMode(*opts.match_drop_of, kfd_params),
+                            opts.skip_scans, opts.laser_only);
+        sum.cpu_s_match = static_cast<double>(std::clock() - m0) / CLOCKS_PER_SEC;
+    } else if (opts.odometry_target_drop_pct) {
+        sum.target_drop_pct = *opts.odometry_target_drop_pct;
+    }
+    if (sum.target_drop_pct) {
+        const double target = *sum.target_drop_pct;
         if (!(target >= 0.0 && target < 100.0))
             throw SlamError("the target drop rate must be in [0, 100)");
-        sum.pipeline.get<MotionStage>() = matchDropRate(scanOdometry(sum.rawlog), target);
+        if (opts.mode == PrefilterMode::Odometry)
+            sum.pipeline.get<MotionStage>() =
+                matchDropRate(scanOdometry(sum.rawlog, opts.skip_scans, opts.laser_only), target);
+        else
+            sum.pipeline.get<DecimateStage>().keep_fraction = 1.0 - target / 100.0;
     }
     StreamFilter prefilter(sum.pipeline);
 
@@ -262,7 +349,7 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
     // never reaches a stage nor the map builder), bad ranges are marked invalid, non-finite
     // odometry becomes unknown.
     auto prefilterScan = [&](CObservation2DRangeScan& scan) {
-        std::optional<Pose2D> odo = e.odometry;
+        std::optional<Pose2D> odo = opts.laser_only ? std::nullopt : e.odometry;
         const ScanCheck check = checkScan(scan, &odo);
         sum.beams_bad_range += check.bad_ranges;
         sum.odometry_bad += check.bad_odometry ? 1 : 0;
@@ -292,9 +379,11 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
         builder_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     };
 
+    StartSkipper skipper(opts.skip_scans);
+    mrpt::obs::CActionCollection no_odometry;  // laser_only: what the builder gets (empty)
     while (nextEntry(*source, e)) {
         throwIfCancelled();
-        if (!steps.feed(e, step) || e.objects_read < rawlog_offset) continue;
+        if (!steps.feed(e, step) || e.objects_read < rawlog_offset || skipper.skip(step)) continue;
         entry_scans.clear();
         if (step.observation) {
             bool process = true;
@@ -302,7 +391,8 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
                 process = prefilterScan(*scan);
             else if (const auto* odo = dynamic_cast<const mrpt::obs::CObservationOdometry*>(
                          step.observation.get()))
-                process = finitePose(odo->odometry.x(), odo->odometry.y(), odo->odometry.phi());
+                process = !opts.laser_only &&
+                          finitePose(odo->odometry.x(), odo->odometry.y(), odo->odometry.phi());
             if (process) timed([&] { builder.processObservation(step.observation); });
         } else {
             for (auto it = step.frame->begin(); it != step.frame->end();) {
@@ -314,7 +404,8 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
             }
             // odometry kept even if the frame is empty; a non-finite odometry action is left out
             // (the map builder then matches without a motion prior)
-            mrpt::obs::CActionCollection* action = step.action.get();
+            mrpt::obs::CActionCollection* action =
+                opts.laser_only ? &no_odometry : step.action.get();
             mrpt::obs::CActionCollection finite_actions;
             if (auto mv = action->getBestMovementEstimation()) {
                 const auto d = mv->rawOdometryIncrementReading;
@@ -386,7 +477,22 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
         // EvalError when no relation matched (never a perfect 0.0)
         sum.relations = evaluateRelations(sorted, relations, opts.relations_max_dt);
         sum.relations_file = opts.relations;
+        // Local and long relations; a subset that is empty or matched nothing stays absent.
+        const RelationsByLength split = splitRelations(relations, opts.split_seconds);
+        sum.relations_local_count = split.local.size();
+        sum.relations_long_count = split.far.size();
+        auto subset = [&](const std::vector<Relation>& r) -> std::optional<RelationsError> {
+            if (r.empty()) return std::nullopt;
+            try {
+                return evaluateRelations(sorted, r, opts.relations_max_dt);
+            } catch (const EvalError&) {
+                return std::nullopt;  // none of this subset matched
+            }
+        };
+        sum.relations_local = subset(split.local);
+        sum.relations_long = subset(split.far);
     }
+    sum.scans_skipped_start = skipper.skipped();
     sum.cpu_s_total = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
     sum.wall_s_total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -32,6 +32,8 @@ std::vector<PrefilterModeInfo> buildModes() {
     v.push_back(mode(PrefilterMode::Dbscan, "dbscan", {"distance", "dbscan"}));
     v.push_back(mode(PrefilterMode::Radius, "radius", {"distance", "radius"}));
     v.push_back(mode(PrefilterMode::Sor, "sor", {"distance", "sor"}));
+    v.push_back(mode(PrefilterMode::Decimate, "decimate", {"decimate"},
+                     defaultStageRegistry().find("decimate")->help));
     return v;
 }
 

@@ -1,7 +1,8 @@
-// The baseline stages (motion, dbscan, radius, sor) and their registration.
+// The baseline stages (motion, dbscan, radius, sor, decimate) and their registration.
 #pragma once
 
 #include "kfd/baselines/dbscan_stage.h"
+#include "kfd/baselines/decimate_stage.h"
 #include "kfd/baselines/motion_stage.h"
 #include "kfd/baselines/radius_stage.h"
 #include "kfd/baselines/sor_stage.h"
@@ -10,7 +11,8 @@
 namespace kfd {
 
 /// Registers the baselines after the core stages: motion (odometry motion filter), dbscan
-/// (DBSCAN denoise), radius (radius outlier removal), sor (statistical outlier removal).
+/// (DBSCAN denoise), radius (radius outlier removal), sor (statistical outlier removal),
+/// decimate (uniform decimation).
 void registerBaselineStages(StageRegistry& registry);
 
 }  // namespace kfd

@@ -38,4 +38,14 @@ struct RelationsError {
 RelationsError evaluateRelations(const Trajectory& traj, const std::vector<Relation>& relations,
                                  double max_dt);
 
+/// Relations split by their time span: `local` when both stamps are at most split_s apart
+/// (|t2 - t1| <= split_s), `far` otherwise. Local relations measure scan matching over a short
+/// stretch (where a pre-filter's effect shows); long ones carry the drift of a SLAM without
+/// loop closure. Order is kept. EvalError (field "split_s") when split_s is negative or not
+/// finite.
+struct RelationsByLength {
+    std::vector<Relation> local, far;
+};
+RelationsByLength splitRelations(const std::vector<Relation>& relations, double split_s);
+
 }  // namespace kfd

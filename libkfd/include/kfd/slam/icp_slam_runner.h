@@ -29,9 +29,25 @@ struct IcpSlamOptions {
     std::string rawlog;       // empty: [MappingApplication] rawlog_file
     std::string output_dir;   // empty: [MappingApplication] logOutput_dir
     PrefilterMode mode = PrefilterMode::Kfd;
-    /// Odometry mode only: choose the motion thresholds (distance D, angle 30 deg/m x D) so
-    /// that this percentage of scans is dropped (e.g. kfd's drop rate on the same log).
+    /// Odometry and decimate modes only: drop this percentage of the scans (e.g. kfd's drop
+    /// rate on the same log). Odometry: the motion thresholds (distance D, angle 30 deg/m x D)
+    /// found by bisection; decimate: decimate_keep = 1 - PCT / 100.
     std::optional<double> odometry_target_drop_pct;
+    /// Odometry and decimate modes only, instead of a percentage: drop as many scans as this
+    /// mode's pipeline drops on the same log with the same options (skip_scans, laser_only),
+    /// found by a pre-pass of the pre-filter alone (no ICP; its CPU time is cpu_s_match).
+    std::optional<PrefilterMode> match_drop_of;
+    /// Skip the first K scans of the log (and every entry before the (K+1)-th scan): they get
+    /// no pose and no relation uses them. The repeats of kfd-compare start K = 0, 1, 2, ...
+    /// scans later: the same problem, a different chaotic run.
+    std::size_t skip_scans = 0;
+    /// What a robot without wheel odometry sees: the pre-filter gets no odometry (its guards and
+    /// the motion stage see none) and neither does the map builder (odometry observations are
+    /// left out; an action-and-frame step gets an empty action).
+    bool laser_only = false;
+    /// Relations spanning at most this many seconds are "local", the others "long"
+    /// (summary.relations_local, relations_long).
+    double split_seconds = 10.0;
     std::string relations;           // ground truth (.relations), optional
     double relations_max_dt = 1e-3;  // s, stamp matching tolerance
     std::string ground_truth_tum;    // ground-truth trajectory (TUM), optional: ATE and figure
@@ -54,13 +70,22 @@ struct IcpSlamSummary {
     std::size_t odometry_bad = 0;     // scans whose odometry was not finite (used as unknown)
     double dropped_pct = 0.0;
     std::size_t points_in = 0, points_removed = 0;
-    double prefilter_us_per_scan = 0.0;  // mean over input scans
-    double icp_ms_per_scan = 0.0;        // map-builder time / input scans
-    double icp_ms_per_kept_scan = 0.0;   // map-builder time / kept scans
-    double cpu_s_total = 0.0;            // process CPU time of the run (I/O included)
+    double prefilter_us_per_scan = 0.0;   // mean over input scans
+    double icp_ms_per_scan = 0.0;         // map-builder time / input scans
+    double icp_ms_per_kept_scan = 0.0;    // map-builder time / kept scans
+    double cpu_s_total = 0.0;             // process CPU time of the run (I/O included)
+    double cpu_s_match = 0.0;             // of which the match_drop_of pre-pass
+    std::size_t scans_skipped_start = 0;  // the first skip_scans scans, not in scans_in
+    bool laser_only = false;
+    std::optional<double> target_drop_pct;  // what the odometry or decimate mode matched
     double wall_s_total = 0.0;
     Pipeline::Params pipeline;  // what ran
     std::optional<RelationsError> relations;
+    double split_seconds = 10.0;
+    /// relations over at most / over more than split_seconds; absent when that subset is empty
+    /// or none of it matched (counted in relations_*_count / relations_*_unmatched)
+    std::optional<RelationsError> relations_local, relations_long;
+    std::size_t relations_local_count = 0, relations_long_count = 0;
     std::optional<double> ate_rmse;  // m, against ground_truth_tum after SE(2) alignment
     std::string relations_file;
 };

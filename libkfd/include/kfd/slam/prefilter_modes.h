@@ -17,6 +17,7 @@ enum class PrefilterMode {
     Dbscan,    // the paper's comparison: DBSCAN denoise of every scan (distance + dbscan)
     Radius,    // baseline: radius outlier removal of every scan (distance + radius)
     Sor,       // baseline: statistical outlier removal of every scan (distance + sor)
+    Decimate,  // baseline: keep a fixed share of the scans, evenly (decimate stage)
 };
 
 /// One mode: its name, the stages it runs (names in kfd::defaultStageRegistry()), and a
@@ -33,7 +34,8 @@ struct PrefilterModeInfo {
 const std::vector<PrefilterModeInfo>& prefilterModes();
 
 const char* toString(PrefilterMode m);
-/// "none", "odometry", "keyframe", "kfd", "dbscan", "radius", "sor"; kfd::ParameterError (field
+/// "none", "odometry", "keyframe", "kfd", "dbscan", "radius", "sor", "decimate";
+/// kfd::ParameterError (field
 /// "mode") otherwise.
 PrefilterMode parsePrefilterMode(const std::string& s);
 

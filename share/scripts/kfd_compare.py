@@ -1,0 +1,463 @@
+#!/usr/bin/env python3
+"""kfd-compare: repeated, paired ICP-SLAM runs that tell signal from noise.
+
+For logs x configs x modes x R repeats it runs kfd-icp-slam, then reports per (log, config,
+mode) n, median, IQR and mean +- std over the runs of: the relations error split into local
+(relations spanning at most S s) and long, ATE (when a ground-truth trajectory exists), drop %,
+process CPU time (user + sys of kfd-icp-slam, from the kernel) and CPU per scan; and paired
+comparisons (runs matched by repeat): every mode against a baseline mode and named pairs, with
+wins / losses / ties, the two-sided exact sign test, the exact Wilcoxon signed-rank test and the
+median ratio with a seeded bootstrap 95 % interval. Lower is better for every metric.
+
+Repeat K (0 ... R-1) skips the first K scans of the log (kfd-icp-slam --skip-scans K): the same
+problem, a different run of a chaotic estimator. A simulated log (sim:WORLD:SENSOR:SPEED) is
+also simulated again with seed K + 1.
+
+  kfd-compare run --logs intel aces --modes none kfd odometry@kfd --repeats 20 --out OUT
+  kfd-compare run ... --emit-jobs jobs.txt      # one shell command per line, then:
+  parallel -j 8 < jobs.txt                       # (or xargs -P, a Slurm array), then:
+  kfd-compare collect OUT                        # report.md, runs.csv, runs.json, plots/
+
+Logs: a dataset folder name under --datasets (NAME/NAME.rawlog with NAME.relations) or a path
+to a .rawlog (NAME.relations and NAME.gt.tum beside it are used when present), or
+sim:WORLD:SENSOR:SPEED[:DURATION] (kfd-simulate; ground truth .gt.tum). Modes: any of
+`kfd-icp-slam --list-modes`, with `@MODE` to drop as many scans as MODE does on the same run
+(odometry@kfd, decimate@kfd) and `+lo` for a laser-only run (no odometry to the pre-filter or
+to ICP-SLAM: kfd+lo, decimate@kfd+lo).
+"""
+import argparse
+import concurrent.futures
+import csv
+import json
+import math
+import os
+import shlex
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import kfd_stats  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SELF = os.path.abspath(__file__)
+DEFAULT_EXE = os.path.join(ROOT, "build", "apps", "kfd-icp-slam")
+DEFAULT_SIM = os.path.join(ROOT, "build", "apps", "kfd-simulate")
+DEFAULT_DATASETS = os.path.join(ROOT, "..", "shared", "datasets")
+DEFAULT_CONFIG = os.path.join(ROOT, "share", "kfd-icp-slam", "sick-180-5hz.ini")
+MAX_DT = {"mit-killian": 0.22}  # estimated stamps (its PROVENANCE.md)
+# (metric key, label, unit): what every table and plot reports
+METRICS = [("local", "relations error, local", "m"), ("long", "relations error, long", "m"),
+           ("all", "relations error, all", "m"), ("ate", "ATE RMSE", "m"),
+           ("drop", "dropped", "%"), ("cpu", "CPU (user+sys)", "s"),
+           ("cpu_ms_per_scan", "CPU per scan", "ms")]
+PAIR_METRICS = ["local", "long", "ate", "cpu"]
+NAMED_PAIRS = [("kfd", "odometry@kfd"), ("kfd", "keyframe"), ("kfd+lo", "decimate@kfd+lo"),
+               ("kfd", "decimate@kfd")]
+
+
+class CompareError(Exception):
+    pass
+
+
+# --- logs, modes, jobs ----------------------------------------------------------------------
+
+def resolve_log(spec, datasets):
+    """A log spec -> dict(name, kind, rawlog, relations, gt, max_dt, sim settings)."""
+    if spec.startswith("sim:"):
+        parts = spec.split(":")[1:]
+        if not 1 <= len(parts) <= 4:
+            raise CompareError("bad simulated log '%s' (sim:WORLD:SENSOR:SPEED[:DURATION])" % spec)
+        world, sensor, speed, duration = parts + ["office", "mit", "0.752", ""][len(parts):]
+        return {"name": "sim-%s-%s-%s" % (world, sensor, speed) + ("-%ss" % duration
+                                                                   if duration else ""),
+                "kind": "sim", "world": world, "sensor": sensor, "speed": speed,
+                "duration": duration, "max_dt": 1e-3}
+    if spec.endswith(".rawlog") or os.path.sep in spec:
+        rawlog = os.path.abspath(spec)
+        name = os.path.basename(rawlog)[:-len(".rawlog")] if rawlog.endswith(".rawlog") \
+            else os.path.basename(rawlog)
+    else:
+        rawlog = os.path.abspath(os.path.join(datasets, spec, spec + ".rawlog"))
+        name = spec
+    if not os.path.isfile(rawlog):
+        raise CompareError("log not found: %s (%s)" % (spec, rawlog))
+    stem = rawlog[:-len(".rawlog")] if rawlog.endswith(".rawlog") else rawlog
+    rel = stem + ".relations"
+    gt = stem + ".gt.tum"
+    return {"name": name, "kind": "file", "rawlog": rawlog,
+            "relations": rel if os.path.isfile(rel) else None,
+            "gt": gt if os.path.isfile(gt) else None, "max_dt": MAX_DT.get(name, 1e-3)}
+
+
+def parse_mode(spec):
+    """'decimate@kfd+lo' -> ('decimate', 'kfd', True)."""
+    laser = spec.endswith("+lo")
+    base = spec[:-3] if laser else spec
+    mode, _, match = base.partition("@")
+    if not mode:
+        raise CompareError("bad mode '%s'" % spec)
+    if match and mode not in ("odometry", "decimate"):
+        raise CompareError("'%s': only odometry and decimate can match another mode's drop rate"
+                           % spec)
+    return mode, match or None, laser
+
+
+def check_modes(exe, specs):
+    out = subprocess.run([exe, "--list-modes"], check=True, capture_output=True, text=True).stdout
+    known = [line.split("\t")[0] for line in out.splitlines() if line.strip()]
+    for s in specs:
+        mode, match, _ = parse_mode(s)
+        for m in [mode] + ([match] if match else []):
+            if m not in known:
+                raise CompareError("unknown mode '%s' in '%s' (kfd-icp-slam --list-modes: %s)"
+                                   % (m, s, ", ".join(known)))
+
+
+def config_tag(config):
+    return os.path.basename(config)[:-len(".ini")] if config.endswith(".ini") \
+        else os.path.basename(config)
+
+
+def run_dir(out, log_name, config, mode, repeat):
+    return os.path.join(out, "runs", log_name, config_tag(config), mode, "r%02d" % repeat)
+
+
+def job_args(a, log, config, mode, repeat):
+    args = [sys.executable, SELF, "job", "--out", os.path.abspath(a.out), "--log", log,
+            "--datasets", os.path.abspath(a.datasets), "--config", os.path.abspath(config),
+            "--mode", mode, "--repeat", str(repeat), "--exe", os.path.abspath(a.exe),
+            "--sim-exe", os.path.abspath(a.sim_exe), "--split-seconds", repr(a.split_seconds)]
+    if a.maps:
+        args.append("--map")
+    return args
+
+
+def simulated_log(a, log, repeat):
+    """The simulated log of one repeat (seed repeat + 1), generated once and shared by modes."""
+    folder = os.path.join(a.out, "logs", log["name"])
+    os.makedirs(folder, exist_ok=True)
+    path = os.path.join(folder, "seed%02d.rawlog" % (repeat + 1))
+    if not os.path.exists(path):  # kfd-simulate renames complete files into place
+        cmd = [a.sim_exe, "-o", path, "-w", log["world"], "-s", log["sensor"], "-v",
+               log["speed"], "--seed", str(repeat + 1), "-q"]
+        if log["duration"]:
+            cmd += ["-d", log["duration"]]
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    return path, path[:-len(".rawlog")] + ".gt.tum"
+
+
+def run_job(a):
+    """One kfd-icp-slam run: writes run.json (the summary, kernel CPU times, the command) into
+    its run folder; a folder that already holds run.json is kept (resume)."""
+    log = resolve_log(a.log, a.datasets)
+    mode, match, laser = parse_mode(a.mode)
+    folder = run_dir(a.out, log["name"], a.config, a.mode, a.repeat)
+    done = os.path.join(folder, "run.json")
+    if os.path.exists(done):
+        return json.load(open(done))
+    rawlog, rel, gt, seed = log.get("rawlog"), log.get("relations"), log.get("gt"), None
+    if log["kind"] == "sim":
+        rawlog, gt = simulated_log(a, log, a.repeat)
+        seed = a.repeat + 1
+    cmd = [a.exe, a.config, rawlog, "-o", folder, "-m", mode, "-q", "--skip-scans",
+           str(a.repeat), "--split-seconds", repr(a.split_seconds)]
+    if not a.map:
+        cmd.append("--no-map")
+    if rel:
+        cmd += ["-g", rel]
+    if gt:
+        cmd += ["--gt", gt]
+    if rel or gt:
+        cmd += ["--max-dt", repr(log["max_dt"])]
+    if match:
+        cmd += ["--match-drop-of", match]
+    if laser:
+        cmd.append("--laser-only")
+    os.makedirs(os.path.dirname(folder), exist_ok=True)
+    t0 = time.monotonic()
+    with open(folder + ".stderr", "w") as err:
+        p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err)
+        _, status, ru = os.wait4(p.pid, 0)
+    wall = time.monotonic() - t0
+    code = os.waitstatus_to_exitcode(status)
+    if code != 0:
+        msg = open(folder + ".stderr").read().strip().splitlines()
+        raise CompareError("kfd-icp-slam failed (exit %d) on %s %s r%d: %s\n  %s" % (
+            code, log["name"], a.mode, a.repeat, msg[0] if msg else "",
+            " ".join(shlex.quote(c) for c in cmd)))
+    os.remove(folder + ".stderr")
+    s = json.load(open(os.path.join(folder, "summary.json")))
+
+    def trans(key):
+        r = s.get(key)
+        return r.get("trans_mean_m") if r else None
+
+    cpu = ru.ru_utime + ru.ru_stime - s.get("cpu_s_match", 0.0)
+    run = {"log": log["name"], "config": config_tag(a.config), "mode": a.mode,
+           "repeat": a.repeat, "seed": seed, "skip_scans": a.repeat,
+           "local": trans("relations_local"), "long": trans("relations_long"),
+           "all": trans("relations"), "ate": s.get("ate_rmse_m"), "drop": s["dropped_pct"],
+           "cpu": cpu, "cpu_ms_per_scan": 1e3 * cpu / max(1, s["scans_in"]),
+           "cpu_user_s": ru.ru_utime, "cpu_sys_s": ru.ru_stime,
+           "cpu_match_s": s.get("cpu_s_match", 0.0), "wall_s": wall,
+           "scans_in": s["scans_in"], "scans_kept": s["scans_kept"],
+           "relations_local_used": (s.get("relations_local") or {}).get("used"),
+           "relations_long_used": (s.get("relations_long") or {}).get("used"),
+           "target_drop_pct": s.get("target_drop_pct"), "laser_only": s.get("laser_only"),
+           "command": cmd}
+    tmp = done + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump(run, f, indent=1)
+    os.replace(tmp, done)
+    return run
+
+
+def plan(a):
+    """Every job of a run command, as (log, config, mode, repeat), repeat by repeat: a run cut
+    short still has every log, config and mode, with fewer repeats."""
+    for log in a.logs:
+        resolve_log(log, a.datasets)  # fail early on a missing log
+    return [(log, config, mode, k) for k in range(a.repeats) for log in a.logs
+            for config in a.configs for mode in a.modes]
+
+
+def cmd_run(a):
+    if a.repeats < 1:
+        raise CompareError("--repeats must be >= 1")
+    for c in a.configs:
+        if not os.path.isfile(c):
+            raise CompareError("config not found: " + c)
+    if not os.access(a.exe, os.X_OK):
+        raise CompareError("kfd-icp-slam not found: %s (build it: bash share/scripts/test.sh)"
+                           % a.exe)
+    check_modes(a.exe, a.modes)
+    jobs = plan(a)
+    if a.emit_jobs:
+        with open(a.emit_jobs, "w") as f:
+            for j in jobs:
+                f.write(" ".join(shlex.quote(x) for x in job_args(a, *j)) + "\n")
+        print("[kfd-compare] %d jobs written to %s; run them (e.g. parallel -j N < %s), then "
+              "kfd-compare collect %s" % (len(jobs), a.emit_jobs, a.emit_jobs, a.out),
+              file=sys.stderr)
+        return 0
+    t0 = time.monotonic()
+    failed = []
+
+    def one(j):
+        log, config, mode, k = j
+        ns = argparse.Namespace(out=a.out, log=log, datasets=a.datasets, config=config,
+                                mode=mode, repeat=k, exe=a.exe, sim_exe=a.sim_exe,
+                                split_seconds=a.split_seconds, map=a.maps)
+        return run_job(ns)
+
+    with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
+        futures = {pool.submit(one, j): j for j in jobs}
+        for n, fut in enumerate(concurrent.futures.as_completed(futures), 1):
+            j = futures[fut]
+            try:
+                fut.result()
+            except (CompareError, subprocess.CalledProcessError) as e:
+                failed.append((j, str(e)))
+            if not a.quiet:
+                el = time.monotonic() - t0
+                print("[kfd-compare] %d/%d %s %s %s r%02d  (%.0f s, eta %.0f s)" % (
+                    n, len(jobs), j[0], config_tag(j[1]), j[2], j[3], el,
+                    el / n * (len(jobs) - n)), file=sys.stderr, flush=True)
+    for j, e in failed:
+        print("[kfd-compare] failed: %s" % e, file=sys.stderr)
+    collect(a.out, a.baseline, a.pairs, a.plots, a.quiet)
+    return 1 if failed else 0
+
+
+# --- collect ---------------------------------------------------------------------------------
+
+def load_runs(out):
+    runs = []
+    base = os.path.join(out, "runs")
+    if not os.path.isdir(base):
+        raise CompareError("no runs under %s (run kfd-compare run first)" % base)
+    for dirpath, _, files in os.walk(base):
+        if "run.json" in files:
+            runs.append(json.load(open(os.path.join(dirpath, "run.json"))))
+    if not runs:
+        raise CompareError("no finished run under " + base)
+    runs.sort(key=lambda r: (r["log"], r["config"], r["mode"], r["repeat"]))
+    return runs
+
+
+def fmt(x, digits=3):
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "–"
+    return ("%." + str(digits) + "f") % x
+
+
+def fmt_p(p):
+    return "%.2g" % p if p < 0.01 else "%.2f" % p
+
+
+def collect(out, baseline="none", pairs=None, plots=True, quiet=False):
+    runs = load_runs(out)
+    by = {}
+    for r in runs:
+        by.setdefault((r["log"], r["config"]), {}).setdefault(r["mode"], {})[r["repeat"]] = r
+    # every run, CSV and JSON
+    keys = ["log", "config", "mode", "repeat", "seed", "skip_scans"] + [m for m, _, _ in METRICS] \
+        + ["cpu_user_s", "cpu_sys_s", "cpu_match_s", "wall_s", "scans_in", "scans_kept",
+           "relations_local_used", "relations_long_used", "target_drop_pct", "laser_only"]
+    with open(os.path.join(out, "runs.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
+        w.writeheader()
+        for r in runs:
+            w.writerow(r)
+    stats = {"runs": runs, "summary": [], "pairs": []}
+    lines = ["# kfd-compare report", "",
+             "%d runs under `%s`. Medians over repeats (repeat K skips the first K scans; "
+             "simulated logs also use seed K + 1); IQR in brackets; lower is better. Paired "
+             "comparisons match runs by repeat: W/L/T = runs where the first mode is better / "
+             "worse / equal; p: two-sided exact sign test and exact Wilcoxon signed-rank test; "
+             "ratio: median of the per-run ratios first/second with a bootstrap 95 %% interval "
+             "(2000 resamples, seed 1). CPU is user + sys of kfd-icp-slam (the drop-rate "
+             "matching pre-pass excluded)." % (len(runs), out), ""]
+    for (log, config), modes in sorted(by.items()):
+        lines += ["## %s, %s" % (log, config), "",
+                  "| mode | n | dropped % | local (m) | long (m) | all (m) | ATE (m) | CPU (s) "
+                  "| CPU/scan (ms) |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        for mode in sorted(modes, key=lambda m: (m != baseline, m)):
+            rs = list(modes[mode].values())
+            row = {"log": log, "config": config, "mode": mode}
+            cells = []
+            for m, _, _ in METRICS:
+                s = kfd_stats.summary([r[m] for r in rs if r.get(m) is not None])
+                row[m] = s
+                d = 1 if m == "drop" else 2 if m in ("cpu", "cpu_ms_per_scan") else 3
+                cells.append("–" if s["n"] == 0 else "%s [%s–%s]" % (
+                    fmt(s["median"], d), fmt(s["q1"], d), fmt(s["q3"], d)))
+            stats["summary"].append(row)
+            lines.append("| %s | %d | %s |" % (mode, len(rs), " | ".join(
+                [cells[4], cells[0], cells[1], cells[2], cells[3], cells[5], cells[6]])))
+        lines.append("")
+        wanted = [(m, baseline) for m in sorted(modes) if m != baseline and baseline in modes]
+        for p in NAMED_PAIRS + [tuple(x.split(":", 1)) for x in (pairs or [])]:
+            if p[0] in modes and p[1] in modes and p not in wanted:
+                wanted.append(p)
+        if wanted:
+            lines += ["| A vs B | metric | n | W/L/T | p sign | p Wilcoxon | ratio A/B [95 %] |",
+                      "|---|---|---:|---:|---:|---:|---:|"]
+        for first, second in wanted:
+            common = sorted(set(modes[first]) & set(modes[second]))
+            for m in PAIR_METRICS:
+                xs = [(modes[first][k].get(m), modes[second][k].get(m)) for k in common]
+                xs = [(x, y) for x, y in xs if x is not None and y is not None]
+                if not xs:
+                    continue
+                res = kfd_stats.paired([x for x, _ in xs], [y for _, y in xs])
+                stats["pairs"].append(dict(res, log=log, config=config, a=first, b=second,
+                                           metric=m))
+                lines.append("| %s vs %s | %s | %d | %d/%d/%d | %s | %s | %s [%s–%s] |" % (
+                    first, second, m, res["n"], res["wins"], res["losses"], res["ties"],
+                    fmt_p(res["p_sign"]), fmt_p(res["p_wilcoxon"]), fmt(res["median_ratio"]),
+                    fmt(res["ratio_lo"]), fmt(res["ratio_hi"])))
+        lines.append("")
+        if plots:
+            plot(out, log, config, modes, baseline)
+            lines += ["![%s %s](plots/%s-%s.png)" % (log, config, log, config), ""]
+    with open(os.path.join(out, "runs.json"), "w") as f:
+        json.dump(stats, f, indent=1)
+    with open(os.path.join(out, "report.md"), "w") as f:
+        f.write("\n".join(lines))
+    if not quiet:
+        print("[kfd-compare] %d runs: %s, %s, %s" % (
+            len(runs), os.path.join(out, "report.md"), os.path.join(out, "runs.csv"),
+            os.path.join(out, "runs.json")), file=sys.stderr)
+    return stats
+
+
+def plot(out, log, config, modes, baseline):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    order = sorted(modes, key=lambda m: (m != baseline, m))
+    shown = [(m, label, unit) for m, label, unit in METRICS
+             if m in ("local", "long", "ate", "cpu") and any(
+                 r.get(m) is not None for mode in order for r in modes[mode].values())]
+    if not shown:
+        return
+    fig, axes = plt.subplots(1, len(shown), figsize=(4.2 * len(shown), 3.6), squeeze=False)
+    for ax, (m, label, unit) in zip(axes[0], shown):
+        data = [[r[m] for r in modes[mode].values() if r.get(m) is not None] for mode in order]
+        ax.boxplot(data, labels=order, showfliers=True)
+        ax.set_title("%s (%s)" % (label, unit), fontsize=9)
+        ax.tick_params(axis="x", labelrotation=45, labelsize=7)
+        ax.tick_params(axis="y", labelsize=7)
+        if m != "cpu" and all(v > 0 for d in data for v in d):
+            ax.set_yscale("log")
+    n = max(len(modes[m]) for m in order)
+    fig.suptitle("%s, %s: %d repeats per mode" % (log, config, n), fontsize=10)
+    fig.tight_layout()
+    os.makedirs(os.path.join(out, "plots"), exist_ok=True)
+    fig.savefig(os.path.join(out, "plots", "%s-%s.png" % (log, config)), dpi=110)
+    plt.close(fig)
+
+
+# --- command line ----------------------------------------------------------------------------
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(
+        prog="kfd-compare", description=__doc__.split("\n\n")[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="Exit status: 0 on success, 1 when a run failed or an input is bad, 2 on bad usage.")
+    sub = ap.add_subparsers(dest="command", required=True)
+    r = sub.add_parser("run", help="run (or emit) every job, then collect")
+    r.add_argument("--logs", nargs="+", required=True, help="dataset names, .rawlog paths, sim:...")
+    r.add_argument("--modes", nargs="+", default=["none", "kfd", "odometry@kfd", "keyframe"])
+    r.add_argument("--configs", nargs="+", default=[DEFAULT_CONFIG], help="kfd-icp-slam .ini files")
+    r.add_argument("--repeats", "-R", type=int, default=20)
+    r.add_argument("--out", "-o", required=True)
+    r.add_argument("--jobs", "-j", type=int, default=os.cpu_count() or 1, help="local parallel runs")
+    r.add_argument("--emit-jobs", metavar="FILE", help="write one command per line and stop")
+    r.add_argument("--maps", action="store_true", help="keep each run's map and map figure")
+    for p in (r,):
+        p.add_argument("--datasets", default=DEFAULT_DATASETS)
+        p.add_argument("--exe", default=DEFAULT_EXE, help="kfd-icp-slam")
+        p.add_argument("--sim-exe", default=DEFAULT_SIM, help="kfd-simulate")
+        p.add_argument("--split-seconds", type=float, default=10.0,
+                       help="relations over at most S s are local (default 10)")
+        p.add_argument("--baseline", default="none")
+        p.add_argument("--pairs", nargs="*", default=[], help="more pairs A:B")
+        p.add_argument("--no-plots", dest="plots", action="store_false")
+        p.add_argument("-q", "--quiet", action="store_true")
+    j = sub.add_parser("job", help="one run (what --emit-jobs writes)")
+    j.add_argument("--out", required=True)
+    j.add_argument("--log", required=True)
+    j.add_argument("--datasets", default=DEFAULT_DATASETS)
+    j.add_argument("--config", required=True)
+    j.add_argument("--mode", required=True)
+    j.add_argument("--repeat", type=int, required=True)
+    j.add_argument("--exe", default=DEFAULT_EXE)
+    j.add_argument("--sim-exe", default=DEFAULT_SIM)
+    j.add_argument("--split-seconds", type=float, default=10.0)
+    j.add_argument("--map", action="store_true")
+    c = sub.add_parser("collect", help="merge the finished runs of DIR into its report")
+    c.add_argument("dir")
+    c.add_argument("--baseline", default="none")
+    c.add_argument("--pairs", nargs="*", default=[])
+    c.add_argument("--no-plots", dest="plots", action="store_false")
+    c.add_argument("-q", "--quiet", action="store_true")
+    a = ap.parse_args(argv)
+    try:
+        if a.command == "run":
+            return cmd_run(a)
+        if a.command == "job":
+            parse_mode(a.mode)
+            run_job(a)
+            return 0
+        collect(a.dir, a.baseline, a.pairs, a.plots, a.quiet)
+        return 0
+    except (CompareError, subprocess.CalledProcessError, OSError) as e:
+        print("kfd-compare: %s" % e, file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

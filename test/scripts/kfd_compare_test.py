@@ -1,0 +1,121 @@
+"""kfd-compare end to end: a small run (2 logs x 2 modes x 3 repeats) through the real
+kfd-icp-slam, and the emitted job list run through GNU parallel, then collected.
+Usage: kfd_compare_test.py BUILD_APPS_DIR DATASETS_DIR"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+COMPARE = os.path.join(ROOT, "share", "scripts", "kfd-compare")
+OFFICE = os.path.join(ROOT, "rawlogs", "office-mit-0.752.rawlog")
+APPS = DATASETS = None
+
+
+def compare(*args):
+    return subprocess.run([COMPARE] + list(args), capture_output=True, text=True)
+
+
+class KfdCompare(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="kfd_compare_test_")
+        self.exe = ["--exe", os.path.join(APPS, "kfd-icp-slam"),
+                    "--sim-exe", os.path.join(APPS, "kfd-simulate"), "--datasets", DATASETS]
+
+    def tearDown(self):
+        shutil.rmtree(self.tmp)
+
+    def test_small_run_reports_every_log_mode_and_pair(self):
+        csail = os.path.join(DATASETS, "mit-csail", "mit-csail.rawlog")
+        if not os.path.exists(csail):
+            self.skipTest("missing " + csail)
+        out = os.path.join(self.tmp, "out")
+        r = compare("run", "--logs", OFFICE, "mit-csail", "--modes", "none", "kfd",
+                    "--repeats", "3", "--jobs", "2", "--out", out, "-q", *self.exe)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        stats = json.load(open(os.path.join(out, "runs.json")))
+        runs = stats["runs"]
+        self.assertEqual(len(runs), 12)
+        # repeat K skips the first K scans: one scan fewer per repeat
+        office = sorted((x for x in runs if x["log"] == "office-mit-0.752" and
+                         x["mode"] == "none"), key=lambda x: x["repeat"])
+        self.assertEqual([x["scans_in"] for x in office], [600, 599, 598])
+        for x in runs:
+            self.assertGreater(x["cpu"], 0.0)
+            if x["log"] == "mit-csail":  # relations split into local and long
+                self.assertGreater(x["relations_local_used"], 0)
+                self.assertGreater(x["relations_long_used"], 0)
+                self.assertIsNone(x["ate"])
+            else:  # ground truth trajectory, no relations
+                self.assertIsNone(x["local"])
+                self.assertGreater(x["ate"], 0.0)
+        pairs = {(p["log"], p["a"], p["b"], p["metric"]): p for p in stats["pairs"]}
+        p = pairs[("mit-csail", "kfd", "none", "local")]
+        self.assertEqual(p["n"], 3)
+        self.assertEqual(p["wins"] + p["losses"] + p["ties"], 3)
+        self.assertIn(("office-mit-0.752", "kfd", "none", "ate"), pairs)
+        report = open(os.path.join(out, "report.md")).read()
+        self.assertIn("## mit-csail, sick-180-5hz", report)
+        self.assertIn("| kfd vs none | local | 3 |", report)
+        for log in ("mit-csail", "office-mit-0.752"):
+            self.assertTrue(os.path.getsize(os.path.join(out, "plots",
+                                                         log + "-sick-180-5hz.png")) > 1000)
+        header = open(os.path.join(out, "runs.csv")).readline()
+        self.assertTrue(header.startswith("log,config,mode,repeat,seed,skip_scans,local,long"))
+
+    def test_emitted_jobs_run_through_gnu_parallel_give_the_same_runs(self):
+        if not shutil.which("parallel"):
+            self.skipTest("GNU parallel not installed")
+        modes = ["none", "decimate@kfd"]
+        local = os.path.join(self.tmp, "local")
+        r = compare("run", "--logs", OFFICE, "--modes", *modes, "--repeats", "2", "--jobs", "2",
+                    "--out", local, "-q", "--no-plots", *self.exe)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        farm = os.path.join(self.tmp, "farm")
+        jobs = os.path.join(self.tmp, "jobs.txt")
+        r = compare("run", "--logs", OFFICE, "--modes", *modes, "--repeats", "2", "--out", farm,
+                    "--emit-jobs", jobs, *self.exe)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        lines = open(jobs).read().splitlines()
+        self.assertEqual(len(lines), 4)
+        with open(jobs) as f:
+            p = subprocess.run(["parallel", "--will-cite", "-j", "2", "--halt", "now,fail=1"],
+                               stdin=f, capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        r = compare("collect", farm, "-q", "--no-plots")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        a = json.load(open(os.path.join(local, "runs.json")))["runs"]
+        b = json.load(open(os.path.join(farm, "runs.json")))["runs"]
+        key = lambda x: (x["mode"], x["repeat"])  # noqa: E731
+        self.assertEqual([key(x) for x in a], [key(x) for x in b])
+        for x, y in zip(a, b):  # the same deterministic runs (CPU times aside)
+            self.assertEqual((x["ate"], x["drop"], x["scans_kept"]),
+                             (y["ate"], y["drop"], y["scans_kept"]))
+        dec = [x for x in b if x["mode"] == "decimate@kfd"]
+        self.assertTrue(all(x["target_drop_pct"] > 0 for x in dec))
+        self.assertTrue(all(abs(x["drop"] - x["target_drop_pct"]) < 0.5 for x in dec))
+
+    def test_bad_input_is_a_clear_error(self):
+        out = os.path.join(self.tmp, "bad")
+        r = compare("run", "--logs", "no-such-log", "--out", out, "--repeats", "1", *self.exe)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("kfd-compare: log not found: no-such-log", r.stderr)
+        r = compare("run", "--logs", OFFICE, "--modes", "kfd@none", "--out", out, *self.exe)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("only odometry and decimate can match", r.stderr)
+        r = compare("run", "--logs", OFFICE, "--modes", "nosuch", "--out", out, *self.exe)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("unknown mode 'nosuch'", r.stderr)
+        r = compare("collect", os.path.join(self.tmp, "empty"))
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("no runs under", r.stderr)
+        self.assertFalse(os.path.exists(out))
+
+
+if __name__ == "__main__":
+    APPS, DATASETS = sys.argv[1], sys.argv[2]
+    unittest.main(argv=sys.argv[:1])
