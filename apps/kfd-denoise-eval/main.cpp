@@ -11,12 +11,19 @@ int main(int argc, char** argv) {
         "kfd-denoise-eval", "-i SIM.rawlog -l SIM.labels.csv -c CONFIG",
         "Runs every scan through the CONFIG pipeline (.ini [KFD] or .yaml; use a pipeline\n"
         "without the keyframe stage to denoise every scan) and scores the removed beams\n"
-        "against kfd-simulate's labels: precision, recall, F1, recall per noise kind, and\n"
-        "the fraction of true points kept.",
+        "against the labels of kfd-simulate or kfd-inject: precision, recall, F1, recall per\n"
+        "noise kind (and per model, for kfd-inject's labels), the fraction of true points\n"
+        "kept and the share removed by range (0-2, 2-5, 5-10, 10+ m).",
         "Exit 1 on bad input, 2 on bad usage.");
     std::string rawlog, labels, config;
-    cli.option("-i", rawlog, "simulated rawlog (kfd-simulate)")->type_name("FILE")->required();
-    cli.option("-l", labels, "its labels (OUT.labels.csv)")->type_name("FILE")->required();
+    cli.option("-i", rawlog, "labelled rawlog (kfd-simulate or kfd-inject)")
+        ->type_name("FILE")
+        ->required();
+    cli.option("-l", labels,
+               "its labels (OUT.labels.csv); an empty label file (header only)\nscores a clean "
+               "log: what a method removes of real returns")
+        ->type_name("FILE")
+        ->required();
     cli.option("-c", config, "pipeline configuration (.ini [KFD] or .yaml)")
         ->type_name("FILE")
         ->required();
@@ -31,5 +38,19 @@ int main(int argc, char** argv) {
                     q.recall(kfd::NoiseKind::Isolated), q.recall(kfd::NoiseKind::Clustered),
                     q.recall(kfd::NoiseKind::Edge));
         std::printf("us_per_scan %.2f\n", q.microseconds / static_cast<double>(q.scans));
+        std::printf("clean_removed_by_range");
+        for (std::size_t b = 0; b < q.clean_by_band.size(); ++b)
+            std::printf(" %g-%s:%.5f", q.kBandStartM[b],
+                        b + 1 < q.kBandStartM.size()
+                            ? std::to_string(static_cast<int>(q.kBandStartM[b + 1])).c_str()
+                            : "inf",
+                        q.cleanRemoved(b));
+        std::printf("\n");
+        for (std::size_t m = 1; m < kfd::kNoiseModels; ++m) {
+            const auto model = static_cast<kfd::NoiseModel>(m);
+            if (q.noise_by_model[m])
+                std::printf("recall_%s %.4f (%zu)\n", kfd::toString(model), q.recall(model),
+                            q.noise_by_model[m]);
+        }
     });
 }

@@ -21,25 +21,49 @@ NoiseKind parseKind(const std::string& s) {
     throw SimulationError("unknown noise kind '" + s + "' in labels");
 }
 
-// scan index -> (beam, kind) list
-std::map<std::size_t, std::vector<std::pair<std::size_t, NoiseKind>>> readLabels(
-    const std::string& path) {
+NoiseModel parseModel(const std::string& s) {
+    for (std::size_t m = 1; m < kNoiseModels; ++m)
+        if (s == toString(static_cast<NoiseModel>(m))) return static_cast<NoiseModel>(m);
+    throw SimulationError("unknown noise model '" + s + "' in labels");
+}
+
+struct Label {
+    std::size_t beam;
+    NoiseKind kind;
+    NoiseModel model;
+};
+
+// scan index -> labelled beams
+std::map<std::size_t, std::vector<Label>> readLabels(const std::string& path) {
     std::ifstream f(path);
     if (!f) throw SimulationError("cannot open labels " + path);
-    std::map<std::size_t, std::vector<std::pair<std::size_t, NoiseKind>>> out;
+    std::map<std::size_t, std::vector<Label>> out;
     std::string line;
     std::getline(f, line);
-    if (line != "scan,timestamp,beam,kind")
-        throw SimulationError(path + " is not a kfd-simulate label file");
+    const bool with_model = line == "scan,timestamp,beam,kind,model";
+    if (line != "scan,timestamp,beam,kind" && !with_model)
+        throw SimulationError(path + " is not a kfd-simulate or kfd-inject label file");
     std::size_t lineno = 1;
     while (std::getline(f, line)) {
         ++lineno;
         std::stringstream ss(line);
-        std::string scan, stamp, beam, kind;
-        if (!std::getline(ss, scan, ',') || !std::getline(ss, stamp, ',') ||
-            !std::getline(ss, beam, ',') || !std::getline(ss, kind))
+        std::string scan, stamp, beam, kind, model;
+        const bool ok = std::getline(ss, scan, ',') && std::getline(ss, stamp, ',') &&
+                        std::getline(ss, beam, ',') &&
+                        (with_model ? std::getline(ss, kind, ',') && std::getline(ss, model)
+                                    : static_cast<bool>(std::getline(ss, kind)));
+        if (!ok) throw SimulationError(path + ":" + std::to_string(lineno) + ": malformed row");
+        try {
+            const NoiseKind k = parseKind(kind);
+            const NoiseModel m = with_model ? parseModel(model) : NoiseModel::None;
+            if (with_model && kindOf(m) != k)
+                throw SimulationError("model '" + model + "' is not of kind '" + kind + "'");
+            out[std::stoul(scan)].push_back({std::stoul(beam), k, m});
+        } catch (const std::logic_error&) {  // stoul: not a number
             throw SimulationError(path + ":" + std::to_string(lineno) + ": malformed row");
-        out[std::stoul(scan)].emplace_back(std::stoul(beam), parseKind(kind));
+        } catch (const SimulationError& e) {
+            throw SimulationError(path + ":" + std::to_string(lineno) + ": " + e.what());
+        }
     }
     return out;
 }
@@ -54,16 +78,19 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
     DenoiseQuality q;
     std::vector<std::uint8_t> before;
     std::vector<NoiseKind> kind;
+    std::vector<NoiseModel> model;
     SourceEntry e;
     auto score = [&](const mrpt::obs::CObservation2DRangeScan::Ptr& scan) {
         const std::size_t n = scan->getScanSize();
         before.resize(n);
         kind.assign(n, NoiseKind::Clean);
+        model.assign(n, NoiseModel::None);
         for (std::size_t i = 0; i < n; ++i) before[i] = scan->getScanRangeValidity(i);
         if (const auto it = labels.find(q.scans); it != labels.end())
-            for (const auto& [beam, k] : it->second) {
-                if (beam >= n) throw SimulationError("labels do not fit the rawlog");
-                kind[beam] = k;
+            for (const auto& l : it->second) {
+                if (l.beam >= n) throw SimulationError("labels do not fit the rawlog");
+                kind[l.beam] = l.kind;
+                model[l.beam] = l.model;
             }
         const auto r = filter.process(*scan);
         q.microseconds += r.report.microseconds;
@@ -75,11 +102,19 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
             if (kind[i] == NoiseKind::Clean) {
                 ++q.clean;
                 q.removed_clean += removed;
+                const double range = scan->getScanRange(i);
+                std::size_t band = 0;
+                while (band + 1 < q.kBandStartM.size() && range >= q.kBandStartM[band + 1]) ++band;
+                ++q.clean_by_band[band];
+                q.removed_clean_by_band[band] += removed;
             } else {
                 ++q.noise;
                 ++q.noise_by_kind[ki];
                 q.removed_noise += removed;
                 q.removed_by_kind[ki] += removed;
+                const auto mi = static_cast<std::size_t>(model[i]);
+                ++q.noise_by_model[mi];
+                q.removed_by_model[mi] += removed;
             }
         }
         ++q.scans;

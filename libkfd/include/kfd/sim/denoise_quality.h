@@ -8,6 +8,7 @@
 
 #include "kfd/core/pipeline.h"
 #include "kfd/sim/noise_injector.h"
+#include "kfd/sim/real_noise.h"
 
 namespace kfd {
 
@@ -20,6 +21,12 @@ struct DenoiseQuality {
     std::array<std::size_t, 4> noise_by_kind{};    // indexed by NoiseKind
     std::array<std::size_t, 4> removed_by_kind{};  // indexed by NoiseKind
     double microseconds = 0;                       // total time in the pipeline
+    /// With a label file that names models (kfd-inject): labelled and removed beams by model.
+    std::array<std::size_t, kNoiseModels> noise_by_model{}, removed_by_model{};
+    /// Clean points and the clean points removed by range band, [0, 2), [2, 5), [5, 10) and
+    /// [10, inf) m: where a method removes real returns.
+    static constexpr std::array<double, 4> kBandStartM = {0.0, 2.0, 5.0, 10.0};
+    std::array<std::size_t, 4> clean_by_band{}, removed_clean_by_band{};
     double precision() const {
         const auto r = removed_noise + removed_clean;
         return r ? static_cast<double>(removed_noise) / r : 0.0;
@@ -33,15 +40,28 @@ struct DenoiseQuality {
         const auto i = static_cast<std::size_t>(k);
         return noise_by_kind[i] ? static_cast<double>(removed_by_kind[i]) / noise_by_kind[i] : 0.0;
     }
+    double recall(NoiseModel m) const {
+        const auto i = static_cast<std::size_t>(m);
+        return noise_by_model[i] ? static_cast<double>(removed_by_model[i]) / noise_by_model[i]
+                                 : 0.0;
+    }
+    /// Share of the clean points of range band b that were removed.
+    double cleanRemoved(std::size_t band) const {
+        return clean_by_band[band]
+                   ? static_cast<double>(removed_clean_by_band[band]) / clean_by_band[band]
+                   : 0.0;
+    }
     /// Fraction of true points kept.
     double cleanKept() const {
         return clean ? 1.0 - static_cast<double>(removed_clean) / clean : 1.0;
     }
 };
 
-/// Runs every scan of a simulated rawlog through `pipeline` (normally without the keyframe
+/// Runs every scan of a labelled rawlog through `pipeline` (normally without the keyframe
 /// stage, so every scan is denoised) and scores the removed beams against the labels CSV
-/// written by kfd-simulate. A dropped scan counts as removing nothing. Throws
+/// written by kfd-simulate ("scan,timestamp,beam,kind") or kfd-inject (with a fifth column,
+/// the model). A clean log scored against a label file with no rows gives the real points a
+/// method removes. A dropped scan counts as removing nothing. Throws
 /// SimulationError on unreadable files or labels that do not fit the rawlog.
 DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& labels_csv,
                                  const Pipeline::Params& pipeline);

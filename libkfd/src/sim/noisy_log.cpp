@@ -1,0 +1,102 @@
+#include "kfd/sim/noisy_log.h"
+
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <vector>
+
+#include "kfd/core/cancel.h"
+#include "kfd/core/output_paths.h"
+#include "kfd/mrpt/scan_adapter.h"
+#include "kfd/mrpt/scan_check.h"
+#include "kfd/mrpt/source.h"
+#include "kfd/sim/world.h"
+
+namespace kfd {
+
+namespace fs = std::filesystem;
+
+NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
+    NoisyLogSummary sum;
+    if (o.input.empty() || o.output.empty()) throw SimulationError("give an input and an output");
+    const fs::path out(o.output);
+    sum.rawlog = o.output;
+    sum.labels = (out.parent_path() / out.stem()).string() + ".labels.csv";
+    checkOutputPaths({{"input rawlog", o.input}},
+                     {{"output rawlog", sum.rawlog}, {"labels", sum.labels}});
+    RealNoiseInjector noise;
+    try {
+        noise.initialize(o.noise);
+    } catch (const ParameterError& e) {
+        throw SimulationError(e.what());
+    }
+    const auto source = openSource(o.input);
+    TempOutputFile tmp(sum.rawlog), tmp_labels(sum.labels);
+    mrpt::io::CFileGZOutputStream f;
+    if (!f.open(tmp.path().string(), 1)) throw SimulationError("cannot write " + o.output);
+    auto arch = mrpt::serialization::archiveFrom(f);
+    std::ofstream labels(tmp_labels.path());
+    if (!labels) throw SimulationError("cannot write " + sum.labels);
+    labels << "scan,timestamp,beam,kind,model\n";
+
+    std::mt19937 rng(o.seed);
+    Scan core;
+    std::vector<NoiseKind> kinds;
+    std::vector<NoiseModel> models;
+    auto inject = [&](const mrpt::obs::CObservation2DRangeScan::Ptr& scan) {
+        const std::size_t k = sum.scans++;
+        if (!checkScan(*scan, nullptr).ok()) return;  // unusable geometry: copied unchanged
+        toCore(*scan, core);
+        for (std::size_t i = 0; i < core.size(); ++i) sum.beams += core.valid[i] ? 1 : 0;
+        noise.apply(core, kinds, models, rng);
+        const std::string t = std::to_string(core.timestamp);
+        for (std::size_t i = 0; i < core.size(); ++i) {
+            if (kinds[i] == NoiseKind::Clean) continue;
+            scan->setScanRange(i, core.range[i]);
+            scan->setScanRangeValidity(i, true);
+            labels << k << ',' << t << ',' << i << ',' << toString(kinds[i]) << ','
+                   << toString(models[i]) << '\n';
+            ++sum.by_kind[static_cast<std::size_t>(kinds[i])];
+            ++sum.by_model[static_cast<std::size_t>(models[i])];
+        }
+    };
+    SourceEntry e;
+    const double total = static_cast<double>(std::max<std::uint64_t>(1, source->bytesTotal()));
+    std::size_t n = 0;
+    while (source->next(e)) {
+        throwIfCancelled();
+        e.forEachScan(inject);
+        switch (e.kind) {
+            case SourceEntry::Kind::Frame:
+                if (e.action) arch << *e.action;
+                arch << *e.frame;
+                break;
+            case SourceEntry::Kind::Action:
+                arch << *e.action;
+                break;
+            case SourceEntry::Kind::Observation:
+                arch << *e.observation;
+                break;
+            case SourceEntry::Kind::Other:
+                arch << *e.other;
+                break;
+        }
+        if (o.on_progress && ++n % 500 == 0)
+            o.on_progress(static_cast<double>(source->bytesRead()) / total);
+    }
+    if (sum.scans == 0) throw SimulationError("no 2D scans in " + o.input);
+    f.close();
+    labels.close();
+    if (!labels) throw SimulationError("failed writing " + sum.labels);
+    throwIfCancelled();
+    tmp.commit();
+    tmp_labels.commit();
+    if (o.on_progress) o.on_progress(1.0);
+    return sum;
+}
+
+}  // namespace kfd
