@@ -364,6 +364,8 @@ def collect(out, baseline="none", pairs=None, plots=True, quiet=False):
             lines += ["![%s %s](plots/%s-%s.png)" % (log, config, log, config), ""]
     with open(os.path.join(out, "runs.json"), "w") as f:
         json.dump(stats, f, indent=1)
+    with open(os.path.join(out, "summary.md"), "w") as f:
+        f.write(compact(stats, baseline))
     with open(os.path.join(out, "report.md"), "w") as f:
         f.write("\n".join(lines))
     if not quiet:
@@ -371,6 +373,45 @@ def collect(out, baseline="none", pairs=None, plots=True, quiet=False):
             len(runs), os.path.join(out, "report.md"), os.path.join(out, "runs.csv"),
             os.path.join(out, "runs.json")), file=sys.stderr)
     return stats
+
+
+def compact(stats, baseline):
+    """summary.md: per config, one row per (log, mode) with medians, and one row per (log,
+    pair) with wins/losses and sign-test p for the local and long relations error (or ATE) and
+    the CPU ratio."""
+    lines = ["# kfd-compare summary", ""]
+    configs = sorted({r["config"] for r in stats["summary"]})
+    for config in configs:
+        rows = [r for r in stats["summary"] if r["config"] == config]
+        lines += ["## %s" % config, "",
+                  "| log | mode | n | dropped % | local (m) | long (m) | ATE (m) | CPU (s) |",
+                  "|---|---|---:|---:|---:|---:|---:|---:|"]
+        for r in sorted(rows, key=lambda r: (r["log"], r["mode"] != baseline, r["mode"])):
+            def med(m, d=3):
+                return fmt(r[m]["median"], d) if r[m]["n"] else "–"
+            lines.append("| %s | %s | %d | %s | %s | %s | %s | %s |" % (
+                r["log"], r["mode"], r["drop"]["n"], med("drop", 1), med("local"), med("long"),
+                med("ate"), med("cpu", 2)))
+        lines += ["", "| log | A vs B | n | local W/L (p) | long W/L (p) | ATE W/L (p) | "
+                  "CPU ratio A/B [95 %] |", "|---|---|---:|---:|---:|---:|---:|"]
+        pairs = {}
+        for p in stats["pairs"]:
+            if p["config"] == config:
+                pairs.setdefault((p["log"], p["a"], p["b"]), {})[p["metric"]] = p
+
+        def wl(p):
+            return "–" if p is None else "%d/%d (%s)" % (p["wins"], p["losses"],
+                                                         fmt_p(p["p_sign"]))
+        for (log, a, b), ms in sorted(pairs.items()):
+            c = ms.get("cpu")
+            lines.append("| %s | %s vs %s | %d | %s | %s | %s | %s |" % (
+                log, a, b, max(p["n"] for p in ms.values()), wl(ms.get("local")),
+                wl(ms.get("long")), wl(ms.get("ate")),
+                "–" if c is None else "%s [%s–%s]" % (fmt(c["median_ratio"], 2),
+                                                      fmt(c["ratio_lo"], 2),
+                                                      fmt(c["ratio_hi"], 2))))
+        lines.append("")
+    return "\n".join(lines)
 
 
 def plot(out, log, config, modes, baseline):

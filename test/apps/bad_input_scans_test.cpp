@@ -116,7 +116,7 @@ TEST(BadInputScans, IcpSlamInEveryModeSkipsBadScansAndWritesFinitePoses) {
     TempDir dir;
     for (const bool observations : {false, true})
         for (const char* mode :
-             {"none", "odometry", "keyframe", "kfd", "dbscan", "radius", "sor"}) {
+             {"none", "odometry", "keyframe", "kfd", "dbscan", "radius", "sor", "decimate"}) {
             SCOPED_TRACE(std::string(mode) + (observations ? ", observations" : ", frames"));
             const std::string in = dir / "bad.rawlog";
             writeBadScanLog(in, observations);
