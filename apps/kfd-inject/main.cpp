@@ -17,7 +17,6 @@ int main(int argc, char** argv) {
         "Same input, options and seed = same files. Exit 1 on bad input (an output that is the\n"
         "input included), 2 on bad usage, 130/143 when interrupted (no output is left).");
     kfd::NoisyLogOptions o;
-    std::string only;
     cli.option("-i,--input", o.input, "real rawlog")->type_name("FILE")->required();
     cli.option("-o,--output", o.output, "noisy rawlog")->type_name("FILE")->required();
     cli.option("--isolated", o.noise.isolated_rate, "isolated spikes, probability per beam")
@@ -29,24 +28,16 @@ int main(int argc, char** argv) {
     cli.option("--edge", o.noise.edge_rate, "mixed pixels, probability per depth edge")
         ->type_name("P")
         ->capture_default_str();
-    cli.option("--model", only,
+    cli.option("--model", o.noise.only,
                "only this model (spike_uniform, spike_near_sensor, spike_near_surface,\n"
                "cluster_near_sensor, cluster_mid_range, cluster_before_wall, edge_uniform,\n"
-               "edge_near_front, edge_near_back); default: all of them")
+               "edge_near_front, edge_near_back); default: all of them",
+               kfd::parseNoiseModel)
         ->type_name("NAME");
     cli.option("--seed", o.seed, "random seed")->type_name("N")->capture_default_str();
     cli.addQuiet("no progress");
     cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM
     return cli.run(argc, argv, [&] {
-        if (!only.empty()) {
-            bool found = false;
-            for (std::size_t m = 1; m < kfd::kNoiseModels && !found; ++m)
-                if (only == kfd::toString(static_cast<kfd::NoiseModel>(m))) {
-                    o.noise.only = static_cast<kfd::NoiseModel>(m);
-                    found = true;
-                }
-            if (!found) throw kfd::app::UsageError("--model: unknown model '" + only + "'");
-        }
         if (auto* progress = cli.progress())
             o.on_progress = [progress](double f) { progress->update(f, 0, 0); };
         const auto s = kfd::writeNoisyLog(o);

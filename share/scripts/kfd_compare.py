@@ -449,7 +449,18 @@ def main(argv=None):
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="Exit status: 0 on success, 1 when a run failed or an input is bad, 2 on bad usage.")
     sub = ap.add_subparsers(dest="command", required=True)
-    r = sub.add_parser("run", help="run (or emit) every job, then collect")
+    tools = argparse.ArgumentParser(add_help=False)  # how one run is made: run and job
+    tools.add_argument("--datasets", default=DEFAULT_DATASETS)
+    tools.add_argument("--exe", default=DEFAULT_EXE, help="kfd-icp-slam")
+    tools.add_argument("--sim-exe", default=DEFAULT_SIM, help="kfd-simulate")
+    tools.add_argument("--split-seconds", type=float, default=10.0,
+                       help="relations over at most S s are local (default 10)")
+    report = argparse.ArgumentParser(add_help=False)  # how runs are compared: run and collect
+    report.add_argument("--baseline", default="none")
+    report.add_argument("--pairs", nargs="*", default=[], help="more pairs A:B")
+    report.add_argument("--no-plots", dest="plots", action="store_false")
+    report.add_argument("-q", "--quiet", action="store_true")
+    r = sub.add_parser("run", parents=[tools, report], help="run (or emit) every job, then collect")
     r.add_argument("--logs", nargs="+", required=True, help="dataset names, .rawlog paths, sim:...")
     r.add_argument("--modes", nargs="+", default=["none", "kfd", "odometry@kfd", "keyframe"])
     r.add_argument("--configs", nargs="+", default=[DEFAULT_CONFIG], help="kfd-icp-slam .ini files")
@@ -458,33 +469,16 @@ def main(argv=None):
     r.add_argument("--jobs", "-j", type=int, default=os.cpu_count() or 1, help="local parallel runs")
     r.add_argument("--emit-jobs", metavar="FILE", help="write one command per line and stop")
     r.add_argument("--maps", action="store_true", help="keep each run's map and map figure")
-    for p in (r,):
-        p.add_argument("--datasets", default=DEFAULT_DATASETS)
-        p.add_argument("--exe", default=DEFAULT_EXE, help="kfd-icp-slam")
-        p.add_argument("--sim-exe", default=DEFAULT_SIM, help="kfd-simulate")
-        p.add_argument("--split-seconds", type=float, default=10.0,
-                       help="relations over at most S s are local (default 10)")
-        p.add_argument("--baseline", default="none")
-        p.add_argument("--pairs", nargs="*", default=[], help="more pairs A:B")
-        p.add_argument("--no-plots", dest="plots", action="store_false")
-        p.add_argument("-q", "--quiet", action="store_true")
-    j = sub.add_parser("job", help="one run (what --emit-jobs writes)")
+    j = sub.add_parser("job", parents=[tools], help="one run (what --emit-jobs writes)")
     j.add_argument("--out", required=True)
     j.add_argument("--log", required=True)
-    j.add_argument("--datasets", default=DEFAULT_DATASETS)
     j.add_argument("--config", required=True)
     j.add_argument("--mode", required=True)
     j.add_argument("--repeat", type=int, required=True)
-    j.add_argument("--exe", default=DEFAULT_EXE)
-    j.add_argument("--sim-exe", default=DEFAULT_SIM)
-    j.add_argument("--split-seconds", type=float, default=10.0)
     j.add_argument("--map", action="store_true")
-    c = sub.add_parser("collect", help="merge the finished runs of DIR into its report")
+    c = sub.add_parser("collect", parents=[report],
+                       help="merge the finished runs of DIR into its report")
     c.add_argument("dir")
-    c.add_argument("--baseline", default="none")
-    c.add_argument("--pairs", nargs="*", default=[])
-    c.add_argument("--no-plots", dest="plots", action="store_false")
-    c.add_argument("-q", "--quiet", action="store_true")
     a = ap.parse_args(argv)
     try:
         if a.command == "run":

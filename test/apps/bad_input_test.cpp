@@ -470,6 +470,30 @@ TEST(BadInputTruncated, SimulateOnAGridmapWithoutItsGzipTrailerFails) {
     snap.expectUnchanged();
 }
 
+// kfd-inject: an output on its input, an unknown model, labels that do not name a model.
+TEST(BadInputInject, OutputOnTheInputOrAnUnknownModelIsRefused) {
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const Snapshot snap({in});
+    Result r = run(KFD_INJECT_EXE, {"-q", "-i", in, "-o", in}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-inject: the output rawlog " + in + " is the input rawlog " + in +
+                             ": refusing to overwrite an input");
+    r = run(KFD_INJECT_EXE, {"-q", "-i", in, "-o", d / "n.rawlog", "--model", "spike"}, d.path);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.first().find("--model"), std::string::npos) << r.err;
+    EXPECT_NE(r.first().find("unknown model 'spike'"), std::string::npos) << r.err;
+    EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
+    // kfd-denoise-eval on labels with a model it does not know: the file and line named.
+    const auto labels = d.write("l.csv", "scan,timestamp,beam,kind,model\n0,1.0,3,isolated,nope\n");
+    const auto cfg = d.copy(kIni, "kfd.ini");
+    r = run(KFD_DENOISE_EVAL_EXE, {"-i", in, "-l", labels, "-c", cfg}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(),
+              "kfd-denoise-eval: " + labels + ":2: unknown noise model 'nope' in labels");
+    snap.expectUnchanged();
+}
+
 // --- configuration ---------------------------------------------------------------------------
 
 // kfd-filter with a bad configuration: exit 1, the first line, nothing written, inputs kept.

@@ -21,12 +21,6 @@ NoiseKind parseKind(const std::string& s) {
     throw SimulationError("unknown noise kind '" + s + "' in labels");
 }
 
-NoiseModel parseModel(const std::string& s) {
-    for (std::size_t m = 1; m < kNoiseModels; ++m)
-        if (s == toString(static_cast<NoiseModel>(m))) return static_cast<NoiseModel>(m);
-    throw SimulationError("unknown noise model '" + s + "' in labels");
-}
-
 struct Label {
     std::size_t beam;
     NoiseKind kind;
@@ -55,10 +49,13 @@ std::map<std::size_t, std::vector<Label>> readLabels(const std::string& path) {
         if (!ok) throw SimulationError(path + ":" + std::to_string(lineno) + ": malformed row");
         try {
             const NoiseKind k = parseKind(kind);
-            const NoiseModel m = with_model ? parseModel(model) : NoiseModel::None;
+            const NoiseModel m = with_model ? parseNoiseModel(model) : NoiseModel::None;
             if (with_model && kindOf(m) != k)
                 throw SimulationError("model '" + model + "' is not of kind '" + kind + "'");
             out[std::stoul(scan)].push_back({std::stoul(beam), k, m});
+        } catch (const ParameterError&) {  // an unknown model name
+            throw SimulationError(path + ":" + std::to_string(lineno) + ": unknown noise model '" +
+                                  model + "' in labels");
         } catch (const std::logic_error&) {  // stoul: not a number
             throw SimulationError(path + ":" + std::to_string(lineno) + ": malformed row");
         } catch (const SimulationError& e) {

@@ -31,6 +31,12 @@ const char* toString(NoiseModel m) {
     return "unknown";
 }
 
+NoiseModel parseNoiseModel(const std::string& s) {
+    for (std::size_t m = 1; m < kNoiseModels; ++m)
+        if (s == toString(static_cast<NoiseModel>(m))) return static_cast<NoiseModel>(m);
+    throw ParameterError("model", "unknown model '" + s + "'");
+}
+
 NoiseKind kindOf(NoiseModel m) {
     const auto v = static_cast<int>(m);
     if (v == 0) return NoiseKind::Clean;

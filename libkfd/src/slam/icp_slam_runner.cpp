@@ -127,12 +127,11 @@ class StartSkipper {
     std::size_t left_, skipped_ = 0;
 };
 
-// Reads only timestamps and odometry of every scan after the skipped start (for matching the
-// odometry baseline's drop rate to a target before the real run).
-std::vector<ScanStamp> scanOdometry(const std::string& rawlog, std::size_t skip_scans,
-                                    bool laser_only) {
+// Every 2D scan of the log as the real run meets it (icp-slam's steps, after the skipped
+// start), with its entry's odometry: what the pre-passes that match a drop rate read.
+template <class Fn>
+void forEachRunScan(const std::string& rawlog, std::size_t skip_scans, Fn&& fn) {
     auto source = openLog(rawlog);
-    std::vector<ScanStamp> out;
     IcpSlamSteps steps;
     IcpSlamStep step;
     StartSkipper skipper(skip_scans);
@@ -140,18 +139,28 @@ std::vector<ScanStamp> scanOdometry(const std::string& rawlog, std::size_t skip_
     while (nextEntry(*source, e)) {
         throwIfCancelled();
         if (!steps.feed(e, step) || skipper.skip(step)) continue;
-        auto add = [&](const mrpt::obs::CObservation& o) {
-            if (!IS_CLASS(o, CObservation2DRangeScan)) return;
-            std::optional<Pose2D> odo = e.odometry;  // non-finite: unknown, as checkScan does
-            if (odo && !finitePose(odo->x, odo->y, odo->phi)) odo.reset();
-            if (laser_only) odo.reset();
-            out.push_back({stampOf(o), odo});
+        auto visit = [&](mrpt::obs::CObservation& o) {
+            if (auto* scan = dynamic_cast<CObservation2DRangeScan*>(&o)) fn(*scan, e.odometry);
         };
         if (step.observation)
-            add(*step.observation);
+            visit(*step.observation);
         else
-            for (const auto& o : *step.frame) add(*o);
+            for (const auto& o : *step.frame) visit(*o);
     }
+}
+
+// Timestamps and odometry of every scan after the skipped start (for matching the odometry
+// baseline's drop rate to a target before the real run).
+std::vector<ScanStamp> scanOdometry(const std::string& rawlog, std::size_t skip_scans,
+                                    bool laser_only) {
+    std::vector<ScanStamp> out;
+    forEachRunScan(rawlog, skip_scans,
+                   [&](const CObservation2DRangeScan& scan, std::optional<Pose2D> odo) {
+                       // non-finite: unknown, as checkScan does
+                       if (laser_only || (odo && !finitePose(odo->x, odo->y, odo->phi)))
+                           odo.reset();
+                       out.push_back({stampOf(scan), odo});
+                   });
     return out;
 }
 
@@ -160,28 +169,14 @@ std::vector<ScanStamp> scanOdometry(const std::string& rawlog, std::size_t skip_
 double pipelineDropPct(const std::string& rawlog, const Pipeline::Params& pipeline,
                        std::size_t skip_scans, bool laser_only) {
     StreamFilter filter(pipeline);
-    auto source = openLog(rawlog);
-    IcpSlamSteps steps;
-    IcpSlamStep step;
-    StartSkipper skipper(skip_scans);
-    SourceEntry e;
     std::size_t in = 0, kept = 0;
-    while (nextEntry(*source, e)) {
-        throwIfCancelled();
-        if (!steps.feed(e, step) || skipper.skip(step)) continue;
-        auto add = [&](mrpt::obs::CObservation& o) {
-            auto* scan = dynamic_cast<CObservation2DRangeScan*>(&o);
-            if (!scan) return;
-            std::optional<Pose2D> odo = laser_only ? std::nullopt : e.odometry;
-            ++in;
-            if (!checkScan(*scan, &odo).ok()) return;
-            kept += filter.process(*scan, odo).keep ? 1 : 0;
-        };
-        if (step.observation)
-            add(*step.observation);
-        else
-            for (const auto& o : *step.frame) add(*o);
-    }
+    forEachRunScan(rawlog, skip_scans,
+                   [&](CObservation2DRangeScan& scan, std::optional<Pose2D> odo) {
+                       if (laser_only) odo.reset();
+                       ++in;
+                       if (!checkScan(scan, &odo).ok()) return;
+                       kept += filter.process(scan, odo).keep ? 1 : 0;
+                   });
     return in ? 100.0 * static_cast<double>(in - kept) / static_cast<double>(in) : 0.0;
 }
 

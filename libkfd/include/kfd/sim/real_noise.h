@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "kfd/core/error.h"
@@ -40,6 +41,9 @@ enum class NoiseModel : std::uint8_t {
 };
 inline constexpr std::size_t kNoiseModels = 10;
 const char* toString(NoiseModel m);
+/// The model named `s` (toString's names, None excluded); kfd::ParameterError (field "model",
+/// detail "unknown model 's'") otherwise.
+NoiseModel parseNoiseModel(const std::string& s);
 /// The kind a model belongs to.
 NoiseKind kindOf(NoiseModel m);
 
