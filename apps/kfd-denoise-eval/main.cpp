@@ -1,4 +1,5 @@
-// kfd-denoise-eval: precision / recall of a denoising pipeline on a labelled simulated rawlog.
+// kfd-denoise-eval: precision / recall of a denoising pipeline on a labelled rawlog
+// (kfd-simulate's or kfd-inject's).
 #include <cstdio>
 #include <string>
 
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
         "kept and the share removed by range (0-2, 2-5, 5-10, 10+ m).",
         "Exit 1 on bad input, 2 on bad usage.");
     std::string rawlog, labels, config;
+    bool laser_only = false;
     cli.option("-i", rawlog, "labelled rawlog (kfd-simulate or kfd-inject)")
         ->type_name("FILE")
         ->required();
@@ -27,8 +29,11 @@ int main(int argc, char** argv) {
     cli.option("-c", config, "pipeline configuration (.ini [KFD] or .yaml)")
         ->type_name("FILE")
         ->required();
+    cli.flag("--laser-only", laser_only,
+             "withhold the log's odometry from the pipeline (as from a LaserScan-only source)");
     return cli.run(argc, argv, [&] {
-        const auto q = kfd::evaluateDenoising(rawlog, labels, kfd::loadConfigFile(config));
+        const auto q =
+            kfd::evaluateDenoising(rawlog, labels, kfd::loadConfigFile(config), laser_only);
         std::printf("scans %zu, points %zu, noise %zu (isolated %zu, clustered %zu, edge %zu)\n",
                     q.scans, q.points, q.noise, q.noise_by_kind[1], q.noise_by_kind[2],
                     q.noise_by_kind[3]);

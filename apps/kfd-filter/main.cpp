@@ -17,6 +17,18 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
     std::printf("  input    %s (%s, %zu sensor%s)\n", o.input.c_str(), s.layout.c_str(), s.sensors,
                 s.sensors == 1 ? "" : "s");
     std::printf("  output   %s\n", o.output.c_str());
+    const kfd::SensorSummary& sn = s.sensor;
+    if (sn.beams) {
+        std::printf("  sensor   %s%s%zu beams over %.1f deg (%.3f deg per beam)", sn.label.c_str(),
+                    sn.label.empty() ? "" : ": ", sn.beams, sn.aperture_deg, sn.resolution_deg);
+        if (sn.rate_hz > 0.0) std::printf(", %.1f Hz", sn.rate_hz);
+        std::printf(", %s\n", sn.odometry ? "odometry" : "no odometry (laser only)");
+        if (sn.range_noise_m > 0.0)
+            std::printf(
+                "  derived  range noise %.1f cm (from the scans' residuals); resolution and "
+                "noise set the evidence denoiser's thresholds\n",
+                100.0 * sn.range_noise_m);
+    }
     std::printf("  scans    in %zu, kept %zu, dropped %zu (%.1f %%)\n", s.scans_in, s.scans_kept,
                 s.scans_dropped, s.droppedPercent());
     std::printf("  points   in %zu; in kept scans removed: %zu out of range, %zu noise (%.2f %%)\n",
@@ -79,7 +91,8 @@ int main(int argc, char** argv) {
         ->type_name("FILE");
     cli.option("-c,--config", config,
                ".ini ([KFD] section) or .yaml configuration;\n"
-               "default: built-in defaults (= share/kfd/paper-mit-0.752.ini)")
+               "default: kfd's defaults (= share/kfd/default.ini, compiled in);\n"
+               "the paper's exact method: share/kfd/paper-mit-*.ini")
         ->type_name("FILE");
     cli.option("--stats", opts.stats_csv,
                "per-scan CSV (timestamp, sensor, keyframe, reason, P_common,\n"
@@ -106,7 +119,7 @@ int main(int argc, char** argv) {
             return;
         }
         if (!window.empty()) return printWindowSuggestion(window);
-        if (!config.empty()) opts.pipeline = kfd::loadConfigFile(config);
+        opts.pipeline = config.empty() ? kfd::kfdDefaults() : kfd::loadConfigFile(config);
         if (print_config) {
             std::fputs(kfd::toIni(opts.pipeline).c_str(), stdout);
             return;

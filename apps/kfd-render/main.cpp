@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <deque>
+#include <optional>
 #include <string>
 
 #include "common/cli.h"
@@ -20,7 +22,9 @@ int main(int argc, char** argv) {
         "Runs the distance filter and the denoiser of CONFIG on one scan and draws its clusters\n"
         "(each in its own colour), the removed noise points (red), the ring boundaries, the "
         "sensor\n"
-        "and a 1 m grid and scale bar, top-down with +x right and +y up. No display needed.");
+        "and a 1 m grid and scale bar, top-down with +x right and +y up. No display needed.\n"
+        "The scans just before it go through the denoiser first (--history), as the previous\n"
+        "keyframes the evidence variant compares with.");
     std::string in, out, cfg;
     long index = -1;
     double stamp = std::nan(""), extent = 0.0;
@@ -28,7 +32,12 @@ int main(int argc, char** argv) {
     cli.option("-i", in, "rawlog")->type_name("FILE")->required();
     cli.option("--index", index, "the N-th 2D scan (0-based)")->type_name("N");
     cli.option("--time", stamp, "the scan nearest to timestamp T (s)")->type_name("T");
-    cli.option("-c", cfg, "configuration (.ini [KFD] or .yaml); default: built-in defaults")
+    long history = 2;
+    cli.option("--history", history, "scans before it that the denoiser sees first")
+        ->type_name("K")
+        ->check(kfd::app::inRange(0, 100))
+        ->capture_default_str();
+    cli.option("-c", cfg, "configuration (.ini [KFD] or .yaml); default: kfd's defaults")
         ->type_name("FILE");
     cli.option("-o", out, "output PNG")->type_name("FILE")->required();
     cli.option("--size", size, "image width and height")->type_name("PX")->capture_default_str();
@@ -40,33 +49,45 @@ int main(int argc, char** argv) {
             throw kfd::app::UsageError("give exactly one of --index and --time");
         kfd::app::checkOutputPaths({{"input rawlog", in}, {"configuration", cfg}},
                                    {{"output image", out}});
-        const kfd::Pipeline::Params p =
-            cfg.empty() ? kfd::Pipeline::Params{} : kfd::loadConfigFile(cfg);
+        const kfd::Pipeline::Params p = cfg.empty() ? kfd::kfdDefaults() : kfd::loadConfigFile(cfg);
         const auto source = kfd::openSource(in);
-        mrpt::obs::CObservation2DRangeScan::Ptr chosen;
+        // The chosen scan and the `history` scans before it (with their odometry): the evidence
+        // denoiser takes them as its previous keyframes.
+        struct Seen {
+            mrpt::obs::CObservation2DRangeScan::Ptr scan;
+            std::optional<kfd::Pose2D> odometry;
+        };
+        std::deque<Seen> recent, chosen;
         double best = 1e300;
         long n = 0;
         kfd::SourceEntry entry;
-        while (!(index >= 0 && chosen) && source->next(entry)) {
+        while (!(index >= 0 && !chosen.empty()) && source->next(entry)) {
             kfd::throwIfCancelled();
             entry.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
-                if (index >= 0 && n++ == index) chosen = s;
+                recent.push_back({s, entry.odometry});
+                if (recent.size() > static_cast<std::size_t>(history) + 1) recent.pop_front();
+                if (index >= 0 && n++ == index) chosen = recent;
                 if (index < 0) {
                     const double d = std::abs(kfd::stampOf(*s) - stamp);
                     if (d < best) {
                         best = d;
-                        chosen = s;
+                        chosen = recent;
                     }
                 }
             });
         }
-        if (!chosen) throw std::runtime_error("no such scan in " + in);
-        kfd::Scan scan;
-        kfd::toCore(*chosen, scan);
-        kfd::DistanceFilter(p.get<kfd::DistanceStage>()).filter(scan);
-        kfd::Scan work = scan;
+        if (chosen.empty()) throw std::runtime_error("no such scan in " + in);
+        const kfd::DistanceFilter distance(p.get<kfd::DistanceStage>());
         kfd::Denoiser den(p.get<kfd::DenoiseStage>());
-        const auto r = den.filter(work);
+        kfd::Scan scan, work;
+        kfd::Denoiser::Result r;
+        for (const Seen& seen : chosen) {
+            kfd::toCore(*seen.scan, scan);
+            scan.odometry = seen.odometry;
+            distance.filter(scan);
+            work = scan;
+            r = den.filter(work);
+        }
         kfd::ClusterFigureOptions o;
         o.width = o.height = size;
         o.half_extent_m = extent;
@@ -80,6 +101,6 @@ int main(int argc, char** argv) {
         kfd::throwIfCancelled();  // interrupted while drawing: nothing is moved into place
         tmp.commit();
         std::printf("kfd-render: scan at %.6f, %zu clusters, %zu noise points -> %s\n",
-                    kfd::stampOf(*chosen), r.clusters, r.points_removed, out.c_str());
+                    kfd::stampOf(*chosen.back().scan), r.clusters, r.points_removed, out.c_str());
     });
 }

@@ -51,7 +51,7 @@ METRICS = [("local", "relations error, local", "m"), ("long", "relations error, 
            ("all", "relations error, all", "m"), ("ate", "ATE RMSE", "m"),
            ("drop", "dropped", "%"), ("cpu", "CPU (user+sys)", "s"),
            ("cpu_ms_per_scan", "CPU per scan", "ms")]
-PAIR_METRICS = ["local", "long", "ate", "cpu"]
+PAIR_METRICS = ["local", "long", "all", "ate", "cpu"]
 NAMED_PAIRS = [("kfd", "odometry@kfd"), ("kfd", "keyframe"), ("kfd+lo", "decimate@kfd+lo"),
                ("kfd", "decimate@kfd")]
 
@@ -377,7 +377,7 @@ def collect(out, baseline="none", pairs=None, plots=True, quiet=False):
 
 def compact(stats, baseline):
     """summary.md: per config, one row per (log, mode) with medians, and one row per (log,
-    pair) with wins/losses and sign-test p for the local and long relations error (or ATE) and
+    pair) with wins/losses and sign-test p for the local, long and all relations error, ATE and
     the CPU ratio."""
     lines = ["# kfd-compare summary", ""]
     configs = sorted({r["config"] for r in stats["summary"]})
@@ -392,8 +392,8 @@ def compact(stats, baseline):
             lines.append("| %s | %s | %d | %s | %s | %s | %s | %s |" % (
                 r["log"], r["mode"], r["drop"]["n"], med("drop", 1), med("local"), med("long"),
                 med("ate"), med("cpu", 2)))
-        lines += ["", "| log | A vs B | n | local W/L (p) | long W/L (p) | ATE W/L (p) | "
-                  "CPU ratio A/B [95 %] |", "|---|---|---:|---:|---:|---:|---:|"]
+        lines += ["", "| log | A vs B | n | local W/L (p) | long W/L (p) | all W/L (p) | "
+                  "ATE W/L (p) | CPU ratio A/B [95 %] |", "|---|---|---:|---:|---:|---:|---:|---:|"]
         pairs = {}
         for p in stats["pairs"]:
             if p["config"] == config:
@@ -404,9 +404,9 @@ def compact(stats, baseline):
                                                          fmt_p(p["p_sign"]))
         for (log, a, b), ms in sorted(pairs.items()):
             c = ms.get("cpu")
-            lines.append("| %s | %s vs %s | %d | %s | %s | %s | %s |" % (
+            lines.append("| %s | %s vs %s | %d | %s | %s | %s | %s | %s |" % (
                 log, a, b, max(p["n"] for p in ms.values()), wl(ms.get("local")),
-                wl(ms.get("long")), wl(ms.get("ate")),
+                wl(ms.get("long")), wl(ms.get("all")), wl(ms.get("ate")),
                 "–" if c is None else "%s [%s–%s]" % (fmt(c["median_ratio"], 2),
                                                       fmt(c["ratio_lo"], 2),
                                                       fmt(c["ratio_hi"], 2))))

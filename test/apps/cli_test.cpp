@@ -260,6 +260,8 @@ TEST(CliApps, BadUsageExitsTwoAndSaysWhatIsWrong) {
         {"kfd-simulate", "-o x.rawlog --seed -1", "--seed: '-1' is not a non-negative integer"},
         {"kfd-chart", "in.csv -o out.png --size 640 wide", "--size: 'wide' is not an integer"},
         {"kfd-render", "-i a -o b.png --index 3rd", "--index: '3rd' is not an integer"},
+        {"kfd-render", "-i a -o b.png --index 3 --history 101", "--history: '101' is outside"},
+        {"kfd-denoise-eval", "-i a -l b -c c --laser-only=maybe", "--laser-only"},
         // A missing required argument.
         {"kfd-filter", "-o out.rawlog", "no input rawlog (-i)"},
         {"kfd-icp-slam", "", "CONFIG.ini is required"},

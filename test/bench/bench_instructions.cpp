@@ -32,9 +32,10 @@ namespace {
 
 struct Context {
     kb::Scenario sc = kb::makeScenario();
-    std::vector<kfd::Scan> work = sc.keyframes;        // scratch copies of the keyframe set
-    std::vector<kfd::Scan> work_dropped = sc.dropped;  // ... and of the dropped set
-    std::vector<std::vector<double>> hist;             // histograms of the keyframe set
+    std::vector<kfd::Scan> work = sc.keyframes;            // scratch copies of the keyframe set
+    std::vector<kfd::Scan> work_dropped = sc.dropped;      // ... and of the dropped set
+    std::vector<kfd::Scan> work_loop = sc.loop_keyframes;  // ... and of the loop keyframes
+    std::vector<std::vector<double>> hist;                 // histograms of the keyframe set
     std::vector<double> out;
     kfd::Histogram histogram{kfd::Histogram::Params{20}};
     kfd::DistanceFilter distance{kb::paperParams().get<kfd::DistanceStage>()};
@@ -43,6 +44,7 @@ struct Context {
         kb::paperParams(kfd::DenoiseVariant::Reference).get<kfd::DenoiseStage>()};
     kfd::Denoiser range_aware{
         kb::paperParams(kfd::DenoiseVariant::RangeAware).get<kfd::DenoiseStage>()};
+    kfd::Denoiser evidence{kb::paperParams(kfd::DenoiseVariant::Evidence).get<kfd::DenoiseStage>()};
     kfd::DbscanFilter dbscan{kfd::DbscanFilter::Params{0.7, 10}};
     kfd::RadiusOutlierFilter radius{kfd::RadiusOutlierFilter::Params{}};
     kfd::StatisticalOutlierFilter sor{kfd::StatisticalOutlierFilter::Params{}};
@@ -84,6 +86,12 @@ __attribute__((noinline)) void kfd_ir_denoise_reference(Context& c, std::size_t 
 __attribute__((noinline)) void kfd_ir_denoise_range_aware(Context& c, std::size_t k) {
     c.sink += c.range_aware.filter(c.work[k]).points_removed;
 }
+__attribute__((noinline)) void kfd_ir_denoise_evidence(Context& c, std::size_t k) {
+    c.sink += c.evidence.filter(c.work_loop[k]).points_removed;
+}
+__attribute__((noinline)) void kfd_ir_dbscan_loop(Context& c, std::size_t k) {
+    c.sink += c.dbscan.filter(c.work_loop[k]).points_removed;
+}
 __attribute__((noinline)) void kfd_ir_dbscan(Context& c, std::size_t k) {
     c.sink += c.dbscan.filter(c.work[k]).points_removed;
 }
@@ -109,7 +117,8 @@ namespace {
 struct Case {
     const char* name;
     void (*call)(Context&, std::size_t);
-    bool dropped_set;  // runs on the dropped set (else on the keyframe set)
+    bool dropped_set;       // runs on the dropped set (else on the keyframe set)
+    bool loop_set = false;  // runs on the loop keyframes (overrides dropped_set)
 };
 
 const Case kCases[] = {
@@ -119,6 +128,8 @@ const Case kCases[] = {
     {"keyframe_decision", kfd_ir_keyframe_decision, true},
     {"denoise_reference", kfd_ir_denoise_reference, false},
     {"denoise_range_aware", kfd_ir_denoise_range_aware, false},
+    {"denoise_evidence", kfd_ir_denoise_evidence, false, true},
+    {"dbscan_loop", kfd_ir_dbscan_loop, false, true},
     {"dbscan", kfd_ir_dbscan, false},
     {"radius_outlier", kfd_ir_radius_outlier, false},
     {"statistical_outlier", kfd_ir_statistical_outlier, false},
@@ -129,8 +140,16 @@ const Case kCases[] = {
 
 // Untimed cycle: the same work as a counted call, without going through kfd_ir_*.
 void warmUp(Context& c, const Case& cs) {
-    const std::size_t n = cs.dropped_set ? c.sc.dropped.size() : c.sc.keyframes.size();
     const std::string name = cs.name;
+    if (cs.loop_set) {
+        for (std::size_t k = 0; k < c.sc.loop_keyframes.size(); ++k) {
+            kb::restoreValid(c.sc.loop_keyframes[k], c.work_loop[k]);
+            if (name == "denoise_evidence") c.evidence.filter(c.work_loop[k]);
+            if (name == "dbscan_loop") c.dbscan.filter(c.work_loop[k]);
+        }
+        return;
+    }
+    const std::size_t n = cs.dropped_set ? c.sc.dropped.size() : c.sc.keyframes.size();
     for (std::size_t k = 0; k < n; ++k) {
         kfd::Scan& s = cs.dropped_set ? c.work_dropped[k] : c.work[k];
         kb::restoreValid(cs.dropped_set ? c.sc.dropped[k] : c.sc.keyframes[k], s);
@@ -179,10 +198,14 @@ int main(int argc, char** argv) {
     Context c;
     for (const Case* cs : run) {
         warmUp(c, *cs);
-        const std::size_t size = cs->dropped_set ? c.sc.dropped.size() : c.sc.keyframes.size();
+        const std::size_t size = cs->loop_set      ? c.sc.loop_keyframes.size()
+                                 : cs->dropped_set ? c.sc.dropped.size()
+                                                   : c.sc.keyframes.size();
         for (long i = 0; i < n; ++i) {
             const std::size_t k = static_cast<std::size_t>(i) % size;
-            if (cs->dropped_set)
+            if (cs->loop_set)
+                kb::restoreValid(c.sc.loop_keyframes[k], c.work_loop[k]);
+            else if (cs->dropped_set)
                 kb::restoreValid(c.sc.dropped[k], c.work_dropped[k]);
             else
                 kb::restoreValid(c.sc.keyframes[k], c.work[k]);

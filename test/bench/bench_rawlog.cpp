@@ -4,8 +4,9 @@
 //                    does nothing else: the I/O limit;
 //   BM_CopyRawlog    reads every object and writes it unchanged (gzip level 1, as kfd-filter);
 //   BM_FilterRawlog  kfd::RawlogFilter::run, the whole of kfd-filter (read, filter, write),
-//                    arg 0: built-in defaults (= kfd-filter without -c), 1: share/kfd/default.ini,
-//                    2: built-in defaults with an uncompressed output (kfd-filter --compress 0).
+//                    arg 0: kfd's defaults (= kfd-filter without -c = share/kfd/default.ini),
+//                    1: the paper's method (share/kfd/paper-mit-0.752.ini), 2: kfd's defaults
+//                    with an uncompressed output (kfd-filter --compress 0).
 //
 // Input: $KFD_BENCH_RAWLOG, or KFD_DATASETS_DIR/mit-killian/mit-killian.rawlog (17480 scans).
 // When it is missing every benchmark is skipped with a message.
@@ -110,14 +111,15 @@ void BM_FilterRawlog(benchmark::State& state) {
     kfd::RawlogFilterOptions opts;
     opts.input = inputPath();
     opts.output = tmp.path.string();
+    opts.pipeline = kfd::kfdDefaults();  // kfd-filter without -c (= share/kfd/default.ini)
     if (state.range(0) == 1) {
-        opts.pipeline = kfd::loadConfigFile(KFD_SOURCE_DIR "/share/kfd/default.ini");
-        state.SetLabel("default.ini");
+        opts.pipeline = kfd::loadConfigFile(KFD_SOURCE_DIR "/share/kfd/paper-mit-0.752.ini");
+        state.SetLabel("paper-mit-0.752.ini");
     } else if (state.range(0) == 2) {
         opts.compress_level = 0;
-        state.SetLabel("built-in defaults, --compress 0");
+        state.SetLabel("kfd defaults, --compress 0");
     } else {
-        state.SetLabel("built-in defaults");
+        state.SetLabel("kfd defaults");
     }
     kfd::RawlogFilterSummary sum;
     for (auto _ : state) sum = kfd::RawlogFilter().run(opts);

@@ -28,6 +28,7 @@ constexpr double kSpeed = 0.752;            // m/s, the paper's faster setting
 constexpr unsigned kSeed = 20230101;        // every benchmark uses this seed
 constexpr std::size_t kKeyframeScans = 16;  // distinct poses of the "keyframe kept" set
 constexpr std::size_t kDroppedScans = 16;   // stream scans of the "keyframe dropped" set
+constexpr std::size_t kLoopKeyframes = 32;  // keyframes around the loop (temporal evidence)
 
 inline ScanGeometry mitGeometry() { return ScanGeometry{kBeams, kAperture, true}; }
 
@@ -183,6 +184,10 @@ struct Scenario {
     /// Later scans of the stream that the window primed by `prefix` drops (the selector's
     /// state does not change on a drop, so they can be replayed in any order).
     std::vector<Scan> dropped;
+    /// kLoopKeyframes keyframes evenly around the loop (0.35 m and 11.25 deg apart, with
+    /// odometry), closing the circle: the evidence denoiser, cycled through them, always has
+    /// its previous keyframe (temporal evidence on every call).
+    std::vector<Scan> loop_keyframes;
 };
 
 inline Scenario makeScenario(unsigned seed = kSeed) {
@@ -216,6 +221,15 @@ inline Scenario makeScenario(unsigned seed = kSeed) {
         if (!probe.filter(s).keyframe) sc.dropped.push_back(std::move(s));
     }
     if (sc.dropped.empty()) throw std::runtime_error("bench scenario: no scan is dropped");
+    // One turn of the loop takes 2 pi radius / (speed / rate) scans.
+    const double per_turn = 2.0 * kPi * 1.8 / (kSpeed / kScanRate);
+    for (std::size_t k = 0; k < kLoopKeyframes; ++k) {
+        const auto index = static_cast<std::size_t>(per_turn * static_cast<double>(k) /
+                                                    static_cast<double>(kLoopKeyframes));
+        Scan s = simulateScan(scene, loopPose(index), seed + 2, index);
+        distance.filter(s);
+        sc.loop_keyframes.push_back(std::move(s));
+    }
     return sc;
 }
 

@@ -39,8 +39,7 @@ void perScan(benchmark::State& state) {
 // Runs `filter(scan)` (returns the points it removed) on the keyframe set in turn, restoring
 // valid flags before each call.
 template <class Filter>
-void runOnKeyframes(benchmark::State& state, Filter&& filter) {
-    const auto& pristine = scenario().keyframes;
+void runOn(benchmark::State& state, const std::vector<Scan>& pristine, Filter&& filter) {
     std::vector<Scan> work = pristine;
     double removed = 0.0;
     std::size_t k = 0;
@@ -54,6 +53,18 @@ void runOnKeyframes(benchmark::State& state, Filter&& filter) {
     }
     perScan(state);
     state.counters["removed"] = benchmark::Counter(removed, benchmark::Counter::kAvgIterations);
+}
+
+template <class Filter>
+void runOnKeyframes(benchmark::State& state, Filter&& filter) {
+    runOn(state, scenario().keyframes, filter);
+}
+
+// The loop keyframes, in order around the closed loop: the evidence denoiser always has its
+// previous keyframe (temporal evidence on every scan).
+template <class Filter>
+void runOnLoop(benchmark::State& state, Filter&& filter) {
+    runOn(state, scenario().loop_keyframes, filter);
 }
 
 void BM_RestoreValid(benchmark::State& state) {
@@ -144,6 +155,19 @@ void BM_DenoiseRangeAware(benchmark::State& state) {
     runOnKeyframes(state, [&](Scan& s) { return d.filter(s).points_removed; });
 }
 BENCHMARK(BM_DenoiseRangeAware)->Unit(benchmark::kMicrosecond);
+
+// kfd's default denoiser, on the loop keyframes (DBSCAN on the same scans below).
+void BM_DenoiseEvidence(benchmark::State& state) {
+    kfd::Denoiser d(kb::paperParams(kfd::DenoiseVariant::Evidence).get<kfd::DenoiseStage>());
+    runOnLoop(state, [&](Scan& s) { return d.filter(s).points_removed; });
+}
+BENCHMARK(BM_DenoiseEvidence)->Unit(benchmark::kMicrosecond);
+
+void BM_DbscanLoop(benchmark::State& state) {
+    kfd::DbscanFilter f(kfd::DbscanFilter::Params{0.7, 10});
+    runOnLoop(state, [&](Scan& s) { return f.filter(s).points_removed; });
+}
+BENCHMARK(BM_DbscanLoop)->Unit(benchmark::kMicrosecond);
 
 // The paper's DBSCAN comparison (Eps 0.7 m, minPts 10), on the same scans as the denoisers.
 void BM_Dbscan(benchmark::State& state) {

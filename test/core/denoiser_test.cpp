@@ -247,9 +247,9 @@ TEST(Denoiser, AngleGapFactorReachesBothVariants) {
     EXPECT_NEAR(res.theta_threshold, test::deg2rad(30.0), 1e-12);
 }
 
-TEST(Denoiser, DefaultsAreThePapers) {
+TEST(Denoiser, DefaultsAreKfdsEvidenceVariantAndThePapersParameters) {
     const Denoiser d;
-    EXPECT_EQ(d.params().variant, DenoiseVariant::Reference);
+    EXPECT_EQ(d.params().variant, DenoiseVariant::Evidence);
     EXPECT_EQ(d.params().reference.rings.rings, 5u);
     EXPECT_EQ(d.params().filter.m_threshold, 10u);
     EXPECT_DOUBLE_EQ(d.params().reference.angle_gap_factor, 10.0);

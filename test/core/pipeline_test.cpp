@@ -20,8 +20,15 @@ std::vector<std::string> stageNames(const Pipeline& p) {
     return names;
 }
 
-Pipeline::Params withStages(std::vector<std::string> stages) {
+// The paper's method (the reference denoiser): the expectations below follow Algorithm 2.
+Pipeline::Params paper() {
     Pipeline::Params p;
+    p.get<DenoiseStage>().variant = DenoiseVariant::Reference;
+    return p;
+}
+
+Pipeline::Params withStages(std::vector<std::string> stages) {
+    Pipeline::Params p = paper();
     p.stages = std::move(stages);
     return p;
 }
@@ -254,7 +261,7 @@ TEST(Pipeline, RejectsScanWithMismatchedSizes) {
 
 TEST(Pipeline, LastClustersComeFromTheDenoiseStage) {
     EXPECT_EQ(Pipeline(withStages({"distance", "keyframe"})).lastClusters(), nullptr);
-    Pipeline p;
+    Pipeline p(paper());
     Scan scan = noisyWall();
     p.process(scan);
     const Clusters* c = p.lastClusters();

@@ -41,10 +41,13 @@ TEST(StageRegistry, EachStageOwnsItsKeys) {
         keyNames(*r.find("keyframe")),
         (std::vector<std::string>{"bins", "window", "p_pair", "max_consecutive_drops",
                                   "max_interval_s", "max_translation_m", "max_rotation_deg"}));
-    EXPECT_EQ(keyNames(*r.find("denoise")),
-              (std::vector<std::string>{"variant", "rings", "ring_r_max", "angle_gap_factor",
-                                        "merge_distance_m", "m_threshold", "jump_lambda_deg",
-                                        "jump_sigma_m", "min_object_size_m", "min_points_floor"}));
+    EXPECT_EQ(
+        keyNames(*r.find("denoise")),
+        (std::vector<std::string>{
+            "variant", "rings", "ring_r_max", "angle_gap_factor", "merge_distance_m", "m_threshold",
+            "jump_lambda_deg", "jump_sigma_m", "min_object_size_m", "min_points_floor",
+            "incidence_deg", "sigma_m", "max_gap_beams", "max_small_points", "temporal",
+            "pose_trans_error_m", "pose_rot_error_deg", "motion_error_fraction"}));
 }
 
 TEST(StageRegistry, KeysParseRangeCheckAndPrintBack) {

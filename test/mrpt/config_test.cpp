@@ -68,7 +68,29 @@ TEST(Config, YamlAndIniDefaultsAgree) {
     const auto ini = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.ini");
     const auto yml = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.yaml");
     EXPECT_EQ(kfd::toIni(ini), kfd::toIni(yml));
-    EXPECT_EQ(ini.get<kfd::DenoiseStage>().variant, kfd::DenoiseVariant::RangeAware);
+    EXPECT_EQ(ini.get<kfd::DenoiseStage>().variant, kfd::DenoiseVariant::Evidence);
+}
+
+TEST(Config, KfdDefaultsAreDefaultIniCompiledIn) {
+    const auto ini = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.ini");
+    EXPECT_EQ(kfd::toIni(kfd::kfdDefaults()), kfd::toIni(ini));
+    EXPECT_EQ(kfd::kfdDefaults().get<kfd::DenoiseStage>().variant, kfd::DenoiseVariant::Evidence);
+}
+
+TEST(Config, EveryShippedNonPaperPresetUsesTheEvidenceDenoiser) {
+    namespace fs = std::filesystem;
+    std::size_t seen = 0;
+    for (const char* dir : {KFD_SHARE_DIR, KFD_SHARE_DIR "/../kfd-icp-slam"})
+        for (const auto& e : fs::directory_iterator(dir)) {
+            if (e.path().extension() != ".ini" && e.path().extension() != ".yaml") continue;
+            SCOPED_TRACE(e.path().string());
+            const auto p = kfd::loadConfigFile(e.path().string());
+            const bool paper = e.path().filename().string().rfind("paper-", 0) == 0;
+            EXPECT_EQ(p.get<kfd::DenoiseStage>().variant,
+                      paper ? kfd::DenoiseVariant::Reference : kfd::DenoiseVariant::Evidence);
+            ++seen;
+        }
+    EXPECT_GE(seen, 9u);
 }
 
 TEST(Config, MissingKeysKeepTheBuiltInDefaults) {

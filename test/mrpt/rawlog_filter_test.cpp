@@ -184,6 +184,12 @@ TEST(RawlogFilter, MitCsailObservationsLayoutConservesEverything) {
     const auto s = kfd::RawlogFilter().run(o);
     EXPECT_EQ(s.layout, "observations");
     EXPECT_EQ(s.scans_in, 1988u);  // datasets/README.md
+    EXPECT_EQ(s.sensor.beams, 361u);
+    EXPECT_NEAR(s.sensor.aperture_deg, 180.5, 0.01);  // the log's own aperture field
+    EXPECT_GT(s.sensor.rate_hz, 1.0);                 // a few Hz (datasets/README.md: 5 Hz nominal)
+    EXPECT_LT(s.sensor.rate_hz, 10.0);
+    EXPECT_TRUE(s.sensor.odometry);
+    EXPECT_GT(s.sensor.range_noise_m, 0.0);
     EXPECT_GT(s.scans_dropped, 0u);
     EXPECT_GT(s.points_removed_noise, 0u);
     checkConservation(kMitCsail, o.output, s);
@@ -318,6 +324,25 @@ TEST(KfdFilterCli, FiltersAndPrintsASummary) {
         << text;
     EXPECT_NE(text.find("scans    in 225"), std::string::npos) << text;
     EXPECT_TRUE(fs::exists(dir / "out.rawlog"));
+}
+
+TEST(KfdFilterCli, WithoutAConfigUsesKfdsDefaultsAndPrintsTheSensor) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    std::string text, printed;
+    ASSERT_EQ(
+        run(quoted(KFD_FILTER_EXE) + " -i " + quoted(kSena) + " -o " + quoted(dir / "out.rawlog"),
+            &text),
+        0)
+        << text;
+    // SENA: 361 beams over 180 degrees with odometry; the noise is measured from its scans.
+    EXPECT_NE(text.find("361 beams over 180.0 deg (0.500 deg per beam)"), std::string::npos)
+        << text;
+    EXPECT_NE(text.find(", odometry"), std::string::npos) << text;
+    EXPECT_NE(text.find("range noise"), std::string::npos) << text;
+    ASSERT_EQ(run(quoted(KFD_FILTER_EXE) + " --print-config", &printed), 0);
+    EXPECT_EQ(printed, kfd::toIni(kfd::kfdDefaults()));
+    EXPECT_NE(printed.find("variant = evidence"), std::string::npos) << printed;
 }
 
 TEST(RawlogFilter, BaselineDenoisersCountTheirNoise) {

@@ -93,10 +93,12 @@ TEST(IcpSlamRunner, KfdOnMitCsailHasBoundedErrorAndAPoseForEveryScan) {
     ASSERT_TRUE(s.relations.has_value());
     EXPECT_EQ(s.relations->unmatched, 0u);  // every relation stamp found a pose
     EXPECT_EQ(s.relations->used, 1172u);
-    // Bounds well above the measured value (docs/RESULTS.md) and far below a failed run
-    // (lost tracking gives metres).
-    EXPECT_LT(s.relations->trans_mean, 0.6);
-    EXPECT_LT(s.relations->rot_mean_deg, 4.0);
+    // Bounds above every measured run and far below a failed one (lost tracking gives tens of
+    // metres and degrees). One run is not a measurement: over 20 perturbed runs each of
+    // none / keyframe / kfd (sick-180-5hz.ini, kfd-compare) the means ranged 0.09-3.0 m and
+    // 1.4-9.0 deg, so a tighter bound would fail on chaos, not on a fault.
+    EXPECT_LT(s.relations->trans_mean, 3.5);
+    EXPECT_LT(s.relations->rot_mean_deg, 10.0);
     const auto traj = kfd::readTum(dir / "out/trajectory.tum");
     EXPECT_EQ(traj.size(), s.scans_in);
     EXPECT_EQ(lines(dir / "out/scans.csv"), s.scans_in + 1);

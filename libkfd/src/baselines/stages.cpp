@@ -7,6 +7,7 @@ void registerBaselineStages(StageRegistry& registry) {
     registry.add<DbscanStage>();
     registry.add<RadiusStage>();
     registry.add<SorStage>();
+    registry.add<ShadowStage>();
     registry.add<DecimateStage>();
 }
 

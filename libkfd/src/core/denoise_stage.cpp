@@ -26,8 +26,9 @@ StageKey angleGapKey() {
 std::vector<StageKey> DenoiseStage::keys() {
     return {
         keys::custom<P>(
-            "variant", "variant", "denoiser: reference (the paper) or range_aware (kfd's)",
-            "reference, range_aware",
+            "variant", "variant",
+            "denoiser: reference (the paper), range_aware or evidence (kfd's default)",
+            "reference, range_aware, evidence",
             [](P& p, const std::string& text) { p.variant = parseDenoiseVariant(text); },
             [](const P& p) { return std::string(toString(p.variant)); }),
         keys::count<P>("rings", "rings", "Sec. 3.2.1: equal-area rings t", 1, 254,
@@ -48,11 +49,44 @@ std::vector<StageKey> DenoiseStage::keys() {
         keys::real<P>("jump_sigma_m", "jump_sigma_m", "range_aware: sensor range noise sigma (m)",
                       0, 10, false, [](P& p) -> double& { return p.range_aware.jump_sigma_m; }),
         keys::real<P>("min_object_size_m", "min_object_size_m",
-                      "range_aware: object width that needs m_threshold points (m)", 0, 100, false,
+                      "range_aware, evidence: width of the smallest object kept (m)", 0, 100, false,
                       [](P& p) -> double& { return p.filter.min_object_size_m; }),
         keys::count<P>("min_points_floor", "min_points_floor",
                        "range_aware: fewest points a kept cluster may have", 1, 1e6,
-                       [](P& p) -> std::size_t& { return p.filter.min_points_floor; })};
+                       [](P& p) -> std::size_t& { return p.filter.min_points_floor; }),
+        keys::real<P>("incidence_deg", "incidence_deg",
+                      "evidence: breakpoint incidence limit lambda (deg)", 0, 89.9, true,
+                      [](P& p) -> double& { return p.evidence.incidence_deg; }),
+        keys::real<P>("sigma_m", "sigma_m",
+                      "evidence: sensor range noise (m), 0 = estimated from the scans", 0, 10,
+                      false, [](P& p) -> double& { return p.evidence.sigma_m; }),
+        keys::count<P>("max_gap_beams", "max_gap_beams",
+                       "evidence: missing beams a surface may span", 0, 16,
+                       [](P& p) -> std::size_t& { return p.evidence.max_gap_beams; }),
+        keys::count<P>("max_small_points", "max_small_points",
+                       "evidence: segments of at most this many points may be small", 0, 1000,
+                       [](P& p) -> std::size_t& { return p.evidence.max_small_points; }),
+        keys::custom<P>(
+            "temporal", "temporal", "evidence: compare with the previous keyframe (needs odometry)",
+            "true, false",
+            [](P& p, const std::string& text) {
+                if (text == "true" || text == "1")
+                    p.evidence.temporal = true;
+                else if (text == "false" || text == "0")
+                    p.evidence.temporal = false;
+                else
+                    throw ParameterError("temporal", "temporal must be true or false");
+            },
+            [](const P& p) { return std::string(p.evidence.temporal ? "true" : "false"); }),
+        keys::real<P>("pose_trans_error_m", "pose_trans_error_m",
+                      "evidence: odometry translation error of one keyframe step (m)", 0, 10, false,
+                      [](P& p) -> double& { return p.evidence.pose_trans_error_m; }),
+        keys::real<P>("pose_rot_error_deg", "pose_rot_error_deg",
+                      "evidence: odometry rotation error of one keyframe step (deg)", 0, 90, false,
+                      [](P& p) -> double& { return p.evidence.pose_rot_error_deg; }),
+        keys::real<P>("motion_error_fraction", "motion_error_fraction",
+                      "evidence: odometry error per metre and per radian of the step", 0, 10, false,
+                      [](P& p) -> double& { return p.evidence.motion_error_fraction; })};
 }
 
 }  // namespace kfd

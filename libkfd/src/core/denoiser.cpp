@@ -5,14 +5,23 @@
 namespace kfd {
 
 const char* toString(DenoiseVariant v) {
-    return v == DenoiseVariant::Reference ? "reference" : "range_aware";
+    switch (v) {
+        case DenoiseVariant::Reference:
+            return "reference";
+        case DenoiseVariant::RangeAware:
+            return "range_aware";
+        case DenoiseVariant::Evidence:
+            return "evidence";
+    }
+    return "unknown";
 }
 
 DenoiseVariant parseDenoiseVariant(const std::string& s) {
     if (s == "reference") return DenoiseVariant::Reference;
     if (s == "range_aware") return DenoiseVariant::RangeAware;
-    throw ParameterError("variant",
-                         "unknown denoise variant '" + s + "' (expected reference or range_aware)");
+    if (s == "evidence") return DenoiseVariant::Evidence;
+    throw ParameterError("variant", "unknown denoise variant '" + s +
+                                        "' (expected reference, range_aware or evidence)");
 }
 
 void Denoiser::initialize(const Params& p) {
@@ -23,8 +32,11 @@ void Denoiser::initialize(const Params& p) {
         throw ParameterError("min_points_floor", "min_points_floor must be >= 1");
     reference_.initialize(p.reference);
     range_aware_.initialize(p.range_aware);
+    EvidenceFilter::Params ev = p.evidence;
+    ev.min_object_size_m = p.filter.min_object_size_m;
+    evidence_.initialize(ev);
     filter_ = p.filter;
-    if (p.variant != DenoiseVariant::RangeAware) filter_.min_object_size_m = 0.0;
+    if (p.variant == DenoiseVariant::Reference) filter_.min_object_size_m = 0.0;
     params_ = p;
 }
 
@@ -40,6 +52,16 @@ Denoiser::Result Denoiser::filter(Scan& scan) {
             scan.valid[i] = 0;
             ++unusable;
         }
+    if (params_.variant == DenoiseVariant::Evidence) {
+        const auto r = evidence_.filter(scan, clusters_);
+        res.points_removed = unusable + r.points_removed;
+        res.clusters = r.segments;
+        for (const auto f : clusters_.noise) res.noise_clusters += f;
+        res.temporal = r.temporal;
+        res.sigma = r.sigma;
+        res.free_points = r.free_points;
+        return res;
+    }
     if (params_.variant == DenoiseVariant::Reference) {
         const auto r = reference_.cluster(scan, clusters_);
         res.blocks = r.blocks;

@@ -9,6 +9,7 @@
 #include <mrpt/serialization/CArchive.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +18,8 @@
 #include "kfd/core/cancel.h"
 #include "kfd/core/output_paths.h"
 
+#include "kfd/core/denoiser.h"
+#include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/scan_check.h"
 
 namespace kfd {
@@ -83,6 +86,8 @@ class Run {
     void handleFrame(const std::shared_ptr<CSensoryFrame>& sf);
     // Processes one scan; returns true when kept.
     bool handleScan(CObservation2DRangeScan& scan);
+    void noteSensor(const CObservation2DRangeScan& scan, const std::optional<Pose2D>& odometry,
+                    const StreamResult& r);
     void write(const mrpt::serialization::CSerializable& obj);
     void flushPendingAction(bool frame_kept);
 
@@ -109,6 +114,31 @@ void Run::write(const mrpt::serialization::CSerializable& obj) {
     ++sum_.objects_out;
 }
 
+void Run::noteSensor(const CObservation2DRangeScan& scan, const std::optional<Pose2D>& odometry,
+                     const StreamResult& r) {
+    SensorSummary& s = sum_.sensor;
+    if (s.beams == 0) {
+        const ScanGeometry g = geometryOf(scan);
+        s.label = scan.sensorLabel;
+        s.beams = g.beams;
+        s.aperture_deg = g.aperture * 180.0 / kPi;
+        s.resolution_deg = g.resolution() * 180.0 / kPi;
+    }
+    if (scan.sensorLabel != s.label) return;
+    s.odometry = s.odometry || odometry.has_value();
+    const double t = stampOf(scan);
+    if (std::isfinite(t) && s.stamped < SensorSummary::kMaxRateScans) {
+        if (s.stamped == 0) s.first_stamp = t;
+        s.last_stamp = t;
+        ++s.stamped;
+        if (s.stamped > 1 && s.last_stamp > s.first_stamp)
+            s.rate_hz = static_cast<double>(s.stamped - 1) / (s.last_stamp - s.first_stamp);
+    }
+    if (r.keep)
+        if (const auto* d = r.report.find<Denoiser::Result>())
+            if (d->variant == DenoiseVariant::Evidence) s.range_noise_m = d->sigma;
+}
+
 bool Run::handleScan(CObservation2DRangeScan& scan) {
     ++sum_.scans_in;
     const double stamp = stampForOutput(stampOf(scan));
@@ -132,6 +162,7 @@ bool Run::handleScan(CObservation2DRangeScan& scan) {
     } catch (const ScanError& e) {  // not reached: checkScan passed
         throw RawlogError("scan " + std::to_string(scan_index_) + ": " + e.what());
     }
+    noteSensor(scan, odometry, r);
     sum_.stamps_backwards += r.stamp_backwards ? 1 : 0;
     sum_.points_in += r.report.points_in;
     sum_.filter_seconds += r.report.microseconds * 1e-6;

@@ -24,6 +24,7 @@ void toCore(const mrpt::obs::CObservation2DRangeScan& obs, Scan& out) {
         out.valid[i] = obs.getScanRangeValidity(i) ? 1 : 0;
     }
     out.timestamp = stampOf(obs);
+    out.sensor_pose = Pose2D{obs.sensorPose.x(), obs.sensorPose.y(), obs.sensorPose.yaw()};
 }
 
 std::size_t applyValidity(const Scan& scan, mrpt::obs::CObservation2DRangeScan& obs) {

@@ -68,7 +68,7 @@ std::map<std::size_t, std::vector<Label>> readLabels(const std::string& path) {
 }  // namespace
 
 DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& labels_csv,
-                                 const Pipeline::Params& pipeline) {
+                                 const Pipeline::Params& pipeline, bool laser_only) {
     const auto labels = readLabels(labels_csv);
     const auto source = openSource(rawlog);
     StreamFilter filter(pipeline);
@@ -89,7 +89,7 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
                 kind[l.beam] = l.kind;
                 model[l.beam] = l.model;
             }
-        const auto r = filter.process(*scan);
+        const auto r = filter.process(*scan, laser_only ? std::nullopt : e.odometry);
         q.microseconds += r.report.microseconds;
         for (std::size_t i = 0; i < n; ++i) {
             if (!before[i]) continue;

@@ -246,8 +246,8 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
                     sum.output_dir);
     }
 
-    // Pre-filter configuration: [KFD] when present, else the built-in defaults.
-    Pipeline::Params kfd_params;
+    // Pre-filter configuration: [KFD] when present, else kfd's defaults (share/kfd/default.ini).
+    Pipeline::Params kfd_params = kfdDefaults();
     if (cfg.sectionExists("KFD")) kfd_params = loadIni(cfg, "KFD");
     sum.pipeline = pipelineForMode(opts.mode, kfd_params);
     sum.laser_only = opts.laser_only;

@@ -5,6 +5,7 @@
 #include "kfd/baselines/decimate_stage.h"
 #include "kfd/baselines/motion_stage.h"
 #include "kfd/baselines/radius_stage.h"
+#include "kfd/baselines/shadow_stage.h"
 #include "kfd/baselines/sor_stage.h"
 #include "kfd/core/stage_registry.h"
 

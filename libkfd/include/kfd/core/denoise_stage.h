@@ -15,11 +15,14 @@ class DenoiseStage : public DenoisingStage<Denoiser> {
     static constexpr const char* kHelp =
         "clustering denoise (Sec. 3.2, Algorithm 2): drop points of small clusters";
     /// Keys: variant, rings, ring_r_max, angle_gap_factor, merge_distance_m, m_threshold,
-    /// jump_lambda_deg, jump_sigma_m, min_object_size_m, min_points_floor.
+    /// jump_lambda_deg, jump_sigma_m, min_object_size_m, min_points_floor, and the evidence
+    /// variant's incidence_deg, sigma_m, max_gap_beams, max_small_points, temporal,
+    /// pose_trans_error_m, pose_rot_error_deg, motion_error_fraction.
     static std::vector<StageKey> keys();
 
     explicit DenoiseStage(const Params& p = {}) : DenoisingStage(p) {}
     const char* name() const override { return kName; }
+    void reset() override { mutableAlgorithm().reset(); }
 };
 
 }  // namespace kfd

@@ -7,6 +7,7 @@
 
 #include "kfd/core/clusters.h"
 #include "kfd/core/error.h"
+#include "kfd/core/evidence_filter.h"
 #include "kfd/core/range_aware_clustering.h"
 #include "kfd/core/ring_clustering.h"
 #include "kfd/core/scan.h"
@@ -15,10 +16,11 @@ namespace kfd {
 
 enum class DenoiseVariant : std::uint8_t {
     Reference,  // the paper's Algorithm 2 exactly as published (RingClustering + fixed m_threshold)
-    RangeAware,  // kfd's improved variant (RangeAwareClustering + range-adaptive threshold)
+    RangeAware,  // kfd's first variant (RangeAwareClustering + range-adaptive threshold)
+    Evidence,    // kfd's default: spatial + temporal evidence, thresholds from the scan
 };
 const char* toString(DenoiseVariant v);
-/// Parses "reference" or "range_aware"; throws kfd::ParameterError otherwise.
+/// Parses "reference", "range_aware" or "evidence"; throws kfd::ParameterError otherwise.
 DenoiseVariant parseDenoiseVariant(const std::string& s);
 
 class Denoiser {
@@ -26,12 +28,16 @@ class Denoiser {
     /// The parameters of the two clustering variants and of the cluster filter, nested (the
     /// config key angle_gap_factor sets both variants' factor).
     struct Params {
-        DenoiseVariant variant = DenoiseVariant::Reference;
+        /// kfd's evidence variant by default; Reference selects the paper's exact method.
+        DenoiseVariant variant = DenoiseVariant::Evidence;
         /// Reference variant: t, r_max (Formulas 6-8), theta_threshold factor (Sec. 3.2.2),
         /// d_threshold (Formula 10).
         RingClustering::Params reference;
         /// Range-aware variant: theta_threshold factor, breakpoint lambda and sigma.
         RangeAwareClustering::Params range_aware;
+        /// Evidence variant (kfd/core/evidence_filter.h); min_object_size_m follows
+        /// filter.min_object_size_m.
+        EvidenceFilter::Params evidence;
         /// Sec. 3.2.4: m_threshold (both variants); min_object_size_m and min_points_floor
         /// (range-aware variant only: the reference variant always uses the fixed m_threshold).
         ClusterFilterParams filter{10, 0.10, 3};
@@ -39,6 +45,7 @@ class Denoiser {
 
     struct Result {
         DenoiseVariant variant = DenoiseVariant::Reference;
+        bool temporal = false;           // evidence: the previous keyframe was used
         std::size_t points_in = 0;       // valid beams before
         std::size_t clusters = 0;        // all clusters found
         std::size_t noise_clusters = 0;  // clusters removed
@@ -47,6 +54,8 @@ class Denoiser {
         std::size_t merges = 0;          // unions across rings / bridging points / seam
         double r_max = 0.0;              // m, reference: ring radius used
         double theta_threshold = 0.0;    // rad
+        double sigma = 0.0;              // m, evidence: range noise estimated from the scan
+        std::size_t free_points = 0;     // evidence: returns the previous keyframe saw through
     };
 
     Denoiser() { initialize(Params{}); }
@@ -61,6 +70,8 @@ class Denoiser {
     /// passes over the beams plus union-find, each beam compared only with the clusters still
     /// open within the angle gap.
     Result filter(Scan& scan);
+    /// Forgets stream state (the evidence variant's previous keyframe and noise estimate).
+    void reset() { evidence_.reset(); }
 
     /// Clusters of the last filtered scan (labels per beam, noise flags), e.g. for rendering.
     const Clusters& clusters() const { return clusters_; }
@@ -69,6 +80,7 @@ class Denoiser {
     Params params_;
     RingClustering reference_;
     RangeAwareClustering range_aware_;
+    EvidenceFilter evidence_;
     ClusterFilterParams filter_;
     Clusters clusters_;
 };

@@ -107,6 +107,7 @@ struct Scan {
     std::vector<std::uint8_t> valid;  // 1 = usable, 0 = invalid or removed
     double timestamp = std::numeric_limits<double>::quiet_NaN();  // s (any epoch), NaN = unknown
     std::optional<Pose2D> odometry;  // absolute odometry at the scan, when known
+    Pose2D sensor_pose;              // the sensor on the robot (MRPT's sensorPose), m and rad
 
     std::size_t size() const { return range.size(); }
     std::size_t countValid() const {

@@ -127,6 +127,9 @@ class DenoisingStage : public Stage {
     }
     const Algo& algorithm() const { return algo_; }
 
+  protected:
+    Algo& mutableAlgorithm() { return algo_; }
+
   private:
     Algo algo_;
 };

@@ -94,6 +94,11 @@ Pipeline::Params loadYaml(const mrpt::containers::yaml& doc);
 /// file is missing, unreadable, or has no [KFD] section / kfd keys.
 Pipeline::Params loadConfigFile(const std::string& path, const std::string& section = "KFD");
 
+/// kfd's defaults for small indoor robots: share/kfd/default.ini, compiled in (kfd-filter
+/// without -c, kfd-icp-slam without [KFD]). kfdDefaultIni() is that file's text.
+Pipeline::Params kfdDefaults();
+const char* kfdDefaultIni();
+
 /// The effective configuration as an .ini [KFD] section (every key of the default registry,
 /// current values).
 std::string toIni(const Pipeline::Params& p, const std::string& section = "KFD");

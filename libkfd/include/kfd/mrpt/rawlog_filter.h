@@ -30,6 +30,23 @@ struct RawlogFilterOptions {
     std::size_t progress_every = 2000;
 };
 
+/// What the log's first sensor is, measured from its scans: the parameters the evidence
+/// denoiser derives (resolution from the geometry, range noise from the residuals) and the
+/// scan rate (from the stamps of its first kMaxRateScans scans).
+struct SensorSummary {
+    static constexpr std::size_t kMaxRateScans = 50;
+    std::string label;
+    std::size_t beams = 0;
+    double aperture_deg = 0.0;
+    double resolution_deg = 0.0;
+    double rate_hz = 0.0;        // 0 when the stamps do not tell
+    double range_noise_m = 0.0;  // the evidence denoiser's estimate at the last keyframe; 0 = n/a
+    bool odometry = false;       // the log carries odometry (temporal evidence uses it)
+    // internal: the stamps seen so far
+    double first_stamp = 0.0, last_stamp = 0.0;
+    std::size_t stamped = 0;
+};
+
 struct RawlogFilterSummary {
     std::string layout;               // "actions+sensory-frames", "observations", or "mixed"
     std::size_t objects_in = 0;       // top-level objects read
@@ -48,6 +65,7 @@ struct RawlogFilterSummary {
     std::size_t stamps_backwards = 0;  // scans stamped before their sensor's previous scan
     std::size_t geometry_resets = 0;
     std::size_t sensors = 0;
+    SensorSummary sensor;                  // the first sensor, as measured from its scans
     std::size_t points_in = 0;             // valid beams in all input scans
     std::size_t points_removed_range = 0;  // by Algorithm 1, in kept scans
     std::size_t points_removed_noise = 0;  // by the denoising stages, in kept scans

@@ -62,8 +62,9 @@ struct DenoiseQuality {
 /// written by kfd-simulate ("scan,timestamp,beam,kind") or kfd-inject (with a fifth column,
 /// the model). A clean log scored against a label file with no rows gives the real points a
 /// method removes. A dropped scan counts as removing nothing. Throws
-/// SimulationError on unreadable files or labels that do not fit the rawlog.
+/// SimulationError on unreadable files or labels that do not fit the rawlog. With
+/// `laser_only` the log's odometry is withheld from the pipeline (a LaserScan-only source).
 DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& labels_csv,
-                                 const Pipeline::Params& pipeline);
+                                 const Pipeline::Params& pipeline, bool laser_only = false);
 
 }  // namespace kfd

@@ -1,0 +1,495 @@
+#include "kfd/core/evidence_filter.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace kfd {
+
+namespace {
+
+constexpr double kDeg = kPi / 180.0;
+
+/// a^-1 * b for planar poses.
+inline Pose2D between(const Pose2D& a, const Pose2D& b) {
+    const double c = std::cos(a.phi), s = std::sin(a.phi);
+    const double dx = b.x - a.x, dy = b.y - a.y;
+    const double dphi = std::atan2(std::sin(b.phi - a.phi), std::cos(b.phi - a.phi));
+    return Pose2D{c * dx + s * dy, -s * dx + c * dy, dphi};
+}
+
+inline Pose2D compose(const Pose2D& a, const Pose2D& b) {
+    const double c = std::cos(a.phi), s = std::sin(a.phi);
+    return Pose2D{a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, a.phi + b.phi};
+}
+
+/// Distance squared from (px, py) to the segment (ax, ay)-(bx, by).
+inline float segmentDistance2(float px, float py, float ax, float ay, float bx, float by) {
+    const float ux = bx - ax, uy = by - ay, wx = px - ax, wy = py - ay;
+    const float uu = ux * ux + uy * uy;
+    float t = uu > 0.0f ? (wx * ux + wy * uy) / uu : 0.0f;
+    t = std::min(1.0f, std::max(0.0f, t));
+    const float dx = wx - t * ux, dy = wy - t * uy;
+    return dx * dx + dy * dy;
+}
+
+// sqrt(1.5): the residual of a beam against its two neighbours' line has variance 1.5 sigma^2.
+constexpr double kResidualScale = 1.2247448713915889;
+
+}  // namespace
+
+float EvidenceFilter::approxAtan2(float y, float x) {
+    const float ax = std::abs(x), ay = std::abs(y);
+    const float mx = std::max(ax, ay), mn = std::min(ax, ay);
+    if (!(mx > 0.0f)) return 0.0f;
+    const float a = mn / mx, s = a * a;
+    // Minimax polynomial for atan on [0, 1] (error ~1e-5 rad).
+    float r = ((((-0.0117212f * s + 0.05265332f) * s - 0.11643287f) * s + 0.19354346f) * s -
+               0.33262347f) *
+                  s +
+              0.99997726f;
+    r *= a;
+    if (ay > ax) r = 1.57079637f - r;
+    if (x < 0.0f) r = 3.14159274f - r;
+    return y < 0.0f ? -r : r;
+}
+
+double EvidenceFilter::lineResidual(double a, double r, double b, double cos_res) {
+    const double inv = 1.0 / a + 1.0 / b;
+    if (!(inv > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    return r - 2.0 * cos_res / inv;
+}
+
+void EvidenceFilter::initialize(const Params& p) {
+    if (!(p.incidence_deg > 0.0 && p.incidence_deg < 90.0))
+        throw ParameterError("incidence_deg", "incidence_deg must be in (0, 90)");
+    if (!(p.sigma_m >= 0.0) || !std::isfinite(p.sigma_m))
+        throw ParameterError("sigma_m", "sigma_m must be >= 0 (0 = estimated from the scans)");
+    if (!(p.min_sigma_m > 0.0) || !std::isfinite(p.min_sigma_m))
+        throw ParameterError("min_sigma_m", "min_sigma_m must be > 0");
+    if (p.max_gap_beams > 16)
+        throw ParameterError("max_gap_beams", "max_gap_beams must be in [0, 16]");
+    if (!(p.min_object_size_m >= 0.0) || !std::isfinite(p.min_object_size_m))
+        throw ParameterError("min_object_size_m", "min_object_size_m must be >= 0");
+    if (p.max_small_points > 1000)
+        throw ParameterError("max_small_points", "max_small_points must be in [0, 1000]");
+    auto nonneg = [](double v) { return v >= 0.0 && std::isfinite(v); };
+    if (!nonneg(p.pose_trans_error_m) || !nonneg(p.pose_rot_error_deg) ||
+        !nonneg(p.motion_error_fraction) || !nonneg(p.moving_object_m))
+        throw ParameterError("pose_error", "pose error terms must be finite and >= 0");
+    if (!(p.max_step_m > 0.0) || !(p.max_step_deg > 0.0) || !std::isfinite(p.max_step_m) ||
+        !std::isfinite(p.max_step_deg))
+        throw ParameterError("max_step", "max_step_m and max_step_deg must be > 0");
+    if (p.refine_iterations > 20 || p.refine_samples < 1 || !(p.refine_gate_m > 0.0) ||
+        !std::isfinite(p.refine_gate_m))
+        throw ParameterError("refine", "refine_iterations <= 20, refine_samples >= 1, gate > 0");
+    params_ = p;
+    lambda_ = p.incidence_deg * kDeg;
+    reset();
+}
+
+void EvidenceFilter::reset() {
+    refs_[0].present = refs_[1].present = false;
+    sigma_smoothed_ = -1.0;
+    have_pose_ = false;
+}
+
+void EvidenceFilter::updateTables(const ScanGeometry& g) {
+    if (g == table_geometry_ && cos_.size() == g.beams) return;
+    table_geometry_ = g;
+    cos_.resize(g.beams);
+    sin_.resize(g.beams);
+    for (std::size_t i = 0; i < g.beams; ++i) {
+        cos_[i] = static_cast<float>(std::cos(g.angle(i)));
+        sin_[i] = static_cast<float>(std::sin(g.angle(i)));
+    }
+    first_ = static_cast<float>(g.angle(0));
+    inv_step_ = g.beams > 1 ? static_cast<float>(1.0 / g.step()) : 0.0f;
+    res_ = static_cast<float>(g.resolution());
+}
+
+double EvidenceFilter::estimateSigma(const Scan& scan) {
+    if (params_.sigma_m > 0.0) return params_.sigma_m;
+    // The lower decile of |e| over every fourth beam: flat surfaces dominate it, corners and
+    // clutter (which inflate the median on a 1-degree scanner) do not.
+    // decile of |N(0, 1.5 s^2)| = 0.1257 sqrt(1.5) s.
+    const std::size_t n = scan.range.size();
+    const float cos_res = std::cos(res_);
+    scratch_.clear();
+    for (std::size_t i = 1; i + 1 < n; i += 4) {
+        if (!scan.valid[i - 1] || !scan.valid[i] || !scan.valid[i + 1]) continue;
+        const float a = scan.range[i - 1], r = scan.range[i], b = scan.range[i + 1];
+        if (!(a + b > 0.0f)) continue;
+        scratch_.push_back(std::abs(r - 2.0f * cos_res * a * b / (a + b)));
+    }
+    if (scratch_.size() < 16) return sigma_smoothed_ > 0.0 ? sigma_smoothed_ : params_.min_sigma_m;
+    auto q = scratch_.begin() + static_cast<std::ptrdiff_t>(scratch_.size() / 10);
+    std::nth_element(scratch_.begin(), q, scratch_.end());
+    const double sigma =
+        std::max(params_.min_sigma_m, static_cast<double>(*q) / (0.1257 * kResidualScale));
+    sigma_smoothed_ = sigma_smoothed_ < 0.0 ? sigma : 0.8 * sigma_smoothed_ + 0.2 * sigma;
+    return sigma_smoothed_;
+}
+
+void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
+    const std::size_t n = scan.range.size();
+    const float cos_res = std::cos(res_);
+    // On a line with both neighbours: |e| <= 3 sqrt(1.5) sigma, written without the division
+    // (|r (a + b) - 2 cos(res) a b| <= tol (a + b)).
+    const float tol = static_cast<float>(3.0 * kResidualScale * sigma);
+    line_.assign(n, 0);
+    const std::uint8_t* valid = scan.valid.data();
+    const float* range = scan.range.data();
+    for (std::size_t i = 1; i + 1 < n; ++i) {
+        const float a = range[i - 1], r = range[i], b = range[i + 1];
+        const float sum = a + b;
+        line_[i] =
+            static_cast<std::uint8_t>(valid[i - 1] && valid[i] && valid[i + 1] &&
+                                      std::abs(r * sum - 2.0f * cos_res * a * b) <= tol * sum);
+    }
+    // Breakpoint distance / r_min per beam step, for steps 1..max_gap + 1 (dtheta < lambda).
+    const std::size_t max_step = params_.max_gap_beams + 1;
+    float factor[18];
+    for (std::size_t k = 1; k <= max_step; ++k) {
+        const double dt = std::min(static_cast<double>(k) * res_, 0.5 * lambda_);
+        factor[k] = static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt));
+    }
+    const float noise = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
+    link_.assign(n, 0);
+    out.label.assign(n, -1);
+    out.size.clear();
+    sums_.clear();
+    std::size_t first_valid = 0;
+    while (first_valid < n && !valid[first_valid]) ++first_valid;
+    std::size_t last = n;  // the previous valid beam
+    for (std::size_t i = first_valid; i < n; ++i) {
+        if (!valid[i]) continue;
+        bool linked = false;
+        if (last < n && i - last <= max_step) {
+            const float dx = x_[i] - x_[last], dy = y_[i] - y_[last];
+            const float dmax = std::min(range[last], range[i]) * factor[i - last] + noise;
+            linked = dx * dx + dy * dy <= dmax * dmax || (i == last + 1 && line_[i] && line_[last]);
+        }
+        if (linked) {
+            link_[last] = 1;
+        } else {
+            out.size.push_back(0);
+            sums_.push_back(0.0f);
+        }
+        const std::size_t c = out.size.size() - 1;
+        out.label[i] = static_cast<std::int32_t>(c);
+        ++out.size[c];
+        sums_[c] += range[i];
+        last = i;
+    }
+    // A scanner closing the circle: the last segment continues the first across the seam.
+    const ScanGeometry& g = scan.geometry;
+    if (out.size.size() > 1 && last < n && first_valid < last) {
+        const double gap = static_cast<double>(n - 1 - last + first_valid) * res_ + g.seamGap();
+        if (gap <= static_cast<double>(max_step) * res_ + 1e-9) {
+            const float dx = x_[first_valid] - x_[last], dy = y_[first_valid] - y_[last];
+            const double dt = std::min(gap, 0.5 * lambda_);
+            const float dmax = std::min(scan.range[last], scan.range[first_valid]) *
+                                   static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt)) +
+                               noise;
+            if (dx * dx + dy * dy <= dmax * dmax) {
+                const std::size_t tail = out.size.size() - 1;
+                for (std::size_t i = 0; i < n; ++i)
+                    if (out.label[i] == static_cast<std::int32_t>(tail)) out.label[i] = 0;
+                out.size[0] += out.size[tail];
+                sums_[0] += sums_[tail];
+                out.size.pop_back();
+                sums_.pop_back();
+                link_[last] = 1;
+            }
+        }
+    }
+    out.mean_range.resize(out.size.size());
+    for (std::size_t c = 0; c < out.size.size(); ++c)
+        out.mean_range[c] = sums_[c] / static_cast<float>(out.size[c]);
+    out.noise.assign(out.size.size(), 0);
+}
+
+EvidenceFilter::Projection EvidenceFilter::projection(const Reference& ref, const Pose2D& d,
+                                                      double sigma) const {
+    Projection pr;
+    const double step_t = std::hypot(d.x, d.y), step_r = std::abs(d.phi);
+    pr.usable = step_t <= params_.max_step_m && step_r <= params_.max_step_deg * kDeg;
+    pr.m0 = static_cast<float>(3.0 * std::sqrt(2.0) * sigma + params_.pose_trans_error_m +
+                               params_.motion_error_fraction * step_t);
+    pr.m1 = static_cast<float>(params_.pose_rot_error_deg * kDeg +
+                               params_.motion_error_fraction * step_r);
+    pr.c = static_cast<float>(std::cos(d.phi));
+    pr.s = static_cast<float>(std::sin(d.phi));
+    pr.tx = static_cast<float>(d.x);
+    pr.ty = static_cast<float>(d.y);
+    pr.ref = &ref;
+    return pr;
+}
+
+std::uint8_t EvidenceFilter::classify(const Projection& pr, float x, float y,
+                                      bool free_test) const {
+    const Reference& ref = *pr.ref;
+    const std::size_t rn = ref.range.size();
+    const float qx = pr.c * x - pr.s * y + pr.tx, qy = pr.s * x + pr.c * y + pr.ty;
+    const float u = (approxAtan2(qy, qx) - first_) * inv_step_;
+    if (!(u >= 0.0f) || !(u < static_cast<float>(rn - 1))) return kUnknown;  // unseen before
+    const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
+    const float rho = std::sqrt(qx * qx + qy * qy);
+    const float m = pr.m0 + pr.m1 * rho;
+    const float arc = rho * res_;  // the spread of a beam's position within its bracket
+    // Free space: both bracketing beams passed this place. On one surface (linked) that
+    // surface lies beyond the nearer of the two; across a depth edge an object could hide
+    // between the beams, so the margin adds the arc.
+    if (free_test && ref.valid[k0] && ref.valid[k1]) {
+        const float mf = ref.link[k0] ? m : m + arc;
+        if (ref.range[k0] > rho + mf && ref.range[k1] > rho + mf)
+            return trackedMotion(ref, qx, qy, rho, k0) ? kTracked : kFree;
+    }
+    // Supported: a reference return within m plus one beam's arc (the same object sampled at
+    // other angles), a beam either side of the bracket, or the reference surface segment
+    // between the bracketing returns within m.
+    const float ms2 = (m + arc) * (m + arc);
+    const std::size_t lo = k0 > 0 ? k0 - 1 : 0, hi = std::min(rn - 1, k1 + 1);
+    for (std::size_t k = lo; k <= hi; ++k) {
+        if (!ref.valid[k]) continue;
+        const float dx = qx - ref.x[k], dy = qy - ref.y[k];
+        if (dx * dx + dy * dy <= ms2) return kSupported;
+    }
+    if (ref.valid[k0] && ref.valid[k1] && ref.link[k0] &&
+        segmentDistance2(qx, qy, ref.x[k0], ref.y[k0], ref.x[k1], ref.y[k1]) <= m * m)
+        return kSupported;
+    return kUnknown;
+}
+
+bool EvidenceFilter::trackedMotion(const Reference& ref, float qx, float qy, float rho,
+                                   std::size_t k0) const {
+    // A return in the reference's own free space near here: a moving object seen before.
+    const double reach = params_.moving_object_m;
+    if (!(reach > 0.0)) return false;
+    const std::size_t rn = ref.range.size();
+    const std::size_t w = std::min<std::size_t>(
+        64, static_cast<std::size_t>(reach / std::max(0.05, static_cast<double>(rho * res_))) + 1);
+    const std::size_t lo = k0 > w ? k0 - w : 0, hi = std::min(rn - 1, k0 + 1 + w);
+    const float r2 = static_cast<float>(reach * reach);
+    for (std::size_t k = lo; k <= hi; ++k) {
+        if (!ref.valid[k] || (ref.evidence[k] != kFree && ref.evidence[k] != kTracked)) continue;
+        const float dx = qx - ref.x[k], dy = qy - ref.y[k];
+        if (dx * dx + dy * dy <= r2) return true;
+    }
+    return false;
+}
+
+bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& d) const {
+    // Projective point-to-line alignment: each sampled return is projected into the reference
+    // scan and paired with the reference segment between its two bracketing beams (when they
+    // are one surface); Gauss-Newton on the distances to those lines corrects the step. The
+    // gate halves per iteration down to 0.1 m; too few pairs keep the step as it is.
+    const std::size_t n = scan.range.size(), rn = ref.range.size();
+    if (params_.refine_iterations == 0 || rn < 2) return false;
+    const std::size_t stride = std::max<std::size_t>(1, n / params_.refine_samples);
+    double gate = params_.refine_gate_m;
+    bool changed = false;
+    for (std::size_t it = 0; it < params_.refine_iterations; ++it) {
+        const float c = static_cast<float>(std::cos(d.phi)),
+                    s = static_cast<float>(std::sin(d.phi));
+        const float tx = static_cast<float>(d.x), ty = static_cast<float>(d.y);
+        const float gate_f = static_cast<float>(gate);
+        float A[6] = {0, 0, 0, 0, 0, 0}, b[3] = {0, 0, 0};  // upper triangle of J^T J, J^T e
+        std::size_t pairs = 0;
+        for (std::size_t i = 0; i < n; i += stride) {
+            if (!scan.valid[i]) continue;
+            const float qx = c * x_[i] - s * y_[i] + tx, qy = s * x_[i] + c * y_[i] + ty;
+            const float u = (approxAtan2(qy, qx) - first_) * inv_step_;
+            if (!(u >= 0.0f) || !(u < static_cast<float>(rn - 1))) continue;
+            const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
+            if (!ref.valid[k0] || !ref.valid[k1] || !ref.link[k0]) continue;
+            float nx = ref.y[k0] - ref.y[k1], ny = ref.x[k1] - ref.x[k0];
+            const float len2 = nx * nx + ny * ny;
+            if (!(len2 > 1e-12f)) continue;
+            const float inv = 1.0f / std::sqrt(len2);
+            nx *= inv;
+            ny *= inv;
+            const float e = nx * (qx - ref.x[k0]) + ny * (qy - ref.y[k0]);
+            if (std::abs(e) > gate_f) continue;
+            const float j2 = -nx * qy + ny * qx;  // d e / d theta (rotation about the origin)
+            A[0] += nx * nx;
+            A[1] += nx * ny;
+            A[2] += nx * j2;
+            A[3] += ny * ny;
+            A[4] += ny * j2;
+            A[5] += j2 * j2;
+            b[0] += nx * e;
+            b[1] += ny * e;
+            b[2] += j2 * e;
+            ++pairs;
+        }
+        gate = std::max(0.5 * gate, 0.1);
+        if (pairs < 12) break;
+        // Damped normal equations (a corridor leaves one direction unconstrained).
+        const double damp = 1e-3 * static_cast<double>(pairs);
+        const double a00 = A[0] + damp, a01 = A[1], a02 = A[2], a11 = A[3] + damp, a12 = A[4],
+                     a22 = A[5] + damp * 10.0;
+        const double det = a00 * (a11 * a22 - a12 * a12) - a01 * (a01 * a22 - a12 * a02) +
+                           a02 * (a01 * a12 - a11 * a02);
+        if (!(std::abs(det) > 1e-12)) break;
+        const double b0 = b[0], b1 = b[1], b2 = b[2];
+        const double dx = -(b0 * (a11 * a22 - a12 * a12) - a01 * (b1 * a22 - a12 * b2) +
+                            a02 * (b1 * a12 - a11 * b2)) /
+                          det;
+        const double dy = -(a00 * (b1 * a22 - a12 * b2) - b0 * (a01 * a22 - a12 * a02) +
+                            a02 * (a01 * b2 - b1 * a02)) /
+                          det;
+        const double dt = -(a00 * (a11 * b2 - b1 * a12) - a01 * (a01 * b2 - b1 * a02) +
+                            b0 * (a01 * a12 - a11 * a02)) /
+                          det;
+        if (!std::isfinite(dx) || !std::isfinite(dy) || !std::isfinite(dt)) break;
+        // q' = R(dt) q + (dx, dy): compose the increment onto the step.
+        const double cd = std::cos(dt), sd = std::sin(dt);
+        d = Pose2D{cd * d.x - sd * d.y + dx, sd * d.x + cd * d.y + dy, d.phi + dt};
+        changed = true;
+    }
+    return changed;
+}
+
+bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, double sigma,
+                                      Result& res) {
+    const std::size_t n = scan.range.size();
+    have_pose_ = false;
+    if (!params_.temporal) return false;
+    const Reference& r0 = refs_[0];
+    if (!r0.present || r0.geometry != scan.geometry) return false;
+    // This scan's sensor in the newest keyframe's frame: the odometry step (no motion without
+    // odometry), refined.
+    Pose2D d;
+    if (scan.odometry && r0.has_odom)
+        d = between(r0.odom, compose(*scan.odometry, scan.sensor_pose));
+    else if (scan.odometry || r0.has_odom)
+        return false;  // odometry appeared or vanished: no common frame
+    if (!projection(r0, d, sigma).usable) return false;
+    res.refined = refineStep(scan, r0, d);
+    const Projection p0 = projection(r0, d, sigma);
+    pose_ = compose(r0.pose, d);
+    have_pose_ = true;
+    // Every return off a line, every return of a short segment, and every fourth return along
+    // a line (enough to tell how much of a surface lies in free space).
+    free_in_.assign(out.count(), 0);
+    supported_in_.assign(out.count(), 0);
+    classified_in_.assign(out.count(), 0);
+    unknown_.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::int32_t label = out.label[i];
+        if (label < 0) continue;
+        const auto c = static_cast<std::size_t>(label);
+        if (line_[i] && (i & 3u) != 0 && out.size[c] >= 8) continue;
+        const std::uint8_t e = classify(p0, x_[i], y_[i], true);
+        evidence_[i] = e;
+        ++classified_in_[c];
+        if (e == kFree) {
+            ++free_in_[c];
+            ++res.free_points;
+        } else if (e == kSupported) {
+            ++supported_in_[c];
+            ++res.supported;
+        } else if (e == kTracked) {
+            ++res.tracked;
+        } else {
+            unknown_.push_back(static_cast<std::uint32_t>(i));
+        }
+    }
+    // The keyframe before it can support what the newest could not (a thin object between two
+    // beams, a return among dropouts); it never overrules free space.
+    const Reference& r1 = refs_[1];
+    if (r1.present && r1.geometry == scan.geometry) {
+        const Projection p1 = projection(r1, between(r1.pose, pose_), sigma);
+        if (p1.usable)
+            for (const std::uint32_t i : unknown_)
+                if (classify(p1, x_[i], y_[i], false) == kSupported) {
+                    evidence_[i] = kSupported;
+                    ++supported_in_[static_cast<std::size_t>(out.label[i])];
+                    ++res.supported;
+                }
+    }
+    return true;
+}
+
+void EvidenceFilter::keepAsReference(const Scan& scan) {
+    if (!params_.temporal) {
+        refs_[0].present = refs_[1].present = false;
+        return;
+    }
+    std::swap(refs_[0], refs_[1]);  // the newest becomes the older; buffers are reused
+    Reference& r = refs_[0];
+    r.present = true;
+    r.geometry = scan.geometry;
+    r.range = scan.range;
+    r.valid = scan.valid;
+    r.link.swap(link_);
+    r.evidence.swap(evidence_);
+    r.x.swap(x_);
+    r.y.swap(y_);
+    r.has_odom = scan.odometry.has_value();
+    r.odom = r.has_odom ? compose(*scan.odometry, scan.sensor_pose) : Pose2D{};
+    // The refined pose chains the alignments; without one the odometry (or the origin) starts
+    // a new chain, and the older keyframe is no longer in it.
+    r.pose = have_pose_ ? pose_ : r.odom;
+    if (!have_pose_) refs_[1].present = false;
+}
+
+EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
+    Result res;
+    const std::size_t n = scan.range.size();
+    ScanGeometry geom = scan.geometry;
+    geom.beams = n;  // tables follow the data
+    updateTables(geom);
+    x_.resize(n);
+    y_.resize(n);
+    const float* range = scan.range.data();
+    for (std::size_t i = 0; i < n; ++i) {
+        x_[i] = range[i] * cos_[i];
+        y_[i] = range[i] * sin_[i];
+    }
+    // 1.-2. Noise, lines and segments.
+    const double sigma = estimateSigma(scan);
+    res.sigma = sigma;
+    segment(scan, sigma, out);
+    res.segments = out.count();
+
+    // 3. Temporal evidence from the last two keyframes.
+    evidence_.assign(n, kUnknown);
+    res.temporal = temporalEvidence(scan, out, sigma, res);
+
+    // 4. Segments: small and unsupported, or mostly in free space.
+    for (std::size_t c = 0; c < out.count(); ++c) {
+        const double r = std::max(0.05, static_cast<double>(out.mean_range[c]));
+        const double need = res_ > 0.0f ? std::ceil(params_.min_object_size_m / (r * res_)) : 1.0;
+        const auto bar = static_cast<std::size_t>(
+            std::min(static_cast<double>(params_.max_small_points) + 1.0, std::max(2.0, need)));
+        const bool small = out.size[c] < bar;
+        const bool supported = res.temporal && supported_in_[c] > 0;
+        const bool free =
+            res.temporal && classified_in_[c] > 0 && 2 * free_in_[c] >= classified_in_[c];
+        if ((small && !supported) || free) {
+            out.noise[c] = 1;
+            res.small_segments += small;
+        }
+    }
+    // The previous keyframe for the next scan keeps every return (removed ones too: a thin
+    // object removed once as unsupported must still support the next view).
+    keepAsReference(scan);  // swaps evidence_, x_, y_, link_ away: use the reference's below
+    const std::vector<std::uint8_t>& kept_ev = refs_[0].present ? refs_[0].evidence : evidence_;
+    // Free returns go unless they lie on a line with their neighbours (a surface the previous
+    // keyframe saw a little farther: pose error, a door that moved); every return of a removed
+    // segment goes.
+    for (std::size_t i = 0; i < n; ++i) {
+        if (out.label[i] < 0) continue;
+        if (out.noise[static_cast<std::size_t>(out.label[i])] ||
+            (kept_ev[i] == kFree && !line_[i])) {
+            scan.valid[i] = 0;
+            ++res.points_removed;
+        }
+    }
+    return res;
+}
+
+}  // namespace kfd

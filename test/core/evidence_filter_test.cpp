@@ -1,0 +1,228 @@
+// The evidence denoiser on tiny hand-made scans: what spatial and temporal evidence keep and
+// remove, the noise estimate, the approximations against plain references, and bad parameters.
+#include "kfd/core/evidence_filter.h"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "test_scans.h"
+
+namespace kfd {
+namespace {
+
+using test::deg2rad;
+
+// A room seen by a 361-beam, 180-degree scanner (0.5 deg): a wall 4 m ahead across the view.
+Scan room(std::optional<Pose2D> odometry = Pose2D{}) {
+    Scan s = test::flatWall(361, deg2rad(150.0), 4.0);
+    s.odometry = odometry;
+    return s;
+}
+
+// The same wall after the robot moved `dx` metres forward (odometry says so).
+Scan roomAfter(double dx) {
+    Scan s = test::flatWall(361, deg2rad(150.0), 4.0 - dx);
+    s.odometry = Pose2D{dx, 0.0, 0.0};
+    return s;
+}
+
+EvidenceFilter::Params exact() {
+    EvidenceFilter::Params p;
+    p.sigma_m = 0.01;  // noiseless test scans: fix the noise instead of estimating it
+    return p;
+}
+
+TEST(EvidenceFilter, ASpikeInFrontOfAWallThePreviousKeyframeSawThroughIsRemoved) {
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    Scan second = roomAfter(0.1);
+    test::insertSpike(second, 180, 3.6);  // 0.3 m in front of the wall, one beam
+    const auto r = f.filter(second, c);
+    EXPECT_TRUE(r.temporal);
+    EXPECT_EQ(second.valid[180], 0);
+    EXPECT_GE(r.free_points, 1u);
+    EXPECT_EQ(r.points_removed, 1u);  // nothing else
+}
+
+TEST(EvidenceFilter, ABurstInFreeSpaceIsRemovedThoughItLooksLikeAnObject) {
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    Scan second = roomAfter(0.1);
+    test::setRange(second, 170, 185, 1.0);  // 16 beams at 1 m: a flat "object"
+    f.filter(second, c);
+    for (std::size_t i = 170; i <= 185; ++i) EXPECT_EQ(second.valid[i], 0) << i;
+    EXPECT_EQ(second.countValid(), first.countValid() - 16);
+}
+
+TEST(EvidenceFilter, APersistentThinObjectIsKept) {
+    // A chair leg (one beam at 2 m) seen by two keyframes in a row: spatially a lone return, but
+    // the previous keyframe saw it at the same place.
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = room();
+    test::insertSpike(first, 200, 2.0);
+    f.filter(first, c);
+    Scan second = room();  // the robot stands still
+    test::insertSpike(second, 200, 2.0);
+    const auto r = f.filter(second, c);
+    EXPECT_EQ(second.valid[200], 1);
+    EXPECT_EQ(r.points_removed, 0u);
+}
+
+TEST(EvidenceFilter, WithoutAPreviousKeyframeOnlyLoneReturnsAreRemoved) {
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan s = room(std::nullopt);
+    test::insertSpike(s, 100, 1.5);    // alone
+    test::setRange(s, 250, 259, 1.0);  // ten beams at 1 m: an object
+    const auto r = f.filter(s, c);
+    EXPECT_FALSE(r.temporal);
+    EXPECT_EQ(s.valid[100], 0);
+    for (std::size_t i = 250; i <= 259; ++i) EXPECT_EQ(s.valid[i], 1) << i;
+    EXPECT_EQ(r.points_removed, 1u);
+}
+
+TEST(EvidenceFilter, AWallAtGrazingIncidenceStaysOneSegment) {
+    // A wall 0.5 m to the side running along the view: consecutive returns are far apart and
+    // nearly along the beam (the breakpoint cuts it), but they lie on a line.
+    Scan s = test::emptyScan(361, deg2rad(180.0));
+    for (std::size_t i = 10; i < 100; ++i) {
+        const double a = s.geometry.angle(i);  // -90 .. -45 deg: the right side
+        s.range[i] = static_cast<float>(0.5 / std::abs(std::sin(a)));
+        s.valid[i] = 1;
+    }
+    EvidenceFilter f(exact());
+    Clusters c;
+    const auto r = f.filter(s, c);
+    EXPECT_EQ(r.points_removed, 0u);
+    EXPECT_EQ(c.count(), 1u);
+}
+
+// A corner (a wall 4 m ahead, one 1.5 m to the right) seen from (x, 0), heading forward.
+Scan corner(double x) {
+    Scan s = test::emptyScan(361, deg2rad(180.0));
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const double a = s.geometry.angle(i), c = std::cos(a), sn = std::sin(a);
+        double r = c > 1e-9 ? (4.0 - x) / c : 1e9;
+        if (sn < -1e-9) r = std::min(r, 1.5 / -sn);
+        if (r < 10.0) test::setRange(s, i, i, r);
+    }
+    return s;
+}
+
+TEST(EvidenceFilter, WithoutOdometryTheStepIsFoundByAlignment) {
+    // Laser only: the robot moved 0.15 m; the scans are aligned from zero motion.
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = corner(0.0);
+    f.filter(first, c);
+    Scan second = corner(0.15);
+    test::insertSpike(second, 200, 2.5);
+    const auto r = f.filter(second, c);
+    EXPECT_TRUE(r.temporal);
+    EXPECT_TRUE(r.refined);
+    EXPECT_EQ(second.valid[200], 0);
+    EXPECT_EQ(r.points_removed, 1u);
+}
+
+TEST(EvidenceFilter, TheNoiseEstimateFollowsTheSensor) {
+    std::mt19937 rng(7);
+    for (const double sigma : {0.01, 0.03}) {
+        EvidenceFilter f;  // estimated
+        Clusters c;
+        std::normal_distribution<double> noise(0.0, sigma);
+        double last = 0.0;
+        for (int k = 0; k < 20; ++k) {
+            Scan s = test::flatWall(1081, deg2rad(150.0), 3.0);
+            for (auto& r : s.range) r = static_cast<float>(r + noise(rng));
+            last = f.filter(s, c).sigma;
+        }
+        EXPECT_NEAR(last, sigma, 0.35 * sigma) << sigma;
+    }
+}
+
+TEST(EvidenceFilter, ResetForgetsThePreviousKeyframe) {
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    f.reset();
+    Scan second = roomAfter(0.1);
+    EXPECT_FALSE(f.filter(second, c).temporal);
+}
+
+TEST(EvidenceFilter, AnotherGeometryGivesNoTemporalEvidence) {
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    Scan other = test::flatWall(181, deg2rad(150.0), 4.0);
+    other.odometry = Pose2D{};
+    EXPECT_FALSE(f.filter(other, c).temporal);
+}
+
+TEST(EvidenceFilter, ApproxAtan2MatchesStdAtan2) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-50.0f, 50.0f);
+    double worst = 0.0;
+    for (int k = 0; k < 200000; ++k) {
+        const float y = u(rng), x = u(rng);
+        worst =
+            std::max(worst, std::abs(static_cast<double>(EvidenceFilter::approxAtan2(y, x)) -
+                                     std::atan2(static_cast<double>(y), static_cast<double>(x))));
+    }
+    EXPECT_LT(worst, 2e-5);  // a 0.25-degree beam is 4.4e-3 rad
+    EXPECT_EQ(EvidenceFilter::approxAtan2(0.0f, 0.0f), 0.0f);
+}
+
+TEST(EvidenceFilter, LineResidualIsZeroOnAnyLine) {
+    // Three beams 0.5 deg apart hitting a line at any incidence: the middle one is predicted.
+    const double res = deg2rad(0.5);
+    for (const double incidence : {0.0, 40.0, 80.0, 88.0}) {
+        const double a = deg2rad(incidence);
+        auto r = [&](double theta) { return 2.0 * std::cos(a) / std::cos(theta - a); };
+        EXPECT_NEAR(EvidenceFilter::lineResidual(r(-res), r(0.0), r(res), std::cos(res)), 0.0, 1e-9)
+            << incidence;
+    }
+}
+
+TEST(EvidenceFilter, BadParametersAreRejected) {
+    auto bad = [](auto change) {
+        EvidenceFilter::Params p;
+        change(p);
+        EXPECT_THROW(EvidenceFilter{p}, ParameterError);
+    };
+    bad([](auto& p) { p.incidence_deg = 0.0; });
+    bad([](auto& p) { p.incidence_deg = 90.0; });
+    bad([](auto& p) { p.sigma_m = -1.0; });
+    bad([](auto& p) { p.sigma_m = std::nan(""); });
+    bad([](auto& p) { p.min_sigma_m = 0.0; });
+    bad([](auto& p) { p.max_gap_beams = 17; });
+    bad([](auto& p) { p.pose_rot_error_deg = -1.0; });
+    bad([](auto& p) { p.moving_object_m = std::numeric_limits<double>::infinity(); });
+    bad([](auto& p) { p.max_step_m = 0.0; });
+    bad([](auto& p) { p.refine_samples = 0; });
+}
+
+TEST(EvidenceFilter, DegenerateScansAreHandled) {
+    EvidenceFilter f;
+    Clusters c;
+    Scan empty = test::emptyScan(361, kPi);
+    EXPECT_EQ(f.filter(empty, c).points_removed, 0u);
+    Scan two = test::makeScan({1.0f, 1.0f}, kPi);
+    f.filter(two, c);
+    Scan circle = test::circle(720, 3.0);  // closes the circle: one segment across the seam
+    circle.odometry = Pose2D{};
+    f.filter(circle, c);
+    EXPECT_EQ(c.count(), 1u);
+    EXPECT_EQ(circle.countValid(), 720u);
+}
+
+}  // namespace
+}  // namespace kfd
