@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include "kfd/core/error.h"
+#include "kfd/core/pose.h"
 
 namespace kfd {
 
@@ -22,8 +23,7 @@ bool MotionFilter::keep(double timestamp, const std::optional<Pose2D>& odometry)
     bool take = !have_ref_;
     if (!take) {
         const double d = std::hypot(odometry->x - ref_pose_.x, odometry->y - ref_pose_.y);
-        const double a =
-            std::abs(std::remainder(odometry->phi - ref_pose_.phi, 2.0 * kPi)) * 180.0 / kPi;
+        const double a = std::abs(wrapAngle(odometry->phi - ref_pose_.phi)) * 180.0 / kPi;
         take = (params_.max_distance_m > 0.0 && d >= params_.max_distance_m) ||
                (params_.max_angle_deg > 0.0 && a >= params_.max_angle_deg) ||
                (params_.max_interval_s > 0.0 && have_stamp_ && std::isfinite(timestamp) &&

@@ -53,16 +53,13 @@ Denoiser::Result Denoiser::filter(Scan& scan) {
             ++unusable;
         }
     if (params_.variant == DenoiseVariant::Evidence) {
+        // Marks its segments' noise flags and removes their points itself.
         const auto r = evidence_.filter(scan, clusters_);
         res.points_removed = unusable + r.points_removed;
-        res.clusters = r.segments;
-        for (const auto f : clusters_.noise) res.noise_clusters += f;
         res.temporal = r.temporal;
         res.sigma = r.sigma;
         res.free_points = r.free_points;
-        return res;
-    }
-    if (params_.variant == DenoiseVariant::Reference) {
+    } else if (params_.variant == DenoiseVariant::Reference) {
         const auto r = reference_.cluster(scan, clusters_);
         res.blocks = r.blocks;
         res.merges = r.merges;
@@ -73,7 +70,8 @@ Denoiser::Result Denoiser::filter(Scan& scan) {
         res.merges = r.merges;
         res.theta_threshold = r.theta_threshold;
     }
-    res.points_removed = unusable + filterClusters(filter_, scan, clusters_);
+    if (params_.variant != DenoiseVariant::Evidence)
+        res.points_removed = unusable + filterClusters(filter_, scan, clusters_);
     res.clusters = clusters_.count();
     for (const auto f : clusters_.noise) res.noise_clusters += f;
     return res;

@@ -4,24 +4,13 @@
 #include <cmath>
 #include <limits>
 
+#include "kfd/core/pose.h"
+
 namespace kfd {
 
 namespace {
 
 constexpr double kDeg = kPi / 180.0;
-
-/// a^-1 * b for planar poses.
-inline Pose2D between(const Pose2D& a, const Pose2D& b) {
-    const double c = std::cos(a.phi), s = std::sin(a.phi);
-    const double dx = b.x - a.x, dy = b.y - a.y;
-    const double dphi = std::atan2(std::sin(b.phi - a.phi), std::cos(b.phi - a.phi));
-    return Pose2D{c * dx + s * dy, -s * dx + c * dy, dphi};
-}
-
-inline Pose2D compose(const Pose2D& a, const Pose2D& b) {
-    const double c = std::cos(a.phi), s = std::sin(a.phi);
-    return Pose2D{a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, a.phi + b.phi};
-}
 
 /// Distance squared from (px, py) to the segment (ax, ay)-(bx, by).
 inline float segmentDistance2(float px, float py, float ax, float ay, float bx, float by) {
@@ -95,14 +84,7 @@ void EvidenceFilter::reset() {
 }
 
 void EvidenceFilter::updateTables(const ScanGeometry& g) {
-    if (g == table_geometry_ && cos_.size() == g.beams) return;
-    table_geometry_ = g;
-    cos_.resize(g.beams);
-    sin_.resize(g.beams);
-    for (std::size_t i = 0; i < g.beams; ++i) {
-        cos_[i] = static_cast<float>(std::cos(g.angle(i)));
-        sin_[i] = static_cast<float>(std::sin(g.angle(i)));
-    }
+    dirs_.update(g);
     first_ = static_cast<float>(g.angle(0));
     inv_step_ = g.beams > 1 ? static_cast<float>(1.0 / g.step()) : 0.0f;
     res_ = static_cast<float>(g.resolution());
@@ -446,8 +428,8 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     y_.resize(n);
     const float* range = scan.range.data();
     for (std::size_t i = 0; i < n; ++i) {
-        x_[i] = range[i] * cos_[i];
-        y_[i] = range[i] * sin_[i];
+        x_[i] = range[i] * dirs_.cos[i];
+        y_[i] = range[i] * dirs_.sin[i];
     }
     // 1.-2. Noise, lines and segments.
     const double sigma = estimateSigma(scan);

@@ -6,6 +6,7 @@
 #include "kfd/core/error.h"
 
 #include "kfd/core/correlation.h"
+#include "kfd/core/pose.h"
 
 namespace kfd {
 
@@ -93,7 +94,7 @@ KeyframeDecision KeyframeSelector::decide(const std::vector<double>& h, double t
             } else if (odometry && last_odometry_) {
                 const double dx = odometry->x - last_odometry_->x;
                 const double dy = odometry->y - last_odometry_->y;
-                const double dphi = std::remainder(odometry->phi - last_odometry_->phi, 2.0 * kPi);
+                const double dphi = wrapAngle(odometry->phi - last_odometry_->phi);
                 if (params_.max_translation_m > 0.0 &&
                     std::hypot(dx, dy) >= params_.max_translation_m) {
                     d.keyframe = true;

@@ -25,25 +25,13 @@ double RangeAwareClustering::jumpDistance(double ra, double rb, double dtheta) c
     return std::min(ra, rb) * std::sin(a) / sin_lambda_ + 3.0 * params_.jump_sigma_m;
 }
 
-void RangeAwareClustering::updateTables(const ScanGeometry& g) {
-    if (g == table_geometry_ && cos_.size() == g.beams) return;
-    table_geometry_ = g;
-    cos_.resize(g.beams);
-    sin_.resize(g.beams);
-    for (std::size_t i = 0; i < g.beams; ++i) {
-        const double a = g.angle(i);
-        cos_[i] = static_cast<float>(std::cos(a));
-        sin_[i] = static_cast<float>(std::sin(a));
-    }
-}
-
 RangeAwareClustering::Result RangeAwareClustering::cluster(const Scan& scan, Clusters& out) {
     Result res;
     const ScanGeometry& g = scan.geometry;
     const std::size_t n = scan.range.size();
     ScanGeometry geom = g;
     geom.beams = n;  // tables follow the actual data length
-    updateTables(geom);
+    dirs_.update(geom);
     const double res_ang = g.resolution();
     const double theta = params_.angle_gap_factor * res_ang;
     res.theta_threshold = theta;
@@ -65,7 +53,7 @@ RangeAwareClustering::Result RangeAwareClustering::cluster(const Scan& scan, Clu
     for (std::size_t i = 0; i < n; ++i) {
         if (!scan.valid[i]) continue;
         const float r = scan.range[i];
-        const float x = r * cos_[i], y = r * sin_[i];
+        const float x = r * dirs_.cos[i], y = r * dirs_.sin[i];
         // Close clusters whose last point is more than theta behind.
         open_.erase(std::remove_if(open_.begin(), open_.end(),
                                    [&](const Open& o) {
@@ -117,7 +105,7 @@ RangeAwareClustering::Result RangeAwareClustering::cluster(const Scan& scan, Clu
                 if (dtheta > theta + 1e-12) break;
                 if (!scan.valid[j] || provisional_[j] < 0) continue;
                 const float r = scan.range[j];
-                const double d = std::hypot(r * cos_[j] - o.x, r * sin_[j] - o.y);
+                const double d = std::hypot(r * dirs_.cos[j] - o.x, r * dirs_.sin[j] - o.y);
                 if (d <= jumpDistance(r, o.r, std::max(dtheta, 0.0)))
                     res.merges +=
                         sets_.unite(o.id, static_cast<std::uint32_t>(provisional_[j])) ? 1 : 0;

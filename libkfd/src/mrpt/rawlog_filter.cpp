@@ -103,6 +103,9 @@ class Run {
     std::optional<Pose2D> odometry_;  // absolute odometry, for the motion guards
     bool saw_frames_ = false, saw_observations_ = false;
     std::size_t scan_index_ = 0;
+    // The first sensor's stamps counted for its rate (SensorSummary::rate_hz).
+    std::size_t rate_stamps_ = 0;
+    double first_rate_stamp_ = 0.0;
 };
 
 void Run::write(const mrpt::serialization::CSerializable& obj) {
@@ -127,12 +130,11 @@ void Run::noteSensor(const CObservation2DRangeScan& scan, const std::optional<Po
     if (scan.sensorLabel != s.label) return;
     s.odometry = s.odometry || odometry.has_value();
     const double t = stampOf(scan);
-    if (std::isfinite(t) && s.stamped < SensorSummary::kMaxRateScans) {
-        if (s.stamped == 0) s.first_stamp = t;
-        s.last_stamp = t;
-        ++s.stamped;
-        if (s.stamped > 1 && s.last_stamp > s.first_stamp)
-            s.rate_hz = static_cast<double>(s.stamped - 1) / (s.last_stamp - s.first_stamp);
+    if (std::isfinite(t) && rate_stamps_ < SensorSummary::kMaxRateScans) {
+        if (rate_stamps_ == 0) first_rate_stamp_ = t;
+        ++rate_stamps_;
+        if (rate_stamps_ > 1 && t > first_rate_stamp_)
+            s.rate_hz = static_cast<double>(rate_stamps_ - 1) / (t - first_rate_stamp_);
     }
     if (r.keep)
         if (const auto* d = r.report.find<Denoiser::Result>())

@@ -137,9 +137,8 @@ class EvidenceFilter {
 
     Params params_;
     double lambda_ = 0.0;
-    ScanGeometry table_geometry_;
-    std::vector<float> cos_, sin_;
-    float first_ = 0.0f, inv_step_ = 0.0f, res_ = 0.0f;  // of the table geometry
+    BeamDirections dirs_;
+    float first_ = 0.0f, inv_step_ = 0.0f, res_ = 0.0f;  // of the scan's geometry
     std::vector<float> x_, y_;                           // this scan's points (sensor frame)
     std::vector<float> scratch_;                         // residuals sampled for the noise quantile
     std::vector<std::uint8_t> line_;      // per beam: on a line with its two neighbours

@@ -59,13 +59,11 @@ class RangeAwareClustering {
         std::uint32_t beam;
         float x, y, r;
     };
-    void updateTables(const ScanGeometry& g);
 
     Params params_;
     double sin_lambda_ = 0.0;
     double half_lambda_ = 0.0;
-    ScanGeometry table_geometry_;
-    std::vector<float> cos_, sin_;
+    BeamDirections dirs_;
     std::vector<Open> open_;
     std::vector<std::uint8_t> reach_;  // per open cluster: reached by the current point
     std::vector<double> jump_factor_;  // per beam gap: sin(min(gap*res, lambda/2))/sin(lambda)

@@ -50,6 +50,24 @@ struct ScanGeometry {
     bool operator!=(const ScanGeometry& o) const { return !(*this == o); }
 };
 
+/// The unit direction (cos, sin) of every beam of a geometry, as floats; update() recomputes
+/// them only when the geometry changes (per-scan tables of the clustering variants).
+struct BeamDirections {
+    ScanGeometry geometry;
+    std::vector<float> cos, sin;
+
+    void update(const ScanGeometry& g) {
+        if (g == geometry && cos.size() == g.beams) return;
+        geometry = g;
+        cos.resize(g.beams);
+        sin.resize(g.beams);
+        for (std::size_t i = 0; i < g.beams; ++i) {
+            cos[i] = static_cast<float>(std::cos(g.angle(i)));
+            sin[i] = static_cast<float>(std::sin(g.angle(i)));
+        }
+    }
+};
+
 /// Limits of a scan's geometry, checked by checkGeometry() (Pipeline::process throws ScanError
 /// outside them; the MRPT adapter skips such a scan, kfd/mrpt/scan_check.h).
 /// 65 536 beams cover every real 2D lidar (the densest take ~ 10 000 per turn); at least two

@@ -1,4 +1,5 @@
-// Stamped 2D trajectories: SE(2) helpers, TUM file I/O and lookup by timestamp. std only.
+// Stamped 2D trajectories: TUM file I/O and lookup by timestamp (SE(2) helpers: core/pose.h).
+// std only.
 #pragma once
 
 #include <cstddef>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "kfd/core/error.h"
+#include "kfd/core/pose.h"  // compose, inverse, between, wrapAngle
 #include "kfd/core/scan.h"
 
 namespace kfd {
@@ -24,15 +26,6 @@ struct StampedPose {
     Pose2D pose;
 };
 using Trajectory = std::vector<StampedPose>;
-
-/// a (+) b: b expressed in a's frame, composed onto a.
-Pose2D compose(const Pose2D& a, const Pose2D& b);
-/// The inverse transform of a.
-Pose2D inverse(const Pose2D& a);
-/// b in the frame of a: inverse(a) (+) b.
-Pose2D between(const Pose2D& a, const Pose2D& b);
-/// Wraps an angle into (-pi, pi].
-double wrapAngle(double a);
 
 /// TUM format: one "t x y z qx qy qz qw" line per pose ('#' comments allowed); the yaw is read
 /// from the quaternion (any non-zero norm). Throws EvalError naming the file and line on

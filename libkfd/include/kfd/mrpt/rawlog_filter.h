@@ -42,9 +42,6 @@ struct SensorSummary {
     double rate_hz = 0.0;        // 0 when the stamps do not tell
     double range_noise_m = 0.0;  // the evidence denoiser's estimate at the last keyframe; 0 = n/a
     bool odometry = false;       // the log carries odometry (temporal evidence uses it)
-    // internal: the stamps seen so far
-    double first_stamp = 0.0, last_stamp = 0.0;
-    std::size_t stamped = 0;
 };
 
 struct RawlogFilterSummary {
