@@ -1,5 +1,6 @@
 // kfd-filter: keyframe extraction + clustering denoise of every 2D scan of a rawlog.
 // All logic lives in kfd::RawlogFilter; this file parses arguments and reports.
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -31,6 +32,13 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
     }
     std::printf("  scans    in %zu, kept %zu, dropped %zu (%.1f %%)\n", s.scans_in, s.scans_kept,
                 s.scans_dropped, s.droppedPercent());
+    if (s.scans_corridor)
+        std::printf(
+            "  corridor %zu scans degenerate (%.1f %%): %zu keyframes by odometry or time\n",
+            s.scans_corridor,
+            100.0 * static_cast<double>(s.scans_corridor) /
+                static_cast<double>(std::max<std::size_t>(1, s.scans_in)),
+            s.keyframes_corridor);
     std::printf("  points   in %zu; in kept scans removed: %zu out of range, %zu noise (%.2f %%)\n",
                 s.points_in, s.points_removed_range, s.points_removed_noise,
                 s.points_in ? 100.0 * removed / static_cast<double>(s.points_in) : 0.0);

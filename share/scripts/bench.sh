@@ -119,6 +119,8 @@ rows = [
     ("BM_Histogram", "histogram, n = 20"),
     ("BM_Pearson", "one Pearson correlation, n = 20"),
     ("BM_KeyframeDecision", "keyframe decision, m = 8 (histogram + 8 correlations), dropped scan"),
+    ("BM_KeyframeView/0", "keyframe decision, view selector (kfd's default), odometry, dropped scan"),
+    ("BM_KeyframeView/1", "keyframe decision, view selector, laser only, dropped scan"),
     ("BM_DenoiseReference", "denoise, reference (rings + filter) *"),
     ("BM_DenoiseRangeAware", "denoise, range-aware *"),
     ("BM_DenoiseEvidence", "denoise, evidence (kfd's default), loop keyframes *"),
@@ -204,6 +206,19 @@ for key, ir_key, label in [("BM_DenoiseReference", "denoise_reference", "referen
             if ir.get("dbscan") and ir.get(ir_key):
                 ir_ratio = f"; instructions {ir['dbscan'] / ir[ir_key]:.0f}x"
             print(f"| >= 50x faster than DBSCAN ({label}) | DBSCAN {us(db):.0f} us, {r:.0f}x{ir_ratio} | {verdict(r >= 50)} |")
+for key, label in [("BM_KeyframeView/0", "view selector, odometry"),
+                   ("BM_KeyframeView/1", "view selector, laser only")]:
+    b = st.get(key)
+    if b and "error" not in b:
+        print(f"| keyframe decision about 2 us per 1081-beam scan ({label}) | {us(b):.2f} us | {verdict(us(b) <= 2)} |")
+# Issue 12: the keyframe decision of kfd's default selector (view), with and without odometry,
+# and the paper's histogram + correlation decision, per 1081-beam scan.
+for key, label in [("keyframe_view", "view selector, odometry"),
+                   ("keyframe_view_laser_only", "view selector, laser only"),
+                   ("keyframe_decision", "paper's rule (histogram, m = 8)")]:
+    if ir.get(key):
+        n = ir[key] / calls
+        print(f"| keyframe decision <= 10 000 instructions per 1081-beam scan ({label}) | {n:,.0f} | {verdict(n <= 10000)} |")
 # Issue 11: the evidence denoiser, on the loop keyframes (its temporal evidence needs the
 # previous keyframe), against DBSCAN on the same scans and in the same run.
 ev, dbl = st.get("BM_DenoiseEvidence"), st.get("BM_DbscanLoop")

@@ -17,6 +17,7 @@ also simulated again with seed K + 1.
   kfd-compare run ... --emit-jobs jobs.txt      # one shell command per line, then:
   parallel -j 8 < jobs.txt                       # (or xargs -P, a Slurm array), then:
   kfd-compare collect OUT                        # report.md, runs.csv, runs.json, plots/
+  kfd-compare diagnose OUT --modes kfd odometry@kfd   # where the drops cost: diagnose.md
 
 Logs: a dataset folder name under --datasets (NAME/NAME.rawlog with NAME.relations) or a path
 to a .rawlog (NAME.relations and NAME.gt.tum beside it are used when present), or
@@ -479,6 +480,12 @@ def main(argv=None):
     c = sub.add_parser("collect", parents=[report],
                        help="merge the finished runs of DIR into its report")
     c.add_argument("dir")
+    g = sub.add_parser("diagnose", help="gaps between kept scans and the local error they cost")
+    g.add_argument("dir")
+    g.add_argument("--modes", nargs="+", required=True, help="modes to diagnose (2 or more)")
+    g.add_argument("--reference", default="none", help="mode whose repeat 0 gives the motion")
+    g.add_argument("--datasets", default=DEFAULT_DATASETS)
+    g.add_argument("--split-seconds", type=float, default=10.0)
     a = ap.parse_args(argv)
     try:
         if a.command == "run":
@@ -486,6 +493,14 @@ def main(argv=None):
         if a.command == "job":
             parse_mode(a.mode)
             run_job(a)
+            return 0
+        if a.command == "diagnose":
+            import kfd_diagnose
+            text = kfd_diagnose.diagnose(a.dir, a.modes, a.reference, a.split_seconds,
+                                         a.datasets)
+            with open(os.path.join(a.dir, "diagnose.md"), "w") as f:
+                f.write(text)
+            sys.stdout.write(text)
             return 0
         collect(a.dir, a.baseline, a.pairs, a.plots, a.quiet)
         return 0

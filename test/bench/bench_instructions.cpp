@@ -40,6 +40,9 @@ struct Context {
     kfd::Histogram histogram{kfd::Histogram::Params{20}};
     kfd::DistanceFilter distance{kb::paperParams().get<kfd::DistanceStage>()};
     kfd::KeyframeSelector selector{kb::paperParams().get<kfd::KeyframeStage>()};
+    kfd::KeyframeSelector view{kb::viewParamsThatDrop()};
+    kfd::KeyframeSelector view_lo{kb::viewParamsThatDrop()};
+    std::vector<kfd::Scan> dropped_lo;  // the dropped set without odometry
     kfd::Denoiser reference{
         kb::paperParams(kfd::DenoiseVariant::Reference).get<kfd::DenoiseStage>()};
     kfd::Denoiser range_aware{
@@ -58,6 +61,9 @@ struct Context {
         hist.resize(sc.keyframes.size());
         for (std::size_t k = 0; k < hist.size(); ++k) histogram.compute(sc.keyframes[k], hist[k]);
         for (const auto& s : sc.prefix) selector.filter(s);
+        for (const auto& s : sc.dropped) dropped_lo.push_back(kb::laserOnly(s));
+        view.filter(sc.prefix.back());
+        view_lo.filter(kb::laserOnly(sc.prefix.back()));
         for (kfd::Scan s : sc.prefix) pipe_dropped.process(s);
     }
 };
@@ -79,6 +85,12 @@ __attribute__((noinline)) void kfd_ir_distance_filter(Context& c, std::size_t k)
 }
 __attribute__((noinline)) void kfd_ir_keyframe_decision(Context& c, std::size_t k) {
     c.surprises += c.selector.filter(c.sc.dropped[k]).keyframe;
+}
+__attribute__((noinline)) void kfd_ir_keyframe_view(Context& c, std::size_t k) {
+    c.surprises += c.view.filter(c.sc.dropped[k]).keyframe;
+}
+__attribute__((noinline)) void kfd_ir_keyframe_view_laser_only(Context& c, std::size_t k) {
+    c.surprises += c.view_lo.filter(c.dropped_lo[k]).keyframe;
 }
 __attribute__((noinline)) void kfd_ir_denoise_reference(Context& c, std::size_t k) {
     c.sink += c.reference.filter(c.work[k]).points_removed;
@@ -126,6 +138,8 @@ const Case kCases[] = {
     {"pearson", kfd_ir_pearson, false},
     {"distance_filter", kfd_ir_distance_filter, false},
     {"keyframe_decision", kfd_ir_keyframe_decision, true},
+    {"keyframe_view", kfd_ir_keyframe_view, true},
+    {"keyframe_view_laser_only", kfd_ir_keyframe_view_laser_only, true},
     {"denoise_reference", kfd_ir_denoise_reference, false},
     {"denoise_range_aware", kfd_ir_denoise_range_aware, false},
     {"denoise_evidence", kfd_ir_denoise_evidence, false, true},
@@ -156,6 +170,8 @@ void warmUp(Context& c, const Case& cs) {
         if (name == "histogram") c.histogram.compute(c.sc.keyframes[k], c.out);
         if (name == "distance_filter") c.distance.filter(s);
         if (name == "keyframe_decision") c.selector.filter(c.sc.dropped[k]);
+        if (name == "keyframe_view") c.view.filter(c.sc.dropped[k]);
+        if (name == "keyframe_view_laser_only") c.view_lo.filter(c.dropped_lo[k]);
         if (name == "denoise_reference") c.reference.filter(s);
         if (name == "denoise_range_aware") c.range_aware.filter(s);
         if (name == "dbscan") c.dbscan.filter(s);

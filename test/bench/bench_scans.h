@@ -39,6 +39,7 @@ inline Pipeline::Params paperParams(DenoiseVariant variant = DenoiseVariant::Ref
     p.stages = {"distance", "keyframe", "denoise"};
     p.get<DistanceStage>().min_range = 0.1;
     p.get<DistanceStage>().max_range = kMaxRange;
+    p.get<KeyframeStage>().selector = KeyframeRule::Paper;
     p.get<KeyframeStage>().bins = 20;
     p.get<KeyframeStage>().window = 8;
     p.get<KeyframeStage>().p_pair = 0.985;
@@ -231,6 +232,31 @@ inline Scenario makeScenario(unsigned seed = kSeed) {
         sc.loop_keyframes.push_back(std::move(s));
     }
     return sc;
+}
+
+/// kfd's view selector with every threshold out of reach: each call measures the scan against
+/// the keyframe and drops it, so the keyframe never changes (the cost of a dropped scan's
+/// decision; a keyframe adds one copy of the sampled ranges).
+inline KeyframeSelector::Params viewParamsThatDrop() {
+    KeyframeSelector::Params p;
+    p.selector = KeyframeRule::View;
+    p.max_consecutive_drops = 0;
+    p.max_interval_s = 0.0;
+    p.max_translation_m = 0.0;
+    p.max_rotation_deg = 0.0;
+    p.view.max_view_change = 1e3;
+    p.view.max_changed_fraction = 1.0;
+    p.view.change_tolerance_m = 1e3;
+    p.view.corridor_translation_m = 1e6;
+    p.view.corridor_rotation_deg = 360.0;
+    p.view.corridor_interval_s = 1e6;
+    return p;
+}
+
+/// The scan without its odometry (what a robot without wheel encoders gives the selector).
+inline Scan laserOnly(Scan s) {
+    s.odometry.reset();
+    return s;
 }
 
 /// Restores the valid flags of `work` from `pristine` (what a stage invalidated last time).

@@ -141,6 +141,26 @@ void BM_KeyframeDecision(benchmark::State& state) {
 }
 BENCHMARK(BM_KeyframeDecision)->Unit(benchmark::kMicrosecond);
 
+// kfd's view selector (issue 12) on the same dropped scans: with odometry (arg 0) and laser
+// only (arg 1); every threshold out of reach, so the keyframe stays the same.
+void BM_KeyframeView(benchmark::State& state) {
+    const auto& sc = scenario();
+    const bool laser_only = state.range(0) == 1;
+    state.SetLabel(laser_only ? "laser only" : "odometry");
+    std::vector<Scan> scans;
+    for (const auto& s : sc.dropped) scans.push_back(laser_only ? kb::laserOnly(s) : s);
+    kfd::KeyframeSelector sel(kb::viewParamsThatDrop());
+    sel.filter(laser_only ? kb::laserOnly(sc.prefix.back()) : sc.prefix.back());
+    std::size_t k = 0, kept = 0;
+    for (auto _ : state) {
+        kept += sel.filter(scans[k]).keyframe ? 1 : 0;
+        k = (k + 1) % scans.size();
+    }
+    if (kept) state.SkipWithError("a scan was kept: scenario broken");
+    perScan(state);
+}
+BENCHMARK(BM_KeyframeView)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
 // Algorithm 2 as published (t = 5 rings, theta = 10 x resolution) + the m_threshold = 10
 // cluster filter.
 void BM_DenoiseReference(benchmark::State& state) {

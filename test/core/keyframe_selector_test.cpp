@@ -24,6 +24,7 @@ constexpr std::size_t kBins = 6;
 /// Selector with every guard off: decisions follow Formula 3 alone.
 KeyframeSelector::Params paperParams(std::size_t window, double p_pair) {
     KeyframeSelector::Params p;
+    p.selector = KeyframeRule::Paper;
     p.bins = kBins;
     p.window = window;
     p.p_pair = p_pair;
@@ -80,7 +81,9 @@ TEST(KeyframeSelector, FirstScanIsKeyframe) {
 }
 
 TEST(KeyframeSelector, IdenticalScansAreDropped) {
-    KeyframeSelector s;  // default parameters, scans without time or odometry
+    KeyframeSelector::Params p;        // the paper's rule with its default parameters, scans
+    p.selector = KeyframeRule::Paper;  // without time or odometry
+    KeyframeSelector s(p);
     const Scan scan = test::flatWall(181, test::deg2rad(120.0), 3.0);
     EXPECT_EQ(s.filter(scan).reason, KeyframeReason::First);
     for (std::size_t k = 1; k <= 5; ++k) {
@@ -105,7 +108,9 @@ TEST(KeyframeSelector, DissimilarScanIsKeyframe) {
 }
 
 TEST(KeyframeSelector, ScanThatSuddenlySeesNothingIsKeyframe) {
-    KeyframeSelector s;
+    KeyframeSelector::Params p;
+    p.selector = KeyframeRule::Paper;
+    KeyframeSelector s(p);
     Scan scan = test::flatWall(181, test::deg2rad(120.0), 3.0);
     s.filter(scan);
     test::invalidate(scan, 0, scan.size() - 1);
@@ -116,6 +121,7 @@ TEST(KeyframeSelector, ScanThatSuddenlySeesNothingIsKeyframe) {
 
 TEST(KeyframeSelector, FilterUsesTheScanHistogram) {
     KeyframeSelector::Params p;
+    p.selector = KeyframeRule::Paper;
     p.bins = 4;
     KeyframeSelector s(p);
     const Scan scan = test::makeScan({1, 1, 2, 2, 3, 3, 4, 4});
@@ -408,6 +414,7 @@ TEST(KeyframeSelector, RotationInPlaceProducesKeyframes) {
     // A 360-degree scanner turning on the spot in a round room sees the same scan every time;
     // only the rotation guard makes keyframes.
     KeyframeSelector::Params p;  // defaults: A = 15 deg, D = 0.5 m
+    p.selector = KeyframeRule::Paper;
     p.max_interval_s = 0.0;
     KeyframeSelector s(p);
     Scan scan = test::circle(360, 4.0);
@@ -532,6 +539,33 @@ TEST(KeyframeSelector, ReasonNames) {
     EXPECT_EQ(std::string(toString(KeyframeReason::Translation)), "translation");
     EXPECT_EQ(std::string(toString(KeyframeReason::Rotation)), "rotation");
     EXPECT_EQ(std::string(toString(KeyframeReason::Similar)), "similar");
+    EXPECT_EQ(std::string(toString(KeyframeReason::ViewChange)), "view_change");
+    EXPECT_EQ(std::string(toString(KeyframeReason::Corridor)), "corridor");
+    EXPECT_EQ(std::string(toString(KeyframeReason::Covered)), "covered");
+}
+
+TEST(KeyframeSelector, SelectorNamesRoundTrip) {
+    EXPECT_EQ(parseKeyframeRule("paper"), KeyframeRule::Paper);
+    EXPECT_EQ(parseKeyframeRule("view"), KeyframeRule::View);
+    EXPECT_EQ(std::string(toString(KeyframeRule::Paper)), "paper");
+    EXPECT_EQ(std::string(toString(KeyframeRule::View)), "view");
+    try {
+        parseKeyframeRule("histogram");
+        FAIL() << "no error";
+    } catch (const ParameterError& e) {
+        EXPECT_EQ(e.field(), "selector");
+    }
+}
+
+TEST(KeyframeSelector, DefaultIsTheViewSelector) {
+    KeyframeSelector s;
+    const Scan scan = test::flatWall(181, test::deg2rad(120.0), 3.0);
+    EXPECT_EQ(s.filter(scan).reason, KeyframeReason::First);
+    const auto d = s.filter(scan);  // the same view, no odometry: covered
+    EXPECT_FALSE(d.keyframe);
+    EXPECT_EQ(d.reason, KeyframeReason::Covered);
+    EXPECT_EQ(d.changed_fraction, 0.0);
+    EXPECT_TRUE(s.lastHistogram() == std::vector<double>(20, 0.0));  // no histogram computed
 }
 
 }  // namespace

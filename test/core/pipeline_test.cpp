@@ -127,7 +127,7 @@ TEST(Pipeline, DroppedScanStopsLaterStages) {
     EXPECT_FALSE(r.keep);
     EXPECT_EQ(r.dropped_by, "keyframe");
     EXPECT_NE(r.find<kfd::KeyframeDecision>(), nullptr);
-    EXPECT_EQ(r.findOrDefault<kfd::KeyframeDecision>().reason, KeyframeReason::Similar);
+    EXPECT_EQ(r.findOrDefault<kfd::KeyframeDecision>().reason, KeyframeReason::Covered);
     EXPECT_EQ(r.find<kfd::Denoiser::Result>(), nullptr);
     EXPECT_EQ(r.findOrDefault<kfd::Denoiser::Result>().points_removed, 0u);
     // The distance stage ran before the drop; the denoise stage did not run.

@@ -37,10 +37,13 @@ TEST(StageRegistry, CoreRegistryHoldsThePapersStagesInOrder) {
 TEST(StageRegistry, EachStageOwnsItsKeys) {
     const auto& r = coreStageRegistry();
     EXPECT_EQ(keyNames(*r.find("distance")), (std::vector<std::string>{"min_range", "max_range"}));
-    EXPECT_EQ(
-        keyNames(*r.find("keyframe")),
-        (std::vector<std::string>{"bins", "window", "p_pair", "max_consecutive_drops",
-                                  "max_interval_s", "max_translation_m", "max_rotation_deg"}));
+    EXPECT_EQ(keyNames(*r.find("keyframe")),
+              (std::vector<std::string>{
+                  "selector", "bins", "window", "p_pair", "max_consecutive_drops", "max_interval_s",
+                  "max_translation_m", "max_rotation_deg", "view_samples", "view_tolerance_m",
+                  "view_tolerance_deg", "max_view_change", "change_tolerance_m",
+                  "change_tolerance_ratio", "max_changed_fraction", "degeneracy_ratio",
+                  "corridor_translation_m", "corridor_rotation_deg", "corridor_interval_s"}));
     EXPECT_EQ(
         keyNames(*r.find("denoise")),
         (std::vector<std::string>{
@@ -167,7 +170,7 @@ TEST(ScanReport, TheDroppingStageIsMarkedAndLaterStagesAreAbsent) {
     Scan c = noisyWall();
     pipe.reset();
     pipe.process(c);
-    EXPECT_EQ(copy.find<KeyframeDecision>()->reason, KeyframeReason::Similar);
+    EXPECT_EQ(copy.find<KeyframeDecision>()->reason, KeyframeReason::Covered);
 }
 
 TEST(Pipeline, InitializeKeepsTheRegistryItWasBuiltWith) {

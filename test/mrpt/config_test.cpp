@@ -77,7 +77,7 @@ TEST(Config, KfdDefaultsAreDefaultIniCompiledIn) {
     EXPECT_EQ(kfd::kfdDefaults().get<kfd::DenoiseStage>().variant, kfd::DenoiseVariant::Evidence);
 }
 
-TEST(Config, EveryShippedNonPaperPresetUsesTheEvidenceDenoiser) {
+TEST(Config, EveryShippedNonPaperPresetUsesTheViewSelectorAndTheEvidenceDenoiser) {
     namespace fs = std::filesystem;
     std::size_t seen = 0;
     for (const char* dir : {KFD_SHARE_DIR, KFD_SHARE_DIR "/../kfd-icp-slam"})
@@ -88,6 +88,8 @@ TEST(Config, EveryShippedNonPaperPresetUsesTheEvidenceDenoiser) {
             const bool paper = e.path().filename().string().rfind("paper-", 0) == 0;
             EXPECT_EQ(p.get<kfd::DenoiseStage>().variant,
                       paper ? kfd::DenoiseVariant::Reference : kfd::DenoiseVariant::Evidence);
+            EXPECT_EQ(p.get<kfd::KeyframeStage>().selector,
+                      paper ? kfd::KeyframeRule::Paper : kfd::KeyframeRule::View);
             ++seen;
         }
     EXPECT_GE(seen, 9u);

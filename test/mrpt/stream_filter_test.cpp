@@ -27,7 +27,8 @@ mrpt::obs::CObservation2DRangeScan roomScan(std::size_t beams, double aperture, 
 }
 
 kfd::Pipeline::Params paperParams() {
-    kfd::Pipeline::Params p;  // built-in defaults with the guards off
+    kfd::Pipeline::Params p;  // built-in defaults, the paper's selector, the guards off
+    p.get<kfd::KeyframeStage>().selector = kfd::KeyframeRule::Paper;
     p.get<kfd::KeyframeStage>().max_consecutive_drops = 0;
     p.get<kfd::KeyframeStage>().max_interval_s = 0;
     p.get<kfd::KeyframeStage>().max_translation_m = 0;

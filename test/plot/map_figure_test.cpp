@@ -53,3 +53,21 @@ TEST(MapFigure, GroundTruthIsAlignedToTheEstimate) {
     EXPECT_TRUE(green);
     EXPECT_THROW(kfd::renderMapFigure(kfd::MapFigureInput{}), kfd::PlotError);
 }
+
+TEST(MapFigure, DegenerateScansAreMarkedOrange) {
+    mrpt::maps::COccupancyGridMap2D grid(-5, 5, -5, 5, 0.05f);
+    kfd::MapFigureInput in;
+    in.grid = &grid;
+    for (int k = 0; k <= 20; ++k) in.estimate.push_back({double(k), {-2.0 + 0.2 * k, 1.0, 0.0}});
+    in.corridor = {15};  // x = 1 m
+    const auto img = kfd::renderMapFigure(in);
+    auto orange = [&](double x) {
+        const auto p = kfd::mapFigurePixel(grid, x, 1.0);
+        const auto c = rgbAt(img, p.first, p.second - 2);  // beside the blue line
+        return c[0] == 240 && c[1] == 130 && c[2] == 0;
+    };
+    EXPECT_TRUE(orange(1.0));
+    EXPECT_FALSE(orange(-1.0));
+    in.corridor = {99};  // out of range: ignored
+    EXPECT_NO_THROW(kfd::renderMapFigure(in));
+}

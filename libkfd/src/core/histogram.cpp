@@ -14,11 +14,20 @@ std::size_t Histogram::compute(const Scan& scan, std::vector<double>& out) const
     const std::size_t beams = scan.range.size();
     out.assign(n, 0.0);
     counts_.assign(n, 0);
-    for (std::size_t i = 0; i < beams; ++i) {
-        if (!scan.valid[i]) continue;
-        const std::size_t b = (i * n) / beams;  // equal angular intervals
-        out[b] += scan.range[i];
-        ++counts_[b];
+    // Bin b holds the beams i with floor(i * n / beams) = b, i.e. i in [ceil(b * beams / n),
+    // ceil((b + 1) * beams / n)): the same split as a division per beam, without one.
+    std::size_t i = 0;
+    for (std::size_t b = 0; b < n; ++b) {
+        const std::size_t end = ((b + 1) * beams + n - 1) / n;
+        double sum = 0.0;
+        std::size_t count = 0;
+        for (; i < end; ++i) {
+            if (!scan.valid[i]) continue;
+            sum += scan.range[i];
+            ++count;
+        }
+        out[b] = sum;
+        counts_[b] = count;
     }
     std::size_t filled = 0;
     for (std::size_t b = 0; b < n; ++b) {

@@ -26,8 +26,22 @@ const char* toString(KeyframeReason r) {
             return "rotation";
         case KeyframeReason::Similar:
             return "similar";
+        case KeyframeReason::ViewChange:
+            return "view_change";
+        case KeyframeReason::Corridor:
+            return "corridor";
+        case KeyframeReason::Covered:
+            return "covered";
     }
     return "unknown";
+}
+
+const char* toString(KeyframeRule r) { return r == KeyframeRule::Paper ? "paper" : "view"; }
+
+KeyframeRule parseKeyframeRule(const std::string& s) {
+    if (s == "paper") return KeyframeRule::Paper;
+    if (s == "view") return KeyframeRule::View;
+    throw ParameterError("selector", "unknown selector '" + s + "' (paper or view)");
 }
 
 void KeyframeSelector::initialize(const Params& p) {
@@ -42,6 +56,7 @@ void KeyframeSelector::initialize(const Params& p) {
         bad("max_translation_m", "max_translation_m must be >= 0 (0 = off)");
     if (!(p.max_rotation_deg >= 0.0))
         bad("max_rotation_deg", "max_rotation_deg must be >= 0 (0 = off)");
+    view_.initialize(p.view);  // validates the view keys (their own field names)
     params_ = p;
     histogram_.initialize(Histogram::Params{p.bins});
     window_.assign(p.window * p.bins, 0.0);
@@ -55,6 +70,42 @@ void KeyframeSelector::reset() {
     drops_ = 0;
     have_stamp_ = false;
     last_odometry_.reset();
+    view_.reset();
+}
+
+void KeyframeSelector::applyGuards(KeyframeDecision& d, double timestamp,
+                                   const std::optional<Pose2D>& odometry) {
+    // Guards, in order of precedence.
+    const double dt = timestamp - last_stamp_;
+    if (params_.max_consecutive_drops > 0 && drops_ + 1 > params_.max_consecutive_drops) {
+        d.keyframe = true;
+        d.reason = KeyframeReason::MaxDrops;
+    } else if (params_.max_interval_s > 0.0 && have_stamp_ && std::isfinite(timestamp) &&
+               dt >= params_.max_interval_s) {
+        d.keyframe = true;
+        d.reason = KeyframeReason::MaxInterval;
+    } else if (odometry && last_odometry_) {
+        const double dx = odometry->x - last_odometry_->x;
+        const double dy = odometry->y - last_odometry_->y;
+        const double dphi = wrapAngle(odometry->phi - last_odometry_->phi);
+        if (params_.max_translation_m > 0.0 && std::hypot(dx, dy) >= params_.max_translation_m) {
+            d.keyframe = true;
+            d.reason = KeyframeReason::Translation;
+        } else if (params_.max_rotation_deg > 0.0 &&
+                   std::abs(dphi) * 180.0 / kPi >= params_.max_rotation_deg) {
+            d.keyframe = true;
+            d.reason = KeyframeReason::Rotation;
+        }
+    }
+}
+
+void KeyframeSelector::keep(double timestamp, const std::optional<Pose2D>& odometry) {
+    drops_ = 0;
+    if (std::isfinite(timestamp)) {
+        last_stamp_ = timestamp;
+        have_stamp_ = true;
+    }
+    if (odometry) last_odometry_ = odometry;
 }
 
 KeyframeDecision KeyframeSelector::decide(const std::vector<double>& h, double timestamp,
@@ -81,43 +132,14 @@ KeyframeDecision KeyframeSelector::decide(const std::vector<double>& h, double t
         d.p_threshold = std::pow(params_.p_pair, static_cast<double>(count_));
         d.keyframe = p < d.p_threshold;
         d.reason = d.keyframe ? KeyframeReason::Dissimilar : KeyframeReason::Similar;
-        if (!d.keyframe) {
-            // Guards, in order of precedence.
-            const double dt = timestamp - last_stamp_;
-            if (params_.max_consecutive_drops > 0 && drops_ + 1 > params_.max_consecutive_drops) {
-                d.keyframe = true;
-                d.reason = KeyframeReason::MaxDrops;
-            } else if (params_.max_interval_s > 0.0 && have_stamp_ && std::isfinite(timestamp) &&
-                       dt >= params_.max_interval_s) {
-                d.keyframe = true;
-                d.reason = KeyframeReason::MaxInterval;
-            } else if (odometry && last_odometry_) {
-                const double dx = odometry->x - last_odometry_->x;
-                const double dy = odometry->y - last_odometry_->y;
-                const double dphi = wrapAngle(odometry->phi - last_odometry_->phi);
-                if (params_.max_translation_m > 0.0 &&
-                    std::hypot(dx, dy) >= params_.max_translation_m) {
-                    d.keyframe = true;
-                    d.reason = KeyframeReason::Translation;
-                } else if (params_.max_rotation_deg > 0.0 &&
-                           std::abs(dphi) * 180.0 / kPi >= params_.max_rotation_deg) {
-                    d.keyframe = true;
-                    d.reason = KeyframeReason::Rotation;
-                }
-            }
-        }
+        if (!d.keyframe) applyGuards(d, timestamp, odometry);
     }
 
     if (d.keyframe) {
         std::copy(h.begin(), h.end(), window_.begin() + head_ * params_.bins);
         head_ = (head_ + 1) % params_.window;
         count_ = std::min(count_ + 1, params_.window);
-        drops_ = 0;
-        if (std::isfinite(timestamp)) {
-            last_stamp_ = timestamp;
-            have_stamp_ = true;
-        }
-        if (odometry) last_odometry_ = odometry;
+        keep(timestamp, odometry);
     } else {
         ++drops_;
     }
@@ -126,8 +148,34 @@ KeyframeDecision KeyframeSelector::decide(const std::vector<double>& h, double t
 }
 
 KeyframeDecision KeyframeSelector::filter(const Scan& scan) {
-    histogram_.compute(scan, scratch_);
-    return decide(scratch_, scan.timestamp, scan.odometry);
+    if (params_.selector == KeyframeRule::Paper) {
+        histogram_.compute(scan, scratch_);
+        return decide(scratch_, scan.timestamp, scan.odometry);
+    }
+    const ViewMeasure m = view_.measure(scan);
+    KeyframeDecision d;
+    d.references = view_.hasKeyframe() ? 1 : 0;
+    d.view_change = m.view_change;
+    d.changed_fraction = m.changed_fraction;
+    d.degeneracy = m.degeneracy;
+    d.corridor = m.corridor;
+    d.keyframe = m.keyframe;
+    if (!view_.hasKeyframe())
+        d.reason = KeyframeReason::First;
+    else if (m.keyframe)
+        d.reason = m.corridor ? KeyframeReason::Corridor : KeyframeReason::ViewChange;
+    else {
+        d.reason = KeyframeReason::Covered;
+        applyGuards(d, scan.timestamp, scan.odometry);
+    }
+    if (d.keyframe) {
+        view_.accept(scan);
+        keep(scan.timestamp, scan.odometry);
+    } else {
+        ++drops_;
+    }
+    d.consecutive_drops = drops_;
+    return d;
 }
 
 }  // namespace kfd

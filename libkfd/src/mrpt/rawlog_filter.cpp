@@ -39,7 +39,7 @@ class CsvWriter {
         if (!out_) throw RawlogError("cannot write the stats file " + final_path, final_path);
         out_ << "index,timestamp,sensor,keyframe,reason,p_common,p_threshold,references,"
                 "points_in,removed_range,clusters,noise_clusters,removed_noise,points_out,"
-                "microseconds\n";
+                "microseconds,view_change,changed_fraction,degeneracy,corridor\n";
     }
     bool isOpen() const { return out_.is_open(); }
     void row(std::size_t index, double stamp, const StreamResult& r) {
@@ -49,19 +49,21 @@ class CsvWriter {
         const auto d = s.findOrDefault<DistanceFilter::Result>();
         const auto n = s.findOrDefault<Denoiser::Result>();
         char buf[512];
-        std::snprintf(buf, sizeof(buf),
-                      "%zu,%.6f,%s,%d,%s,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu,%zu,%zu,%.2f\n", index,
-                      stamp, r.sensor_label.c_str(), r.keep ? 1 : 0,
-                      kf ? toString(kf->reason) : "none", k.p_common, k.p_threshold, k.references,
-                      s.points_in, d.removed_non_finite + d.removed_out_of_range, n.clusters,
-                      n.noise_clusters, s.noiseRemoved(), s.points_out, s.microseconds);
+        std::snprintf(
+            buf, sizeof(buf),
+            "%zu,%.6f,%s,%d,%s,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu,%zu,%zu,%.2f,%.4f,%.4f,%.4f,%d\n",
+            index, stamp, r.sensor_label.c_str(), r.keep ? 1 : 0,
+            kf ? toString(kf->reason) : "none", k.p_common, k.p_threshold, k.references,
+            s.points_in, d.removed_non_finite + d.removed_out_of_range, n.clusters,
+            n.noise_clusters, s.noiseRemoved(), s.points_out, s.microseconds, k.view_change,
+            k.changed_fraction, k.degeneracy, k.corridor ? 1 : 0);
         out_ << buf;
     }
     void skippedRow(std::size_t index, double stamp, const std::string& sensor, ScanSkipReason why,
                     std::size_t points_in) {
         char buf[256];
-        std::snprintf(buf, sizeof(buf), "%zu,%.6f,%s,0,skipped:%s,0,0,0,%zu,0,0,0,0,0,0\n", index,
-                      stamp, sensor.c_str(), toString(why), points_in);
+        std::snprintf(buf, sizeof(buf), "%zu,%.6f,%s,0,skipped:%s,0,0,0,%zu,0,0,0,0,0,0,0,0,1,0\n",
+                      index, stamp, sensor.c_str(), toString(why), points_in);
         out_ << buf;
     }
     void close() {
@@ -169,6 +171,10 @@ bool Run::handleScan(CObservation2DRangeScan& scan) {
     sum_.points_in += r.report.points_in;
     sum_.filter_seconds += r.report.microseconds * 1e-6;
     sum_.geometry_resets += r.geometry_reset ? 1 : 0;
+    if (const auto* kf = r.report.find<KeyframeDecision>()) {
+        sum_.scans_corridor += kf->corridor ? 1 : 0;
+        sum_.keyframes_corridor += kf->reason == KeyframeReason::Corridor ? 1 : 0;
+    }
     if (r.keep) {
         ++sum_.scans_kept;
         const auto d = r.report.findOrDefault<DistanceFilter::Result>();

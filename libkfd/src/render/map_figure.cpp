@@ -49,10 +49,15 @@ mrpt::img::CImage renderMapFigure(const MapFigureInput& in) {
         for (auto& p : odo) p.pose = compose(t, p.pose);
     }
     const TColor grey(150, 150, 150), green(30, 160, 60), blue(30, 90, 220), navy(10, 20, 90),
-        black(0, 0, 0);
+        black(0, 0, 0), orange(240, 130, 0);
     path(img, g, odo, grey, 1);
     path(img, g, gt, green, 5);  // wide: stays visible under an accurate estimate
     path(img, g, in.estimate, blue, 2);
+    for (const auto k : in.corridor) {  // under the keyframe dots
+        if (k >= in.estimate.size()) continue;
+        const auto p = mapFigurePixel(g, in.estimate[k].pose.x, in.estimate[k].pose.y);
+        img.filledRectangle(p.first - 2, p.second - 2, p.first + 2, p.second + 2, orange);
+    }
     for (const auto k : in.keyframes) {
         if (k >= in.estimate.size()) continue;
         const auto p = mapFigurePixel(g, in.estimate[k].pose.x, in.estimate[k].pose.y);
@@ -74,6 +79,7 @@ mrpt::img::CImage renderMapFigure(const MapFigureInput& in) {
     entry(blue, "estimate (dots: keyframes)");
     if (!gt.empty()) entry(green, "ground truth (aligned)");
     if (!odo.empty()) entry(grey, "odometry");
+    if (!in.corridor.empty()) entry(orange, "corridor switch: degenerate scans");
     const int bar = static_cast<int>(std::lround(1.0 / g.getResolution()));
     const int by = static_cast<int>(img.getHeight()) - 12;
     img.line(8, by, 8 + bar, by, black, 2);

@@ -38,6 +38,12 @@ std::string reportMarkdown(const IcpSlamSummary& sum) {
                   sum.scans_in, sum.scans_kept, sum.dropped_pct, sum.points_removed, sum.points_in,
                   sum.prefilter_us_per_scan, sum.icp_ms_per_scan, sum.cpu_s_total);
     r += line;
+    if (sum.scans_corridor) {
+        std::snprintf(line, sizeof(line),
+                      "- corridor switch: %zu scans degenerate (orange in the figure)\n",
+                      sum.scans_corridor);
+        r += line;
+    }
     if (sum.relations) {
         std::snprintf(line, sizeof(line),
                       "- relations error (%zu used, %zu unmatched): %.4f +- %.4f m, %.3f +- "
@@ -76,6 +82,7 @@ void writeMap(const IcpSlamResult& res, const fs::path& out) {
     fig.ground_truth = res.ground_truth;
     fig.odometry = res.odometry;
     fig.keyframes = res.keyframes;
+    fig.corridor = res.corridor;
     fig.title = fs::path(sum.rawlog).filename().string() + "  mode " + toString(sum.mode);
     if (!renderMapFigure(fig).saveToFile((out / "map_figure.png").string()))
         throw SlamError("cannot write " + (out / "map_figure.png").string());
@@ -106,6 +113,7 @@ std::string toJson(const IcpSlamSummary& s) {
     j["scans_in"] = s.scans_in;
     j["scans_kept"] = s.scans_kept;
     j["dropped_pct"] = s.dropped_pct;
+    j["scans_corridor"] = s.scans_corridor;
     j["scans_skipped"] = s.scans_skipped;  // kfd::checkScan: bad geometry, never reached ICP
     {
         nlohmann::ordered_json by_reason = nlohmann::ordered_json::object();

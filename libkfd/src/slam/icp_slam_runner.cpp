@@ -318,7 +318,7 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
     std::ofstream f_path(out / "log_estimated_path.txt"), f_csv(out / "scans.csv");
     if (!f_path || !f_csv) throw SlamError("cannot write into " + sum.output_dir);
     f_csv << "index,timestamp,sensor,kept,reason,p_common,points_in,points_removed,prefilter_us,"
-             "x,y,phi\n";
+             "x,y,phi,view_change,degeneracy,corridor\n";
 
     auto source = openLog(sum.rawlog);
     const double total_bytes =
@@ -424,16 +424,23 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
             traj.push_back(StampedPose{s.t, Pose2D{pose.x(), pose.y(), pose.yaw()}});
             const auto& rep = s.r.report;
             const auto* kf = rep.find<KeyframeDecision>();
+            if (kf && kf->corridor) {
+                res.corridor.push_back(traj.size());
+                ++sum.scans_corridor;
+            }
             const std::string skipped = s.skipped != ScanSkipReason::None
                                             ? std::string("skipped:") + toString(s.skipped)
                                             : std::string();
-            std::snprintf(buf, sizeof(buf), "%zu,%.6f,%s,%d,%s,%.6f,%zu,%zu,%.2f,%.6f,%.6f,%.6f\n",
+            std::snprintf(buf, sizeof(buf),
+                          "%zu,%.6f,%s,%d,%s,%.6f,%zu,%zu,%.2f,%.6f,%.6f,%.6f,%.4f,%.4f,%d\n",
                           traj.size() - 1, s.t, s.sensor.c_str(), s.r.keep ? 1 : 0,
                           !skipped.empty() ? skipped.c_str()
                           : kf             ? toString(kf->reason)
                                            : (s.r.keep ? "kept" : rep.dropped_by.c_str()),
                           kf ? kf->p_common : 0.0, rep.points_in, rep.points_in - rep.points_out,
-                          rep.microseconds, pose.x(), pose.y(), pose.yaw());
+                          rep.microseconds, pose.x(), pose.y(), pose.yaw(),
+                          kf ? kf->view_change : 0.0, kf ? kf->degeneracy : 1.0,
+                          kf && kf->corridor ? 1 : 0);
             f_csv << buf;
         }
         ++step_no;

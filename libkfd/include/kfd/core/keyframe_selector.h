@@ -4,11 +4,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "kfd/core/error.h"
 #include "kfd/core/histogram.h"
 #include "kfd/core/scan.h"
+#include "kfd/core/view_selector.h"
 
 namespace kfd {
 
@@ -21,6 +23,9 @@ enum class KeyframeReason : std::uint8_t {
     Translation,  // guard: odometry moved too far since the last keyframe
     Rotation,     // guard: odometry turned too far since the last keyframe (rotation in place)
     Similar,      // P_common >= P_threshold: dropped
+    ViewChange,   // view selector: the view moved beyond the keyframe's
+    Corridor,     // view selector, degenerate scene: odometry (or time) since the keyframe
+    Covered,      // view selector: the keyframe covers this view: dropped
 };
 const char* toString(KeyframeReason r);
 
@@ -33,9 +38,26 @@ struct KeyframeDecision {
     double min_similarity = 0.0;  // the weakest pairwise similarity in the window
     std::size_t references = 0;   // k: keyframes compared against (<= window)
     std::size_t consecutive_drops = 0;  // drops since the last keyframe, this one included
+    // the view selector's measures (selector = view; 0 / 1 / false otherwise)
+    double view_change = 0.0;       // RMS displacement since the keyframe, in tolerances
+    double changed_fraction = 0.0;  // laser only: share of common returns that changed
+    double degeneracy = 1.0;        // lambda_min / lambda_max of the normals' information
+    bool corridor = false;          // degeneracy below the switch's ratio
 };
 
-/// Sliding window of the m latest keyframe histograms (Sec. 3.1.4).
+/// Which rule decides novelty: the paper's histogram correlation (Formula 3) or kfd's view
+/// change (view_selector.h). The guards apply to both.
+enum class KeyframeRule : std::uint8_t { Paper, View };
+const char* toString(KeyframeRule r);
+/// "paper" or "view"; kfd::ParameterError (field "selector") otherwise.
+KeyframeRule parseKeyframeRule(const std::string& s);
+
+/// Keyframe selection. With selector = paper (the `reference` and `paper-*` presets): a sliding
+/// window of the m latest keyframe histograms (Sec. 3.1.4), below. With selector = view (kfd's
+/// default): ViewSelector decides whether the view moved beyond the last keyframe's, and the
+/// histogram is not computed.
+///
+/// Paper rule:
 ///
 /// For a target scan with histogram h, P_common = prod_j max(0, pearson(h, K_j)) over the k <= m
 /// keyframes K_j in the window (Formula 3); the scan is dropped when P_common >= P_pair^k and is a
@@ -48,7 +70,8 @@ struct KeyframeDecision {
 class KeyframeSelector {
   public:
     struct Params {
-        std::size_t bins = 20;   // n, histogram columns (Sec. 3.1.2)
+        KeyframeRule selector = KeyframeRule::View;  // novelty rule; Paper = Formula 3
+        std::size_t bins = 20;                       // n, histogram columns (Sec. 3.1.2)
         std::size_t window = 8;  // m, sliding-window size (Sec. 3.1.4, Formulas 4-5)
         double p_pair = 0.985;   // P_pair; P_threshold = P_pair^m (Formula 3)
         // Guards (beyond the paper). 0 disables a guard.
@@ -56,6 +79,7 @@ class KeyframeSelector {
         double max_interval_s = 2.0;             // T (s) since the last keyframe
         double max_translation_m = 0.5;          // D (m) of odometry travel since the last keyframe
         double max_rotation_deg = 15.0;          // A (deg) of odometry turn since the last keyframe
+        ViewSelector::Params view;               // selector = view
     };
 
     KeyframeSelector() { initialize(Params{}); }
@@ -72,17 +96,21 @@ class KeyframeSelector {
     KeyframeDecision decide(const std::vector<double>& histogram, double timestamp,
                             const std::optional<Pose2D>& odometry);
 
-    /// Builds the scan's histogram (Sec. 3.1.2) and decides. Does not modify the scan.
+    /// Decides on the scan (paper: builds its histogram, Sec. 3.1.2; view: ViewSelector).
+    /// Does not modify the scan.
     KeyframeDecision filter(const Scan& scan);
 
     std::size_t windowSize() const { return count_; }
     const std::vector<double>& lastHistogram() const { return scratch_; }
 
   private:
+    void applyGuards(KeyframeDecision& d, double timestamp, const std::optional<Pose2D>& odometry);
+    void keep(double timestamp, const std::optional<Pose2D>& odometry);
     const double* slot(std::size_t i) const { return &window_[i * params_.bins]; }
 
     Params params_;
     Histogram histogram_;
+    ViewSelector view_;
     std::vector<double> window_;   // window * bins, ring buffer of keyframe histograms
     std::vector<double> scratch_;  // the latest histogram
     std::size_t head_ = 0;         // next slot to overwrite

@@ -53,6 +53,8 @@ struct RawlogFilterSummary {
     std::size_t scans_in = 0;
     std::size_t scans_kept = 0;
     std::size_t scans_dropped = 0;
+    std::size_t scans_corridor = 0;      // scans the corridor switch found degenerate
+    std::size_t keyframes_corridor = 0;  // keyframes the switch made (odometry or time)
     /// Scans skipped by kfd::checkScan (bad geometry, kfd/mrpt/scan_check.h): not run through
     /// the pipeline and dropped from the output like a non-keyframe (not in scans_dropped).
     std::size_t scans_skipped = 0;

@@ -19,11 +19,13 @@ struct MapFigureInput {
     Trajectory ground_truth;  // any frame: aligned to the estimate (SE(2), least squares)
     Trajectory odometry;      // any frame: its first pose is put on the estimate's first pose
     std::vector<std::size_t> keyframes;  // indices into `estimate` of scans that were kept
+    std::vector<std::size_t> corridor;   // indices into `estimate` of degenerate scans (orange)
     std::string title;
 };
 
 /// Draws with MRPT's 2D canvas (no OpenGL): the grid (+y up), the odometry (grey), the ground
-/// truth (green) and the estimate (blue) with keyframes as small dots, a legend, the title and a
+/// truth (green) and the estimate (blue) with keyframes as small dots and the scans the corridor
+/// switch found degenerate in orange, a legend, the title and a
 /// 1 m scale bar. Throws PlotError without a grid.
 mrpt::img::CImage renderMapFigure(const MapFigureInput& in);
 

@@ -62,6 +62,7 @@ struct IcpSlamSummary {
     std::string rawlog, output_dir;
     std::size_t entries = 0;
     std::size_t scans_in = 0, scans_kept = 0;
+    std::size_t scans_corridor = 0;  // scans the corridor switch found degenerate
     /// Scans skipped by kfd::checkScan (bad geometry): in scans_in, never reached ICP; scans.csv
     /// reason "skipped:<reason>"; their pose is propagated like a dropped scan's.
     std::size_t scans_skipped = 0;
@@ -96,6 +97,7 @@ struct IcpSlamResult {
     Trajectory trajectory;               // one pose per input scan (time order of the log)
     Trajectory odometry;                 // the odometry of every input scan that had one
     std::vector<std::size_t> keyframes;  // indices into `trajectory` of the kept scans
+    std::vector<std::size_t> corridor;   // ... of the scans the corridor switch found degenerate
     Trajectory ground_truth;             // ground_truth_tum, sorted by time (empty without it)
     std::optional<mrpt::maps::CSimpleMap> map;  // the built map, with write_map
     /// The staged output folder holding what run() wrote; writeIcpSlamReport() adds the report
