@@ -104,7 +104,8 @@ int main(int argc, char** argv) {
         ->type_name("FILE");
     cli.option("--stats", opts.stats_csv,
                "per-scan CSV (timestamp, sensor, keyframe, reason, P_common,\n"
-               "clusters, points removed, microseconds)")
+               "clusters, points removed, microseconds, view change,\n"
+               "changed fraction, degeneracy, corridor)")
         ->type_name("FILE");
     cli.option("--compress", opts.compress_level, "gzip level of the output, 0-9")
         ->type_name("N")
