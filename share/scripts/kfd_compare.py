@@ -38,6 +38,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import kfd_diagnose  # noqa: E402
 import kfd_stats  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -495,7 +496,6 @@ def main(argv=None):
             run_job(a)
             return 0
         if a.command == "diagnose":
-            import kfd_diagnose
             text = kfd_diagnose.diagnose(a.dir, a.modes, a.reference, a.split_seconds,
                                          a.datasets)
             with open(os.path.join(a.dir, "diagnose.md"), "w") as f:

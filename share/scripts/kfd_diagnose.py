@@ -12,7 +12,8 @@ import csv
 import json
 import math
 import os
-import statistics
+
+from kfd_stats import median, quantile
 
 STATIONARY_M, STATIONARY_DEG = 0.005, 0.3
 TRANS_BINS = [(0.0, 0.15), (0.15, 0.3), (0.3, float("inf"))]
@@ -55,13 +56,6 @@ def between(a, b):
     dx, dy = b[1] - a[1], b[2] - a[2]
     c, s = math.cos(a[3]), math.sin(a[3])
     return (c * dx + s * dy, -s * dx + c * dy, wrap(b[3] - a[3]))
-
-
-def quantile(v, q):
-    if not v:
-        return float("nan")
-    v = sorted(v)
-    return v[min(len(v) - 1, int(q * len(v)))]
 
 
 class Nearest:
@@ -179,7 +173,7 @@ def diagnose(out, modes, reference="none", split_s=10.0, datasets=None, max_dt=1
                     for kind, bins in (("trans", TRANS_BINS), ("rot", ROT_BINS)):
                         for lo, _ in bins:
                             v = res[m]["by_bin"].get((kind, lo), [])
-                            cells.append("%.3f [%d]" % (statistics.median(v), len(v)) if v else "–")
+                            cells.append("%.3f [%d]" % (median(v), len(v)) if v else "–")
                     lines.append("| %s | %s |" % (m, " | ".join(cells)))
             lines.append("")
     return "\n".join(lines) + "\n"
