@@ -40,6 +40,15 @@ TEST(Trajectory, WrapAngle) {
     EXPECT_NEAR(kfd::wrapAngle(0.25), 0.25, 1e-15);
 }
 
+TEST(Trajectory, TravelIsDistanceAndWrappedTurn) {
+    const auto t = kfd::travel({1, 2, 3.0}, {4, 6, -3.0});  // 3-4-5; -3 - 3 wraps to 2 pi - 6
+    EXPECT_NEAR(t.metres, 5.0, 1e-12);
+    EXPECT_NEAR(t.degrees, (2 * M_PI - 6.0) * 180.0 / M_PI, 1e-9);
+    const auto none = kfd::travel({1, 2, 0.5}, {1, 2, 0.5});
+    EXPECT_EQ(none.metres, 0.0);
+    EXPECT_EQ(none.degrees, 0.0);
+}
+
 TEST(Trajectory, TumRoundTrip) {
     kfd::Trajectory t{{100.5, {1, 2, 0.3}}, {101.0, {-4, 5, -3.0}}, {101.25, {0, 0, M_PI}}};
     const auto f = tempFile("roundtrip.tum");

@@ -22,10 +22,9 @@ bool MotionFilter::keep(double timestamp, const std::optional<Pose2D>& odometry)
     if (!odometry) return true;
     bool take = !have_ref_;
     if (!take) {
-        const double d = std::hypot(odometry->x - ref_pose_.x, odometry->y - ref_pose_.y);
-        const double a = std::abs(wrapAngle(odometry->phi - ref_pose_.phi)) * 180.0 / kPi;
-        take = (params_.max_distance_m > 0.0 && d >= params_.max_distance_m) ||
-               (params_.max_angle_deg > 0.0 && a >= params_.max_angle_deg) ||
+        const Travel t = travel(ref_pose_, *odometry);
+        take = (params_.max_distance_m > 0.0 && t.metres >= params_.max_distance_m) ||
+               (params_.max_angle_deg > 0.0 && t.degrees >= params_.max_angle_deg) ||
                (params_.max_interval_s > 0.0 && have_stamp_ && std::isfinite(timestamp) &&
                 timestamp - ref_stamp_ >= params_.max_interval_s);
     }

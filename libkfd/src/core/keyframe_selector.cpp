@@ -85,27 +85,30 @@ void KeyframeSelector::applyGuards(KeyframeDecision& d, double timestamp,
         d.keyframe = true;
         d.reason = KeyframeReason::MaxInterval;
     } else if (odometry && last_odometry_) {
-        const double dx = odometry->x - last_odometry_->x;
-        const double dy = odometry->y - last_odometry_->y;
-        const double dphi = wrapAngle(odometry->phi - last_odometry_->phi);
-        if (params_.max_translation_m > 0.0 && std::hypot(dx, dy) >= params_.max_translation_m) {
+        const Travel t = travel(*last_odometry_, *odometry);
+        if (params_.max_translation_m > 0.0 && t.metres >= params_.max_translation_m) {
             d.keyframe = true;
             d.reason = KeyframeReason::Translation;
-        } else if (params_.max_rotation_deg > 0.0 &&
-                   std::abs(dphi) * 180.0 / kPi >= params_.max_rotation_deg) {
+        } else if (params_.max_rotation_deg > 0.0 && t.degrees >= params_.max_rotation_deg) {
             d.keyframe = true;
             d.reason = KeyframeReason::Rotation;
         }
     }
 }
 
-void KeyframeSelector::keep(double timestamp, const std::optional<Pose2D>& odometry) {
-    drops_ = 0;
-    if (std::isfinite(timestamp)) {
-        last_stamp_ = timestamp;
-        have_stamp_ = true;
+void KeyframeSelector::record(KeyframeDecision& d, double timestamp,
+                              const std::optional<Pose2D>& odometry) {
+    if (d.keyframe) {
+        drops_ = 0;
+        if (std::isfinite(timestamp)) {
+            last_stamp_ = timestamp;
+            have_stamp_ = true;
+        }
+        if (odometry) last_odometry_ = odometry;
+    } else {
+        ++drops_;
     }
-    if (odometry) last_odometry_ = odometry;
+    d.consecutive_drops = drops_;
 }
 
 KeyframeDecision KeyframeSelector::decide(const std::vector<double>& h, double timestamp,
@@ -139,11 +142,8 @@ KeyframeDecision KeyframeSelector::decide(const std::vector<double>& h, double t
         std::copy(h.begin(), h.end(), window_.begin() + head_ * params_.bins);
         head_ = (head_ + 1) % params_.window;
         count_ = std::min(count_ + 1, params_.window);
-        keep(timestamp, odometry);
-    } else {
-        ++drops_;
     }
-    d.consecutive_drops = drops_;
+    record(d, timestamp, odometry);
     return d;
 }
 
@@ -168,13 +168,8 @@ KeyframeDecision KeyframeSelector::filter(const Scan& scan) {
         d.reason = KeyframeReason::Covered;
         applyGuards(d, scan.timestamp, scan.odometry);
     }
-    if (d.keyframe) {
-        view_.accept(scan);
-        keep(scan.timestamp, scan.odometry);
-    } else {
-        ++drops_;
-    }
-    d.consecutive_drops = drops_;
+    if (d.keyframe) view_.accept(scan);
+    record(d, scan.timestamp, scan.odometry);
     return d;
 }
 

@@ -21,4 +21,9 @@ double wrapAngle(double a) {
     return a <= -kPi ? a + 2.0 * kPi : a;
 }
 
+Travel travel(const Pose2D& a, const Pose2D& b) {
+    return Travel{std::hypot(b.x - a.x, b.y - a.y),
+                  std::abs(wrapAngle(b.phi - a.phi)) * 180.0 / kPi};
+}
+
 }  // namespace kfd

@@ -43,10 +43,14 @@ void ViewSelector::reset() {
     kf_have_stamp_ = false;
 }
 
+std::size_t ViewSelector::stride(std::size_t beams) const {
+    return std::max<std::size_t>(1, (beams + params_.max_samples - 1) / params_.max_samples);
+}
+
 ViewMeasure ViewSelector::measure(const Scan& scan) {
     const Params& p = params_;
     const std::size_t beams = scan.range.size();
-    const std::size_t k = std::max<std::size_t>(1, (beams + p.max_samples - 1) / p.max_samples);
+    const std::size_t k = stride(beams);
     const std::size_t n = (beams + k - 1) / k;
     dirs_.update(scan.geometry);
 
@@ -134,10 +138,11 @@ ViewMeasure ViewSelector::measure(const Scan& scan) {
             e2 += 2.0 * (1.0 - std::cos(rel.phi)) * q / static_cast<double>(points);
         }
         m.view_change = std::sqrt(std::max(0.0, e2));
-        if (m.corridor)
-            m.keyframe = std::hypot(rel.x, rel.y) >= p.corridor_translation_m ||
-                         std::abs(rel.phi) * 180.0 / kPi >= p.corridor_rotation_deg;
-        else
+        if (m.corridor) {
+            const Travel t = travel(*kf_odometry_, *scan.odometry);
+            m.keyframe =
+                t.metres >= p.corridor_translation_m || t.degrees >= p.corridor_rotation_deg;
+        } else
             m.keyframe = m.view_change >= p.max_view_change;
         return m;
     }
@@ -154,8 +159,7 @@ ViewMeasure ViewSelector::measure(const Scan& scan) {
 
 void ViewSelector::accept(const Scan& scan) {
     const std::size_t beams = scan.range.size();
-    const std::size_t k =
-        std::max<std::size_t>(1, (beams + params_.max_samples - 1) / params_.max_samples);
+    const std::size_t k = stride(beams);
     kf_samples_.resize((beams + k - 1) / k);
     for (std::size_t j = 0, i = 0; i < beams; ++j, i += k)
         kf_samples_[j] = scan.valid[i] ? scan.range[i] : std::numeric_limits<float>::quiet_NaN();

@@ -105,7 +105,9 @@ class KeyframeSelector {
 
   private:
     void applyGuards(KeyframeDecision& d, double timestamp, const std::optional<Pose2D>& odometry);
-    void keep(double timestamp, const std::optional<Pose2D>& odometry);
+    /// Updates the drop count and, for a keyframe, the reference stamp and odometry of the
+    /// guards; sets d.consecutive_drops.
+    void record(KeyframeDecision& d, double timestamp, const std::optional<Pose2D>& odometry);
     const double* slot(std::size_t i) const { return &window_[i * params_.bins]; }
 
     Params params_;

@@ -1,4 +1,5 @@
-// SE(2) helpers on kfd::Pose2D (std only): composition, inverse, relative pose, angle wrap.
+// SE(2) helpers on kfd::Pose2D (std only): composition, inverse, relative pose, angle wrap,
+// travel.
 #pragma once
 
 #include "kfd/core/scan.h"
@@ -13,5 +14,14 @@ Pose2D inverse(const Pose2D& a);
 Pose2D between(const Pose2D& a, const Pose2D& b);
 /// Wraps an angle into (-pi, pi].
 double wrapAngle(double a);
+
+/// How far b lies from a: the distance (m) and the absolute turn (deg, wrapped), what the
+/// keyframe guards, the view selector's corridor switch and the motion filter compare with
+/// their thresholds.
+struct Travel {
+    double metres = 0.0;
+    double degrees = 0.0;
+};
+Travel travel(const Pose2D& a, const Pose2D& b);
 
 }  // namespace kfd

@@ -79,6 +79,9 @@ class ViewSelector {
     bool hasKeyframe() const { return have_keyframe_; }
 
   private:
+    /// k: every k-th beam is sampled, k = ceil(beams / max_samples) (at least 1).
+    std::size_t stride(std::size_t beams) const;
+
     Params params_;
     double tan_b_ = 0.0;
     BeamDirections dirs_;
