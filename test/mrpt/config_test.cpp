@@ -262,6 +262,22 @@ TEST(Config, ConfigErrorIsAKfdErrorNamingTheKey) {
     }
 }
 
+TEST(Config, BadViewSelectorKeysAreErrorsNamingTheKey) {
+    for (const char* line :
+         {"selector = histogram", "max_view_change = 0", "view_tolerance_deg = 90",
+          "max_changed_fraction = 1.5", "degeneracy_ratio = -0.1", "corridor_interval_s = 0",
+          "view_samples = 1"}) {
+        SCOPED_TRACE(line);
+        const std::string key = std::string(line).substr(0, std::string(line).find(' '));
+        try {
+            fromIniText(std::string("[KFD]\n") + line + "\n");
+            ADD_FAILURE() << "accepted";
+        } catch (const kfd::ConfigError& e) {
+            EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+        }
+    }
+}
+
 TEST(Config, KeyTableIsDerivedFromTheStageRegistry) {
     const auto& reg = kfd::defaultStageRegistry();
     std::vector<std::string> want{"pipeline"};
