@@ -1,4 +1,5 @@
-// kfd-filter: keyframe extraction + clustering denoise of every 2D scan of a rawlog.
+// kfd-filter: keyframe extraction + clustering denoise of every 2D scan of a log (rawlog, ROS 1
+// bag, CARMEN).
 // All logic lives in kfd::RawlogFilter; this file parses arguments and reports.
 #include <algorithm>
 #include <cstdio>
@@ -6,6 +7,7 @@
 #include <vector>
 
 #include "common/cli.h"
+#include "common/source_cli.h"
 #include "kfd/core/window_helper.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/rawlog_filter.h"
@@ -15,9 +17,12 @@ namespace {
 void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSummary& s) {
     const double removed = static_cast<double>(s.points_removed_noise);
     std::printf("kfd-filter summary\n");
-    std::printf("  input    %s (%s, %zu sensor%s)\n", o.input.c_str(), s.layout.c_str(), s.sensors,
+    const std::string read = s.input_format == kfd::LogFormat::Rawlog
+                                 ? s.layout
+                                 : std::string(kfd::toString(s.input_format)) + ": " + s.layout;
+    std::printf("  input    %s (%s, %zu sensor%s)\n", o.input.c_str(), read.c_str(), s.sensors,
                 s.sensors == 1 ? "" : "s");
-    std::printf("  output   %s\n", o.output.c_str());
+    std::printf("  output   %s (%s)\n", o.output.c_str(), kfd::toString(s.output_format));
     const kfd::SensorSummary& sn = s.sensor;
     if (sn.beams) {
         std::printf("  sensor   %s%s%zu beams over %.1f deg (%.3f deg per beam)", sn.label.c_str(),
@@ -42,8 +47,14 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
     std::printf("  points   in %zu; in kept scans removed: %zu out of range, %zu noise (%.2f %%)\n",
                 s.points_in, s.points_removed_range, s.points_removed_noise,
                 s.points_in ? 100.0 * removed / static_cast<double>(s.points_in) : 0.0);
-    std::printf("  objects  in %zu, out %zu, dropped %zu, odometry actions merged %zu\n",
-                s.objects_in, s.objects_out, s.objects_dropped, s.actions_merged);
+    if (s.output_format == kfd::LogFormat::Bag)
+        std::printf(
+            "  messages in %zu, out %zu, scans dropped %zu; %zu removed points written as %s\n",
+            s.objects_in, s.objects_out, s.objects_dropped, s.points_marked,
+            kfd::toString(o.bag.removed));
+    else
+        std::printf("  objects  in %zu, out %zu, dropped %zu, odometry actions merged %zu\n",
+                    s.objects_in, s.objects_out, s.objects_dropped, s.actions_merged);
     if (s.scans_skipped) {
         std::printf("  skipped  %zu (bad geometry, dropped from the output):", s.scans_skipped);
         for (std::size_t r = 1; r < kfd::kScanSkipReasons; ++r)
@@ -81,22 +92,38 @@ void printWindowSuggestion(const std::vector<double>& a) {
 
 int main(int argc, char** argv) {
     kfd::app::Cli cli(
-        "kfd-filter", "-i IN.rawlog -o OUT.rawlog [options]",
+        "kfd-filter", "-i IN.{rawlog,bag,clf,log[.gz]} -o OUT.{rawlog,bag} [options]",
         "Drops 2D range scans that carry no new information (keyframe extraction, Hu et al. 2023)\n"
         "and removes noise points from the kept scans (clustering denoise). Every other object is\n"
         "copied unchanged and in order; odometry of dropped frames is composed into the next kept\n"
-        "action. Removed points are marked invalid (beam count and angles are kept).",
+        "action. Removed points are marked invalid (beam count and angles are kept).\n"
+        "The input's format is told by its content: an MRPT rawlog, a ROS 1 bag (LaserScan with\n"
+        "Odometry or /tf; plain, bz2 or lz4) or a CARMEN log (plain or gzip). A bag input can\n"
+        "give a bag output (-o X.bag): every other topic copied in order, the dropped scans\n"
+        "left out, removed points written as NaN (or +Inf, --removed-as; REP 117).",
         "Exit status: 0 on success, 1 on bad input or configuration (an output that is an input\n"
         "included), 2 on bad usage, 130/143 when interrupted (no output is left).");
     kfd::RawlogFilterOptions opts;
     std::string config;
     bool print_config = false, list_keys = false;
     std::vector<double> window;
-    cli.option("-i,--input", opts.input, "input rawlog (either MRPT layout, plain or gzip)")
+    bool list = false;
+    std::string compression = "lz4", removed_as = "nan";
+    cli.option("-i,--input", opts.input,
+               "input log: rawlog (either MRPT layout, plain or gzip),\n"
+               "ROS 1 bag, or CARMEN log (.clf/.log, plain or gzip)")
         ->type_name("FILE");
     cli.option("-o,--output", opts.output,
-               "output rawlog (written to a temporary file, then renamed)")
+               "output: a rawlog, or for a bag input a bag (X.bag);\n"
+               "written to a temporary file, then renamed")
         ->type_name("FILE");
+    kfd::app::addSourceOptions(cli, opts.source, list);
+    cli.option("--removed-as", removed_as, "bag output: removed points as nan or inf (REP 117)")
+        ->check(CLI::IsMember({"nan", "inf"}))
+        ->capture_default_str();
+    cli.option("--bag-compression", compression, "bag output: none, lz4 or bz2")
+        ->check(CLI::IsMember({"none", "lz4", "bz2"}))
+        ->capture_default_str();
     cli.option("-c,--config", config,
                ".ini ([KFD] section) or .yaml configuration;\n"
                "default: kfd's defaults (= share/kfd/default.ini, compiled in);\n"
@@ -128,16 +155,23 @@ int main(int argc, char** argv) {
             return;
         }
         if (!window.empty()) return printWindowSuggestion(window);
+        if (list) {
+            if (opts.input.empty()) throw kfd::app::UsageError("--list: no input log (-i)");
+            return kfd::app::printListing(opts.input, opts.source);
+        }
+        opts.bag.removed = kfd::parseRemovedMark(removed_as);
+        opts.bag.compression = compression == "none"  ? kfd::BagWriterOptions::Compression::None
+                               : compression == "bz2" ? kfd::BagWriterOptions::Compression::Bz2
+                                                      : kfd::BagWriterOptions::Compression::Lz4;
         opts.pipeline = config.empty() ? kfd::kfdDefaults() : kfd::loadConfigFile(config);
         if (print_config) {
             std::fputs(kfd::toIni(opts.pipeline).c_str(), stdout);
             return;
         }
-        if (opts.input.empty()) throw kfd::app::UsageError("no input rawlog (-i)");
-        if (opts.output.empty()) throw kfd::app::UsageError("no output rawlog (-o)");
-        kfd::app::checkOutputPaths(
-            {{"input rawlog", opts.input}, {"configuration", config}},
-            {{"output rawlog", opts.output}, {"stats file", opts.stats_csv}});
+        if (opts.input.empty()) throw kfd::app::UsageError("no input log (-i)");
+        if (opts.output.empty()) throw kfd::app::UsageError("no output (-o)");
+        kfd::app::checkOutputPaths({{"input log", opts.input}, {"configuration", config}},
+                                   {{"output", opts.output}, {"stats file", opts.stats_csv}});
         if (auto* progress = cli.progress())
             opts.on_progress = [progress](const kfd::RawlogProgress& p) {
                 progress->update(

@@ -1,19 +1,22 @@
-// kfd-icp-slam: MRPT ICP-SLAM over a rawlog with the kfd pre-filter in front.
+// kfd-icp-slam: MRPT ICP-SLAM over a log (rawlog, ROS 1 bag, CARMEN) with the kfd pre-filter in
+// front.
 // All logic lives in kfd::IcpSlamRunner; this file parses arguments and reports.
 #include <cstdio>
 #include <string>
 #include <utility>
 
 #include "common/cli.h"
+#include "common/source_cli.h"
 #include "kfd/report/slam_report.h"
 #include "kfd/slam/icp_slam_runner.h"
 
 int main(int argc, char** argv) {
     kfd::app::Cli cli(
-        "kfd-icp-slam", "CONFIG.ini [RAWLOG] [options]",
+        "kfd-icp-slam", "CONFIG.ini [LOG] [options]",
         "Runs MRPT's ICP-SLAM (CMetricMapBuilderICP) like icp-slam does, reading the same .ini\n"
         "([ICP], [MappingApplication], map definitions), with a pre-filter in front of scan\n"
-        "matching configured by an optional [KFD] section (see kfd-filter --list-keys).",
+        "matching configured by an optional [KFD] section (see kfd-filter --list-keys).\n"
+        "LOG is an MRPT rawlog, a ROS 1 bag (LaserScan with Odometry or /tf) or a CARMEN log.",
         "Writes trajectory.tum (a pose for every input scan), log_estimated_path.txt (icp-slam's\n"
         "format), scans.csv, summary.json, final_map.simplemap, map.png, map_figure.png and\n"
         "report.md into the output folder (staged in a temporary folder and moved in at the end;\n"
@@ -22,12 +25,14 @@ int main(int argc, char** argv) {
         "included), 2 on bad usage, 130/143 when interrupted (no output is left).");
     kfd::IcpSlamOptions o;
     std::string rawlog_arg;
+    bool list = false;
     cli.option("CONFIG.ini", o.config_file, "ICP-SLAM configuration (and optional [KFD])")
-        ->type_name("FILE")
-        ->required();
-    cli.option("RAWLOG", rawlog_arg, "input rawlog (or -i)")->type_name("FILE");
-    cli.option("-i,--rawlog", o.rawlog, "input rawlog (default: [MappingApplication] rawlog_file)")
         ->type_name("FILE");
+    cli.option("LOG", rawlog_arg, "input log: rawlog, ROS 1 bag or CARMEN log (or -i)")
+        ->type_name("FILE");
+    cli.option("-i,--rawlog", o.rawlog, "input log (default: [MappingApplication] rawlog_file)")
+        ->type_name("FILE");
+    kfd::app::addSourceOptions(cli, o.source, list);
     cli.option("-o,--out", o.output_dir,
                "output folder (default: [MappingApplication] "
                "logOutput_dir)")
@@ -79,9 +84,15 @@ int main(int argc, char** argv) {
     cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM
     return cli.run(argc, argv, [&] {
         if (!rawlog_arg.empty()) {
-            if (!o.rawlog.empty()) throw kfd::app::UsageError("rawlog given twice");
+            if (!o.rawlog.empty()) throw kfd::app::UsageError("input log given twice");
             o.rawlog = rawlog_arg;
         }
+        if (list) {  // `kfd-icp-slam --list LOG` (no configuration needed)
+            const std::string log = !o.rawlog.empty() ? o.rawlog : o.config_file;
+            if (log.empty()) throw kfd::app::UsageError("--list: no input log");
+            return kfd::app::printListing(log, o.source);
+        }
+        if (o.config_file.empty()) throw kfd::app::UsageError("no configuration (CONFIG.ini)");
         const bool matchable =
             o.mode == kfd::PrefilterMode::Odometry || o.mode == kfd::PrefilterMode::Decimate;
         if ((o.odometry_target_drop_pct || o.match_drop_of) && !matchable)

@@ -1,4 +1,5 @@
-// kfd-render: renders the clusters of one scan of a rawlog to PNG (off-screen, OSMesa).
+// kfd-render: renders the clusters of one scan of a log (rawlog, bag, CARMEN) to PNG (off-screen,
+// OSMesa).
 #include <mrpt/obs/CObservation2DRangeScan.h>
 
 #include <cmath>
@@ -8,6 +9,7 @@
 #include <string>
 
 #include "common/cli.h"
+#include "common/source_cli.h"
 #include "kfd/core/cancel.h"
 #include "kfd/core/denoiser.h"
 #include "kfd/core/distance_filter.h"
@@ -18,7 +20,7 @@
 
 int main(int argc, char** argv) {
     kfd::app::Cli cli(
-        "kfd-render", "-i IN.rawlog (--index N | --time T) -o OUT.png [options]",
+        "kfd-render", "-i IN.{rawlog,bag,clf} (--index N | --time T) -o OUT.png [options]",
         "Runs the distance filter and the denoiser of CONFIG on one scan and draws its clusters\n"
         "(each in its own colour), the removed noise points (red), the ring boundaries, the "
         "sensor\n"
@@ -29,7 +31,11 @@ int main(int argc, char** argv) {
     long index = -1;
     double stamp = std::nan(""), extent = 0.0;
     int size = 800;
-    cli.option("-i", in, "rawlog")->type_name("FILE")->required();
+    kfd::SourceOptions source_opts;
+    bool list = false;
+    cli.option("-i", in, "input log (rawlog, ROS 1 bag or CARMEN log)")
+        ->type_name("FILE")
+        ->required();
     cli.option("--index", index, "the N-th 2D scan (0-based)")->type_name("N");
     cli.option("--time", stamp, "the scan nearest to timestamp T (s)")->type_name("T");
     long history = 2;
@@ -39,18 +45,21 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     cli.option("-c", cfg, "configuration (.ini [KFD] or .yaml); default: kfd's defaults")
         ->type_name("FILE");
-    cli.option("-o", out, "output PNG")->type_name("FILE")->required();
+    cli.option("-o", out, "output PNG")->type_name("FILE");
+    kfd::app::addSourceOptions(cli, source_opts, list);
     cli.option("--size", size, "image width and height")->type_name("PX")->capture_default_str();
     cli.option("--extent", extent, "half the visible height in metres (default: fit the scan)")
         ->type_name("M");
     cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM
     return cli.run(argc, argv, [&] {
+        if (list) return kfd::app::printListing(in, source_opts);
+        if (out.empty()) throw kfd::app::UsageError("no output image (-o)");
         if ((index < 0) == std::isnan(stamp))
             throw kfd::app::UsageError("give exactly one of --index and --time");
-        kfd::app::checkOutputPaths({{"input rawlog", in}, {"configuration", cfg}},
+        kfd::app::checkOutputPaths({{"input log", in}, {"configuration", cfg}},
                                    {{"output image", out}});
         const kfd::Pipeline::Params p = cfg.empty() ? kfd::kfdDefaults() : kfd::loadConfigFile(cfg);
-        const auto source = kfd::openSource(in);
+        const auto source = kfd::openSource(in, source_opts);
         // The chosen scan and the `history` scans before it (with their odometry): the evidence
         // denoiser takes them as its previous keyframes.
         struct Seen {

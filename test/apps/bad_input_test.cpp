@@ -129,7 +129,7 @@ TEST(BadInputOutputPaths, FilterStatsOnTheInputRawlogIsRefused) {
     const Snapshot snap({in});
     const Result r = run(KFD_FILTER_EXE, {"-i", in, "-o", d / "out.rawlog", "--stats", in}, d.path);
     EXPECT_EQ(r.status, 1);
-    EXPECT_EQ(r.first(), "kfd-filter: the stats file " + in + " is the input rawlog " + in +
+    EXPECT_EQ(r.first(), "kfd-filter: the stats file " + in + " is the input log " + in +
                              ": refusing to overwrite an input");
     EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
     snap.expectUnchanged();
@@ -142,7 +142,7 @@ TEST(BadInputOutputPaths, FilterOutputOrStatsOnTheConfigIsRefused) {
     const Snapshot snap({in, cfg});
     Result r = run(KFD_FILTER_EXE, {"-i", in, "-c", cfg, "-o", cfg}, d.path);
     EXPECT_EQ(r.status, 1);
-    EXPECT_EQ(r.first(), "kfd-filter: the output rawlog " + cfg + " is the configuration " + cfg +
+    EXPECT_EQ(r.first(), "kfd-filter: the output " + cfg + " is the configuration " + cfg +
                              ": refusing to overwrite an input");
     r = run(KFD_FILTER_EXE, {"-i", in, "-c", cfg, "-o", d / "out.rawlog", "--stats", cfg}, d.path);
     EXPECT_EQ(r.status, 1);
@@ -162,7 +162,7 @@ TEST(BadInputOutputPaths, FilterOutputThroughASymlinkOrHardLinkToTheInputIsRefus
     for (const std::string& out : {d / "sym.rawlog", d / "hard.rawlog", d / "sub/../in.rawlog"}) {
         const Result r = run(KFD_FILTER_EXE, {"-i", in, "-o", out}, d.path);
         EXPECT_EQ(r.status, 1) << out;
-        EXPECT_EQ(r.first(), "kfd-filter: the output rawlog " + out + " is the input rawlog " + in +
+        EXPECT_EQ(r.first(), "kfd-filter: the output " + out + " is the input log " + in +
                                  ": refusing to overwrite an input");
     }
     // The symlink's target counts too, as a stats file.
@@ -181,7 +181,7 @@ TEST(BadInputOutputPaths, FilterOutputAndStatsOnTheSameFileAreRefused) {
     const std::string out = d / "out.rawlog";
     const Result r = run(KFD_FILTER_EXE, {"-i", in, "-o", out, "--stats", out}, d.path);
     EXPECT_EQ(r.status, 1);
-    EXPECT_EQ(r.first(), "kfd-filter: the stats file " + out + " is also the output rawlog " + out);
+    EXPECT_EQ(r.first(), "kfd-filter: the stats file " + out + " is also the output " + out);
     EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
     snap.expectUnchanged();
 }
@@ -295,7 +295,7 @@ TEST(BadInputOutputPaths, ChartAndRenderOutputOnTheirInputIsRefused) {
     const Snapshot snap2({in});
     r = run(KFD_RENDER_EXE, {"-i", in, "--index", "3", "-o", in}, d.path);
     EXPECT_EQ(r.status, 1);
-    EXPECT_EQ(r.first(), "kfd-render: the output image " + in + " is the input rawlog " + in +
+    EXPECT_EQ(r.first(), "kfd-render: the output image " + in + " is the input log " + in +
                              ": refusing to overwrite an input");
     snap2.expectUnchanged();
 #endif

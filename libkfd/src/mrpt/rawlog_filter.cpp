@@ -99,6 +99,7 @@ class Run {
     CsvWriter csv_;
     mrpt::io::CFileGZOutputStream out_;
     std::optional<mrpt::serialization::CArchiveStreamBase<mrpt::io::CFileGZOutputStream>> arch_;
+    std::optional<BagWriter> bag_;                // a bag output (instead of out_/arch_)
     std::shared_ptr<CActionCollection> pending_;  // action waiting for its sensory frame
     CPose2D carry_;                               // odometry of dropped frames, not yet written
     bool have_carry_ = false;
@@ -265,7 +266,7 @@ void Run::execute() {
     const auto t0 = std::chrono::steady_clock::now();
     std::error_code ec;
     if (!fs::is_regular_file(opts_.input, ec))
-        throw RawlogError("input rawlog not found: " + opts_.input);
+        throw RawlogError("input log not found: " + opts_.input);
     if (opts_.output.empty()) throw RawlogError("no output file given");
     // Before anything is opened for writing: no output may be an input or the other output.
     try {
@@ -275,16 +276,49 @@ void Run::execute() {
         throw RawlogError(e.what(), e.field());
     }
 
-    const auto source = openSource(opts_.input);
+    std::unique_ptr<Source> source;
+    try {
+        sum_.input_format = detectFormat(opts_.input);
+        const std::string& o = opts_.output;
+        sum_.output_format = o.size() > 4 && o.compare(o.size() - 4, 4, ".bag") == 0
+                                 ? LogFormat::Bag
+                                 : LogFormat::Rawlog;
+        if (sum_.output_format == LogFormat::Bag && sum_.input_format != LogFormat::Bag)
+            throw RawlogError("a bag output (" + o + ") needs a ROS bag input; " + opts_.input +
+                                  " is read as: " + toString(sum_.input_format) +
+                                  " (write a .rawlog instead)",
+                              o);
+        source = openSource(opts_.input, opts_.source);
+    } catch (const RawlogError&) {
+        throw;
+    } catch (const SourceError& e) {  // reported like every other input problem of this class
+        throw RawlogError(e.what(), e.field());
+    }
     const std::uint64_t total = source->bytesTotal();
+    if (const auto* bag = dynamic_cast<const BagSource*>(source.get())) {
+        const BagChoice& c = bag->choice();
+        sum_.layout = "scans " + c.scan_topic + ", odometry " +
+                      (c.odometry == BagChoice::Odometry::None ? std::string("none")
+                       : c.odometry == BagChoice::Odometry::Tf
+                           ? c.odom_topic + " " + c.odom_frame + "->" + c.base_frame
+                           : c.odom_topic);
+    }
 
     // Both outputs are written under temporary names beside them and renamed at the end; on
     // any failure or cancellation the destructors remove them.
     TempOutputFile tmp(opts_.output);
     std::optional<TempOutputFile> tmp_csv;
-    if (!out_.open(tmp.path().string(), opts_.compress_level))
-        throw RawlogError("cannot write the output next to " + opts_.output, opts_.output);
-    arch_.emplace(out_);
+    if (sum_.output_format == LogFormat::Bag) {
+        try {
+            bag_.emplace(tmp.path().string(), opts_.bag);
+        } catch (const SourceError& e) {
+            throw RawlogError(e.what(), opts_.output);
+        }
+    } else {
+        if (!out_.open(tmp.path().string(), opts_.compress_level))
+            throw RawlogError("cannot write the output next to " + opts_.output, opts_.output);
+        arch_.emplace(out_);
+    }
     if (!opts_.stats_csv.empty()) {
         tmp_csv.emplace(opts_.stats_csv);
         csv_.open(tmp_csv->path(), opts_.stats_csv);
@@ -294,7 +328,14 @@ void Run::execute() {
     progress.bytes_total = total;
     const std::size_t every = std::max<std::size_t>(1, opts_.progress_every);
     SourceEntry e;
-    while (source->next(e)) {
+    for (;;) {
+        try {
+            if (!source->next(e)) break;
+        } catch (const RawlogError&) {
+            throw;
+        } catch (const SourceError& err) {
+            throw RawlogError(err.what(), err.field());
+        }
         throwIfCancelled();
         const std::size_t before = sum_.objects_in;
         sum_.objects_in = e.objects_read;
@@ -313,17 +354,29 @@ void Run::execute() {
                 saw_observations_ = true;
                 flushPendingAction(true);
                 auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(e.observation);
-                if (!scan)
-                    write(*e.observation);
-                else if (handleScan(*scan))
-                    write(*scan);
-                else
+                if (!scan) {
+                    if (!bag_)
+                        write(*e.observation);  // a bag's own odometry messages are
+                                                // Native entries, copied below
+                } else if (!handleScan(*scan)) {
                     ++sum_.objects_dropped;
+                } else if (!bag_) {
+                    write(*scan);
+                } else if (e.native) {
+                    sum_.points_marked += bag_->writeScan(*e.native, *scan);
+                    ++sum_.objects_out;
+                }
                 break;
             }
             case SourceEntry::Kind::Other:
                 flushPendingAction(true);
                 write(*e.other);
+                break;
+            case SourceEntry::Kind::Native:  // another topic of a bag
+                if (bag_) {
+                    bag_->copy(*e.native);
+                    ++sum_.objects_out;
+                }
                 break;
         }
         if (opts_.on_progress && before / every != sum_.objects_in / every) {
@@ -346,15 +399,26 @@ void Run::execute() {
         have_carry_ = false;
     }
     arch_.reset();
-    out_.close();
+    if (bag_) {
+        try {
+            bag_->close();
+        } catch (const SourceError& err) {
+            throw RawlogError(err.what(), opts_.output);
+        }
+    } else {
+        out_.close();
+    }
     csv_.close();
     throwIfCancelled();
     tmp.commit();
     if (tmp_csv) tmp_csv->commit();
 
-    sum_.layout = saw_frames_ && saw_observations_ ? "mixed"
-                  : saw_frames_                    ? "actions+sensory-frames"
-                                                   : "observations";
+    if (sum_.input_format == LogFormat::Carmen)
+        sum_.layout = "FLASER/RLASER/RAWLASER/ROBOTLASER and ODOM lines";
+    else if (sum_.input_format == LogFormat::Rawlog)
+        sum_.layout = saw_frames_ && saw_observations_ ? "mixed"
+                      : saw_frames_                    ? "actions+sensory-frames"
+                                                       : "observations";
     sum_.sensors = filter_.sensorCount();
     sum_.wall_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -84,6 +84,8 @@ NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
             case SourceEntry::Kind::Other:
                 arch << *e.other;
                 break;
+            case SourceEntry::Kind::Native:  // another topic of a bag: not in a rawlog
+                break;
         }
         if (o.on_progress && ++n % 500 == 0)
             o.on_progress(static_cast<double>(source->bytesRead()) / total);

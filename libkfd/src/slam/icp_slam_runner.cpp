@@ -73,9 +73,9 @@ class IcpSlamSteps {
     mrpt::obs::CActionCollection::Ptr pending_;
 };
 
-std::unique_ptr<Source> openLog(const std::string& path) {
+std::unique_ptr<Source> openLog(const std::string& path, const SourceOptions& options) {
     try {
-        return openSource(path);
+        return openSource(path, options);
     } catch (const SourceError& e) {
         throw SlamError(e.what(), path);
     }
@@ -130,8 +130,9 @@ class StartSkipper {
 // Every 2D scan of the log as the real run meets it (icp-slam's steps, after the skipped
 // start), with its entry's odometry: what the pre-passes that match a drop rate read.
 template <class Fn>
-void forEachRunScan(const std::string& rawlog, std::size_t skip_scans, Fn&& fn) {
-    auto source = openLog(rawlog);
+void forEachRunScan(const std::string& rawlog, const SourceOptions& options, std::size_t skip_scans,
+                    Fn&& fn) {
+    auto source = openLog(rawlog, options);
     IcpSlamSteps steps;
     IcpSlamStep step;
     StartSkipper skipper(skip_scans);
@@ -151,10 +152,10 @@ void forEachRunScan(const std::string& rawlog, std::size_t skip_scans, Fn&& fn) 
 
 // Timestamps and odometry of every scan after the skipped start (for matching the odometry
 // baseline's drop rate to a target before the real run).
-std::vector<ScanStamp> scanOdometry(const std::string& rawlog, std::size_t skip_scans,
-                                    bool laser_only) {
+std::vector<ScanStamp> scanOdometry(const std::string& rawlog, const SourceOptions& options,
+                                    std::size_t skip_scans, bool laser_only) {
     std::vector<ScanStamp> out;
-    forEachRunScan(rawlog, skip_scans,
+    forEachRunScan(rawlog, options, skip_scans,
                    [&](const CObservation2DRangeScan& scan, std::optional<Pose2D> odo) {
                        // non-finite: unknown, as checkScan does
                        if (laser_only || (odo && !finitePose(odo->x, odo->y, odo->phi)))
@@ -166,11 +167,11 @@ std::vector<ScanStamp> scanOdometry(const std::string& rawlog, std::size_t skip_
 
 // The drop rate (%) of a pre-filter over the log, as the real run would see it (the same
 // skipped start, the same checks, odometry or none): the pre-filter alone, no ICP.
-double pipelineDropPct(const std::string& rawlog, const Pipeline::Params& pipeline,
-                       std::size_t skip_scans, bool laser_only) {
+double pipelineDropPct(const std::string& rawlog, const SourceOptions& options,
+                       const Pipeline::Params& pipeline, std::size_t skip_scans, bool laser_only) {
     StreamFilter filter(pipeline);
     std::size_t in = 0, kept = 0;
-    forEachRunScan(rawlog, skip_scans,
+    forEachRunScan(rawlog, options, skip_scans,
                    [&](CObservation2DRangeScan& scan, std::optional<Pose2D> odo) {
                        if (laser_only) odo.reset();
                        ++in;
@@ -267,9 +268,9 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
         throw SlamError("give a drop rate or a mode to match, not both", "match_drop_of");
     if (opts.match_drop_of) {
         const std::clock_t m0 = std::clock();
-        sum.target_drop_pct =
-            pipelineDropPct(sum.rawlog, pipelineForMode(*opts.match_drop_of, kfd_params),
-                            opts.skip_scans, opts.laser_only);
+        sum.target_drop_pct = pipelineDropPct(sum.rawlog, opts.source,
+                                              pipelineForMode(*opts.match_drop_of, kfd_params),
+                                              opts.skip_scans, opts.laser_only);
         sum.cpu_s_match = static_cast<double>(std::clock() - m0) / CLOCKS_PER_SEC;
     } else if (opts.odometry_target_drop_pct) {
         sum.target_drop_pct = *opts.odometry_target_drop_pct;
@@ -279,8 +280,8 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
         if (!(target >= 0.0 && target < 100.0))
             throw SlamError("the target drop rate must be in [0, 100)");
         if (opts.mode == PrefilterMode::Odometry)
-            sum.pipeline.get<MotionStage>() =
-                matchDropRate(scanOdometry(sum.rawlog, opts.skip_scans, opts.laser_only), target);
+            sum.pipeline.get<MotionStage>() = matchDropRate(
+                scanOdometry(sum.rawlog, opts.source, opts.skip_scans, opts.laser_only), target);
         else
             sum.pipeline.get<DecimateStage>().keep_fraction = 1.0 - target / 100.0;
     }
@@ -320,7 +321,7 @@ IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
     f_csv << "index,timestamp,sensor,kept,reason,p_common,points_in,points_removed,prefilter_us,"
              "x,y,phi,view_change,degeneracy,corridor\n";
 
-    auto source = openLog(sum.rawlog);
+    auto source = openLog(sum.rawlog, opts.source);
     const double total_bytes =
         static_cast<double>(std::max<std::uint64_t>(1, source->bytesTotal()));
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "kfd/core/pipeline.h"
+#include "kfd/mrpt/bag_writer.h"
 #include "kfd/mrpt/rawlog_source.h"
 #include "kfd/mrpt/stream_filter.h"
 
@@ -20,8 +21,11 @@ struct RawlogProgress {
 };
 
 struct RawlogFilterOptions {
-    std::string input;      // .rawlog (plain or gzip), either MRPT layout
-    std::string output;     // written to a temporary file, renamed on success
+    std::string input;      // any log openSource() reads: rawlog, ROS 1 bag, CARMEN log
+    std::string output;     // .bag: a filtered bag (input must be a bag); else a rawlog.
+                            // Written to a temporary file, renamed on success
+    SourceOptions source;   // a bag's topics and frames
+    BagWriterOptions bag;   // a bag output's compression and removed-point mark
     std::string stats_csv;  // optional per-scan CSV
     Pipeline::Params pipeline;
     int compress_level = 1;  // gzip level of the output (0 = store, 9 = smallest)
@@ -45,7 +49,11 @@ struct SensorSummary {
 };
 
 struct RawlogFilterSummary {
-    std::string layout;               // "actions+sensory-frames", "observations", or "mixed"
+    std::string layout;  // "actions+sensory-frames", "observations", or "mixed";
+                         // for a bag or CARMEN input, what was read from it
+    LogFormat input_format = LogFormat::Rawlog;
+    LogFormat output_format = LogFormat::Rawlog;
+    std::size_t points_marked = 0;    // bag output: removed points written as NaN / +Inf
     std::size_t objects_in = 0;       // top-level objects read
     std::size_t objects_out = 0;      // top-level objects written
     std::size_t objects_dropped = 0;  // sensory frames / observations dropped whole
@@ -76,7 +84,12 @@ struct RawlogFilterSummary {
 };
 
 /// Reads `input` object by object (never loading it whole), runs every 2D range scan through a
-/// StreamFilter, and writes every other object unchanged and in order. Non-keyframe scans are
+/// StreamFilter, and writes every other object unchanged and in order. A bag or CARMEN input is
+/// read through its source (kfd/mrpt/source.h): a rawlog output then holds the scans and the
+/// odometry in the observations layout, the bag's other topics left out. A bag output (the
+/// output's name ends in .bag; the input must be a bag) copies every message of the input in
+/// order, except the dropped scans; a kept scan keeps every field, its removed points written
+/// as NaN or +Inf (BagWriterOptions::removed, REP 117). Non-keyframe scans are
 /// removed; a sensory frame left empty is dropped and its odometry action is composed into the
 /// next kept action, so the output's odometry still adds up. A scan that kfd::checkScan rejects
 /// (beam count outside [2, 65 536], aperture not finite, <= 0 or > 2*pi) never reaches a stage:

@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "kfd/core/error.h"
 #include "kfd/core/scan.h"
@@ -56,6 +57,11 @@ class OdometryTracker {
     std::optional<Pose2D> current_;
 };
 
+/// A message of a foreign log that has no MRPT form of its own (another topic of a ROS bag), or
+/// the original message behind a scan converted from one: what a bag writer copies. Opaque
+/// outside the bag layer (defined in libkfd/src/mrpt/bag_message.h).
+struct NativeMessage;
+
 /// One step of a log, in file order. Exactly one of the kinds below; the pointers of the other
 /// kinds are null. Consumers may modify the objects (e.g. erase scans from `frame`).
 struct SourceEntry {
@@ -65,12 +71,17 @@ struct SourceEntry {
                       // before it (actions layout), or null when the frame has none
         Action,       // an odometry action not followed by a sensory frame: `action`
         Other,        // any other object (a map, a comment...), to be copied as it is: `other`
+        Native,       // a message with no MRPT form (another topic of a bag): `native` only;
+                      // rawlog outputs leave it out, a bag output copies it
     };
     Kind kind = Kind::Other;
     mrpt::obs::CObservation::Ptr observation;
     mrpt::obs::CActionCollection::Ptr action;
     mrpt::obs::CSensoryFrame::Ptr frame;
     mrpt::serialization::CSerializable::Ptr other;
+    /// The original message of a bag: set for Native entries and for the scans converted from a
+    /// bag's LaserScan messages (null otherwise, e.g. for the odometry a bag source derives).
+    std::shared_ptr<const NativeMessage> native;
     /// The tracker's odometry once this entry is read (its action or odometry observation
     /// applied): the odometry of the entry's scans.
     std::optional<Pose2D> odometry;
@@ -95,6 +106,8 @@ struct SourceEntry {
             case Kind::Other:
                 fn(other);
                 break;
+            case Kind::Native:  // no MRPT object
+                break;
         }
     }
 
@@ -113,7 +126,8 @@ struct SourceEntry {
 };
 
 /// A log read entry by entry, never loaded whole. Implementations: RawlogSource (MRPT
-/// rawlogs); ROS bags and CARMEN logs come next, behind this same interface.
+/// rawlogs), BagSource (ROS 1 bags, kfd/mrpt/bag_source.h), CarmenSource (CARMEN logs,
+/// kfd/mrpt/carmen_source.h).
 class Source {
   public:
     virtual ~Source() = default;
@@ -129,8 +143,53 @@ class Source {
     virtual std::uint64_t bytesTotal() const = 0;
 };
 
-/// Opens the log at `path` with the source for its format (today every file is read as an
-/// MRPT rawlog, plain or gzip). Throws SourceError when it cannot be opened.
-std::unique_ptr<Source> openSource(const std::string& path);
+/// The formats kfd reads.
+enum class LogFormat { Rawlog, Bag, Carmen };
+const char* toString(LogFormat f);
+
+/// What a source reads from a log whose streams are named (a bag's topics and frames). Empty
+/// fields are chosen automatically (BagSource documents the rules); rawlogs and CARMEN logs
+/// ignore them.
+struct SourceOptions {
+    std::string scan_topic;  // a sensor_msgs/LaserScan topic; auto: the only one, else /scan
+    std::string odom_topic;  // a nav_msgs/Odometry topic, "tf" (odom -> base from /tf) or
+                             // "none" (laser only); auto: the only Odometry topic (else
+                             // /odom), else /tf when it holds odom -> base, else none
+    std::string odom_frame;  // tf: the odometry frame; auto: "odom"
+    std::string base_frame;  // the robot frame; auto: the Odometry's child_frame_id, else the
+                             // child of odom in /tf, else "base_link"
+};
+
+/// The format of the file at `path`, by content: a ROS bag starts "#ROSBAG V2.0"; a CARMEN log
+/// (plain or gzip) is text whose first non-comment line starts with a CARMEN keyword (PARAM,
+/// FLASER, ODOM, ...); anything else is read as a rawlog. The extension decides only for a
+/// text file of comments alone (.clf/.log: CARMEN). Throws SourceError when the file is
+/// missing or unreadable, or is a bag of another version.
+LogFormat detectFormat(const std::string& path);
+
+/// Opens the log at `path` with the source for its format (detectFormat). Throws SourceError
+/// when it cannot be opened, naming the file and the reason.
+std::unique_ptr<Source> openSource(const std::string& path, const SourceOptions& options = {});
+
+/// What a log holds, for `--list`: its streams (a bag's topics, a CARMEN log's line kinds, a
+/// rawlog's object classes and sensor labels) and, for a bag, what a source would use.
+struct SourceListing {
+    struct Stream {
+        std::string name;  // topic, line keyword, or "Class[label]"
+        std::string type;  // message type, or what kfd makes of it
+        std::size_t count = 0;
+        double first_stamp = 0.0, last_stamp = 0.0;  // seconds; 0 when unknown
+    };
+    std::string path;
+    LogFormat format = LogFormat::Rawlog;
+    std::string detail;  // e.g. "bz2-compressed, 22125 messages"
+    std::vector<Stream> streams;
+    std::vector<std::string> choices;  // "scans: /scan (sensor_msgs/LaserScan, auto)", ...
+};
+
+/// Reads the log at `path` once (a bag only through its index) and lists it. Throws
+/// SourceError like openSource (and for a bag, the errors of BagSource's topic choice are
+/// reported as choices, not thrown).
+SourceListing listSource(const std::string& path, const SourceOptions& options = {});
 
 }  // namespace kfd

@@ -15,6 +15,7 @@
 #include "kfd/core/pipeline.h"
 #include "kfd/eval/relations.h"
 #include "kfd/eval/trajectory.h"
+#include "kfd/mrpt/source.h"
 #include "kfd/slam/prefilter_modes.h"
 
 namespace kfd {
@@ -26,7 +27,9 @@ struct IcpSlamProgress {
 
 struct IcpSlamOptions {
     std::string config_file;  // icp-slam .ini: [ICP], [MappingApplication], maps, optional [KFD]
-    std::string rawlog;       // empty: [MappingApplication] rawlog_file
+    std::string rawlog;       // any log openSource() reads (rawlog, ROS 1 bag, CARMEN log);
+                              // empty: [MappingApplication] rawlog_file
+    SourceOptions source;     // a bag's topics and frames
     std::string output_dir;   // empty: [MappingApplication] logOutput_dir
     PrefilterMode mode = PrefilterMode::Kfd;
     /// Odometry and decimate modes only: drop this percentage of the scans (e.g. kfd's drop

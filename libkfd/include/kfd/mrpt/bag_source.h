@@ -1,0 +1,94 @@
+// The ROS 1 bag source: sensor_msgs/LaserScan scans with odometry from nav_msgs/Odometry or
+// /tf, the laser mount from /tf_static; plain, bz2 or lz4 bags (Debian's rosbag_storage).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "kfd/mrpt/source.h"
+
+namespace kfd {
+
+/// A bag that cannot be read or used: not a bag, truncated, unindexed or corrupt; a topic that
+/// is missing or of the wrong type; a bag without a usable LaserScan topic.
+class BagError : public SourceError {
+  public:
+    using SourceError::SourceError;
+};
+
+/// Walks every record of a ROS bag 2.0 file (headers, chunks decompressed, the records inside
+/// them, the index entries and the chunk index) and throws BagError naming the file, the byte
+/// offset and what is wrong: not a bag, truncated, no index, a chunk that does not decompress,
+/// a length or an offset outside its record or chunk. rosbag_storage trusts these, so
+/// BagSource and listBag() run this check first. (Corrupt bytes inside a message's data, e.g.
+/// a range value, cannot be told from real data: bags carry no checksums.)
+void checkBagStructure(const std::string& path);
+
+/// What a BagSource reads from its bag (after the automatic choices).
+struct BagChoice {
+    std::string scan_topic;
+    enum class Odometry { None, Topic, Tf } odometry = Odometry::None;
+    std::string odom_topic;  // Topic: the nav_msgs/Odometry topic
+    std::string odom_frame, base_frame;
+    std::string laser_frame;   // header.frame_id of the first scan ("" = unknown yet)
+    bool mount_found = false;  // base -> laser found in /tf_static (else identity)
+    double mount_x = 0.0, mount_y = 0.0, mount_yaw = 0.0;  // metres, radians
+    /// How each choice was made, one line each ("scans: /scan (the only LaserScan topic)").
+    std::vector<std::string> notes;
+};
+
+/// Reads a ROS 1 bag (format 2.0, any chunk compression) message by message in time order,
+/// through the bag's index (a bag whose index is missing, i.e. one cut short while recording,
+/// is refused: `rosbag reindex` repairs it).
+///
+/// Choices (SourceOptions; a named topic must exist and have the right type, else BagError):
+///  - scans: the --scan-topic, else the only sensor_msgs/LaserScan topic, else /scan or scan
+///    among several, else BagError listing them.
+///  - odometry: --odom-topic (a nav_msgs/Odometry topic, "tf" or "none"); else the only
+///    Odometry topic (/odom among several), else /tf when it holds transforms from the odom
+///    frame, else none (laser only). A scan's odometry is the odometry interpolated at its
+///    header stamp (linearly, the heading along the shorter arc) between the last message at
+///    or before it and the first after it; before the first message it is the first, after the
+///    last the last (the rule of the datasets' bag2clf.py, so a bag and the rawlog made from
+///    it give the same poses). The source looks ahead at most 10 s of bag time (or 100 000
+///    messages) for the message after a scan, then holds the last one.
+///  - mount: the chain of /tf_static transforms from the base frame to the scan's frame_id
+///    (leading '/' ignored), composed in 2D; identity when there is none.
+///
+/// Entries: each scan is an Observation entry with a CObservation2DRangeScan (label = topic
+/// without its leading '/', stamp = header.stamp, aperture = angle_max - angle_min, direction
+/// from the sign of angle_increment, sensor pose = mount + the yaw of the beams' middle,
+/// maxRange = range_max, intensities when there is one per beam). A beam is valid when its
+/// range is finite and range_min <= r < range_max (r = range_max is taken as "no return", as
+/// MRPT's CARMEN and rawlog conventions do); invalid non-finite ranges are stored as 0.
+/// With odometry, each scan is preceded by an Observation entry with a CObservationOdometry
+/// (label "ODOMETRY", the scan's stamp and interpolated pose), the layout of kfd's rawlogs.
+/// Every message, the scans' included, also travels as `native` (scans) or as a Native entry
+/// (all other messages, odometry ones too), in the bag's order.
+class BagSource : public Source {
+  public:
+    /// Opens `path` and makes the choices; BagError naming the file and the reason.
+    BagSource(const std::string& path, const SourceOptions& options = {});
+    ~BagSource() override;
+    BagSource(const BagSource&) = delete;
+    BagSource& operator=(const BagSource&) = delete;
+
+    bool next(SourceEntry& e) override;
+    const std::string& path() const override;
+    /// Progress by messages: the file size times the share of messages read.
+    std::uint64_t bytesRead() const override;
+    std::uint64_t bytesTotal() const override;
+
+    const BagChoice& choice() const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// The bag part of listSource(): topics with types, counts and stamp ranges, and the choices a
+/// BagSource would make with `options` (a choice that fails is listed as such).
+SourceListing listBag(const std::string& path, const SourceOptions& options = {});
+
+}  // namespace kfd

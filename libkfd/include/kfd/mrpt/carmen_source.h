@@ -1,0 +1,63 @@
+// The CARMEN log source: .clf / .log text logs, plain or gzip.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "kfd/mrpt/source.h"
+
+namespace kfd {
+
+/// A CARMEN log that cannot be read: a line with the wrong number of fields or a field that is
+/// not a number (the message names the file, the line number and the field).
+class CarmenError : public SourceError {
+  public:
+    using SourceError::SourceError;
+};
+
+/// Reads a CARMEN log line by line (never loaded whole), plain or gzip (the gzip stream's end
+/// is checked like a rawlog's). Each line is one message with its own timestamp (the
+/// ipc_timestamp field):
+///  - FLASER / RLASER n r1..rn x y theta odom_x odom_y odom_theta ipc_ts host logger_ts: an
+///    Observation entry with a CObservationOdometry (label "ODOMETRY", the odom_* pose), then
+///    one with the scan (label "FLASER" / "RLASER"). As MRPT's carmen2rawlog converts them, so
+///    that the log and its rawlog give the same scans: aperture = resolution x n (PARAM
+///    laser_front_laser_resolution / laser_rear_laser_resolution, default 0.5 deg), max range
+///    from PARAM robot_front_laser_max / robot_rear_laser_max (default 81 m), a beam valid
+///    when 0 < r < max, sensor pose = the laser pose x y theta in the frame of the odometry
+///    pose (unless PARAM robot_frontlaser_offset / robot_rearlaser_offset give the mount).
+///  - RAWLASER1..4 (laser_type start_angle fov resolution max_range accuracy remission_mode n
+///    r1..rn n_rem rem.. ipc_ts host logger_ts): a scan without odometry (label RAWLASERk),
+///    beams from start_angle over fov.
+///  - ROBOTLASER1/2 (the RAWLASER fields, then laser pose, robot pose, tv rv forward_safety
+///    side_safety turn_axis, ipc_ts host logger_ts): odometry (the robot pose) and a scan
+///    (label ROBOTLASERk) mounted at the laser pose in the robot's frame.
+///  - ODOM x y theta tv rv accel ipc_ts host logger_ts: a CObservationOdometry.
+///  - PARAM name value [host ts]: applies to the lines after it.
+///  - comments (#), empty lines and other keywords (TRUEPOS, SYNC, ...) are skipped.
+/// A line with the wrong field count or a bad number is a CarmenError ("file:LINE: FLASER
+/// with 361 readings has 370 fields, expected 372").
+class CarmenSource : public Source {
+  public:
+    explicit CarmenSource(const std::string& path);
+    ~CarmenSource() override;
+    CarmenSource(const CarmenSource&) = delete;
+    CarmenSource& operator=(const CarmenSource&) = delete;
+
+    bool next(SourceEntry& e) override;
+    const std::string& path() const override;
+    std::uint64_t bytesRead() const override;
+    std::uint64_t bytesTotal() const override;
+    /// Lines read so far (the number of the last line read).
+    std::size_t line() const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// The CARMEN part of listSource(): the line keywords with counts and stamp ranges, and the
+/// PARAM values.
+SourceListing listCarmen(const std::string& path);
+
+}  // namespace kfd

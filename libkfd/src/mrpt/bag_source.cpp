@@ -1,0 +1,517 @@
+#include "kfd/mrpt/bag_source.h"
+
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/poses/CPose3D.h>
+#include <nav_msgs/Odometry.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include <cmath>
+#include <deque>
+#include <filesystem>
+#include <limits>
+#include <map>
+
+#include "bag_message.h"
+#include "kfd/core/pose.h"
+
+namespace kfd {
+namespace {
+
+namespace fs = std::filesystem;
+using mrpt::obs::CObservation2DRangeScan;
+using mrpt::obs::CObservationOdometry;
+
+constexpr const char* kLaserScan = "sensor_msgs/LaserScan";
+constexpr const char* kOdometry = "nav_msgs/Odometry";
+constexpr const char* kTfMessage = "tf2_msgs/TFMessage";
+constexpr double kLookaheadSeconds = 10.0;  // bag time searched for the odometry after a scan
+constexpr std::size_t kLookaheadMessages = 100000;
+constexpr std::size_t kHistory = 4096;  // odometry samples kept for late scans
+constexpr std::size_t kTfProbe = 500;   // /tf messages searched for the odom frame
+
+std::string stripSlash(const std::string& s) {
+    const auto b = s.find_first_not_of('/');
+    return b == std::string::npos ? std::string() : s.substr(b);
+}
+
+double yawOf(const geometry_msgs::Quaternion& q) {
+    return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
+}
+
+struct TopicInfo {
+    std::string type;
+    std::size_t count = 0;
+    double first = 0.0, last = 0.0;
+};
+
+// The bag's topics, from its index only.
+std::map<std::string, TopicInfo> topicsOf(rosbag::Bag& bag) {
+    std::map<std::string, TopicInfo> topics;
+    rosbag::View all(bag);
+    for (const rosbag::ConnectionInfo* c : all.getConnections())
+        topics[c->topic].type = c->datatype;
+    for (auto& [name, info] : topics) {
+        rosbag::View v(bag, rosbag::TopicQuery(name));
+        info.count = v.size();
+        if (info.count) {
+            info.first = v.getBeginTime().toSec();
+            info.last = v.getEndTime().toSec();
+        }
+    }
+    return topics;
+}
+
+std::string listOf(const std::map<std::string, TopicInfo>& topics, const char* type) {
+    std::string s;
+    for (const auto& [name, info] : topics)
+        if (!type || info.type == type) s += (s.empty() ? "" : ", ") + name;
+    return s.empty() ? "none" : s;
+}
+
+// The topic a choice names, or the one candidate of `type` (prefer one of `preferred` among
+// several). Empty when there is none and `required` is false.
+std::string pickTopic(const std::map<std::string, TopicInfo>& topics, const std::string& named,
+                      const char* type, std::initializer_list<const char*> preferred,
+                      const char* what, const char* flag, std::vector<std::string>& notes,
+                      bool required) {
+    if (!named.empty()) {
+        std::string key = named;
+        if (!topics.count(key) && topics.count("/" + key)) key = "/" + key;
+        const auto it = topics.find(key);
+        if (it == topics.end())
+            throw BagError(std::string(flag) + " " + named +
+                           ": no such topic (topics: " + listOf(topics, nullptr) + ")");
+        if (it->second.type != type)
+            throw BagError(std::string(flag) + " " + named + ": the topic holds " +
+                           it->second.type + ", not " + type);
+        notes.push_back(std::string(what) + ": " + key + " (" + type + ", " + flag + ")");
+        return key;
+    }
+    std::vector<std::string> found;
+    for (const auto& [name, info] : topics)
+        if (info.type == type) found.push_back(name);
+    if (found.size() == 1) {
+        notes.push_back(std::string(what) + ": " + found[0] + " (the only " + type + " topic)");
+        return found[0];
+    }
+    for (const char* p : preferred)
+        for (const auto& f : found)
+            if (f == p) {
+                notes.push_back(std::string(what) + ": " + f + " (of " +
+                                std::to_string(found.size()) + " " + type + " topics; " + flag +
+                                " chooses another)");
+                return f;
+            }
+    if (found.size() > 1)
+        throw BagError(std::to_string(found.size()) + " " + type + " topics (" +
+                       listOf(topics, type) + "): choose one with " + flag);
+    if (required)
+        throw BagError(std::string("no ") + type + " topic (topics: " + listOf(topics, nullptr) +
+                       ")");
+    return {};
+}
+
+// The first transform in /tf whose parent is `odom_frame` (its child is the base frame).
+std::string baseFrameFromTf(rosbag::Bag& bag, const std::string& tf_topic,
+                            const std::string& odom_frame) {
+    rosbag::View v(bag, rosbag::TopicQuery(tf_topic));
+    std::size_t n = 0;
+    for (const rosbag::MessageInstance& m : v) {
+        if (++n > kTfProbe) break;
+        if (const auto tf = m.instantiate<tf2_msgs::TFMessage>())
+            for (const auto& t : tf->transforms)
+                if (stripSlash(t.header.frame_id) == odom_frame)
+                    return stripSlash(t.child_frame_id);
+    }
+    return {};
+}
+
+struct Edge {
+    std::string parent;
+    Pose2D pose;  // child in the parent's frame
+};
+
+void chooseMount(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topics, BagChoice& c) {
+    {
+        rosbag::View v(bag, rosbag::TopicQuery(c.scan_topic));
+        for (const rosbag::MessageInstance& m : v) {
+            if (const auto s = m.instantiate<sensor_msgs::LaserScan>())
+                c.laser_frame = stripSlash(s->header.frame_id);
+            break;
+        }
+    }
+    std::map<std::string, Edge> edges;  // child -> parent
+    for (const char* topic : {"/tf_static", "tf_static"}) {
+        const auto it = topics.find(topic);
+        if (it == topics.end() || it->second.type != kTfMessage) continue;
+        rosbag::View v(bag, rosbag::TopicQuery(topic));
+        for (const rosbag::MessageInstance& m : v)
+            if (const auto tf = m.instantiate<tf2_msgs::TFMessage>())
+                for (const auto& t : tf->transforms)
+                    edges[stripSlash(t.child_frame_id)] =
+                        Edge{stripSlash(t.header.frame_id),
+                             Pose2D{t.transform.translation.x, t.transform.translation.y,
+                                    yawOf(t.transform.rotation)}};
+    }
+    Pose2D mount{0.0, 0.0, 0.0};
+    std::string f = c.laser_frame;
+    for (std::size_t hops = 0; hops < 64 && f != c.base_frame; ++hops) {
+        const auto it = edges.find(f);
+        if (it == edges.end()) break;
+        mount = compose(it->second.pose, mount);
+        f = it->second.parent;
+    }
+    c.mount_found = !c.laser_frame.empty() && f == c.base_frame && c.laser_frame != c.base_frame;
+    if (c.mount_found || c.laser_frame == c.base_frame) {
+        c.mount_x = mount.x;
+        c.mount_y = mount.y;
+        c.mount_yaw = mount.phi;
+    }
+    char buf[256];
+    if (c.mount_found)
+        std::snprintf(buf, sizeof(buf),
+                      "laser mount: %s -> %s from /tf_static: x %.3f m, y %.3f m, yaw %.2f deg",
+                      c.base_frame.c_str(), c.laser_frame.c_str(), c.mount_x, c.mount_y,
+                      c.mount_yaw * 180.0 / kPi);
+    else
+        std::snprintf(buf, sizeof(buf), "laser mount: identity (no /tf_static chain %s -> %s)",
+                      c.base_frame.c_str(), c.laser_frame.empty() ? "?" : c.laser_frame.c_str());
+    c.notes.push_back(buf);
+}
+
+BagChoice choose(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topics,
+                 const SourceOptions& o) {
+    BagChoice c;
+    c.scan_topic = pickTopic(topics, o.scan_topic, kLaserScan, {"/scan", "scan"}, "scans",
+                             "--scan-topic", c.notes, true);
+    c.odom_frame = o.odom_frame.empty() ? "odom" : stripSlash(o.odom_frame);
+    std::string tf_topic;
+    for (const char* t : {"/tf", "tf"})
+        if (topics.count(t) && topics.at(t).type == kTfMessage) tf_topic = t;
+    const std::string mode = o.odom_topic;
+    if (mode == "none") {
+        c.notes.push_back("odometry: none (--odom-topic none): laser only");
+    } else if (mode == "tf") {
+        if (tf_topic.empty()) throw BagError("--odom-topic tf: the bag has no /tf topic");
+        c.odometry = BagChoice::Odometry::Tf;
+    } else {
+        c.odom_topic = pickTopic(topics, mode, kOdometry, {"/odom", "odom"}, "odometry",
+                                 "--odom-topic", c.notes, false);
+        if (!c.odom_topic.empty()) {
+            c.odometry = BagChoice::Odometry::Topic;
+        } else if (!tf_topic.empty() && !baseFrameFromTf(bag, tf_topic, c.odom_frame).empty()) {
+            c.odometry = BagChoice::Odometry::Tf;
+        } else {
+            c.notes.push_back("odometry: none (no " + std::string(kOdometry) + " topic, no " +
+                              c.odom_frame + " frame in /tf): laser only");
+        }
+    }
+    if (c.odometry == BagChoice::Odometry::Topic) {
+        c.base_frame = stripSlash(o.base_frame);
+        if (c.base_frame.empty()) {
+            rosbag::View v(bag, rosbag::TopicQuery(c.odom_topic));
+            for (const rosbag::MessageInstance& m : v) {
+                if (const auto od = m.instantiate<nav_msgs::Odometry>())
+                    c.base_frame = stripSlash(od->child_frame_id);
+                break;
+            }
+        }
+    } else if (c.odometry == BagChoice::Odometry::Tf) {
+        c.odom_topic = tf_topic;
+        c.base_frame = stripSlash(o.base_frame);
+        if (c.base_frame.empty()) c.base_frame = baseFrameFromTf(bag, tf_topic, c.odom_frame);
+        if (c.base_frame.empty())
+            throw BagError("--odom-topic tf: no transform from the " + c.odom_frame +
+                           " frame in the first " + std::to_string(kTfProbe) +
+                           " /tf messages (--odom-frame names it)");
+        c.notes.push_back("odometry: " + tf_topic + " " + c.odom_frame + " -> " + c.base_frame +
+                          (mode == "tf" ? " (--odom-topic tf)" : " (no Odometry topic)"));
+    }
+    if (c.base_frame.empty()) c.base_frame = "base_link";
+    chooseMount(bag, topics, c);
+    return c;
+}
+
+void openBag(rosbag::Bag& bag, const std::string& path) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) throw BagError(path + ": no such file", path);
+    checkBagStructure(path);
+    try {
+        bag.open(path, rosbag::bagmode::Read);
+    } catch (const std::exception& e) {
+        throw BagError(path + ": not a readable ROS 1 bag (" + e.what() +
+                           "; a bag cut short while recording has no index: `rosbag reindex` "
+                           "repairs it)",
+                       path);
+    }
+}
+
+}  // namespace
+
+struct BagSource::Impl {
+    struct Item {
+        std::shared_ptr<const NativeMessage> native;
+        CObservation2DRangeScan::Ptr scan;  // null for other messages
+        double stamp = 0.0;                 // the scan's header stamp
+        double record = 0.0;                // bag time
+        bool resolved = true;
+        bool odom_emitted = false;
+        std::optional<Pose2D> odom;
+    };
+    struct Sample {
+        double t;
+        Pose2D p;
+    };
+
+    std::string path;
+    rosbag::Bag bag;
+    std::map<std::string, TopicInfo> topics;
+    BagChoice choice;
+    std::unique_ptr<rosbag::View> view;
+    rosbag::View::iterator it;
+    bool at_end = false;
+    std::uint64_t size = 0;
+    std::size_t total_messages = 0, messages_read = 0, entries = 0;
+    std::deque<Item> queue;
+    std::deque<Sample> history;
+    double last_record = 0.0;
+    OdometryTracker tracker;
+
+    Impl(const std::string& p, const SourceOptions& o) : path(p) {
+        openBag(bag, path);
+        try {
+            topics = topicsOf(bag);
+            choice = choose(bag, topics, o);
+            view = std::make_unique<rosbag::View>(bag);
+            total_messages = view->size();
+            it = view->begin();
+        } catch (const BagError& e) {
+            throw BagError(path + ": " + e.what(), path);
+        } catch (const std::exception& e) {
+            throw BagError(
+                path + ": cannot read the bag's index or first messages (" + e.what() + ")", path);
+        }
+        std::error_code ec;
+        size = fs::file_size(path, ec);
+        if (ec) size = 0;
+    }
+
+    std::string where(const rosbag::MessageInstance* m) const {
+        std::string s = path + ": message " + std::to_string(messages_read + 1);
+        if (m) {
+            char buf[64];
+            std::snprintf(buf, sizeof(buf), " at t = %.6f s", m->getTime().toSec());
+            s += " (" + m->getTopic() + buf + ")";
+        }
+        return s;
+    }
+
+    static Pose2D interpolate(const Sample& a, const Sample& b, double t) {
+        const double w = b.t == a.t ? 0.0 : (t - a.t) / (b.t - a.t);
+        return Pose2D{a.p.x + w * (b.p.x - a.p.x), a.p.y + w * (b.p.y - a.p.y),
+                      wrapAngle(a.p.phi + w * wrapAngle(b.p.phi - a.p.phi))};
+    }
+
+    // The odometry at `t` from the samples seen so far, or nullopt while the sample after `t`
+    // has not come.
+    std::optional<Pose2D> odometryAt(double t) const {
+        if (history.empty() || history.back().t < t) return std::nullopt;
+        std::size_t k = history.size() - 1;  // the first sample at or after t, from the back
+        while (k > 0 && history[k - 1].t >= t) --k;
+        if (history[k].t == t || k == 0) return history[k].p;
+        return interpolate(history[k - 1], history[k], t);
+    }
+
+    void onSample(double t, const Pose2D& p) {
+        if (!finitePose(p.x, p.y, p.phi) || !std::isfinite(t)) return;
+        history.push_back(Sample{t, p});
+        if (history.size() > kHistory) history.pop_front();
+        for (Item& q : queue)
+            if (!q.resolved) {
+                q.odom = odometryAt(q.stamp);
+                q.resolved = q.odom.has_value();
+            }
+    }
+
+    // Holds the last odometry for scans whose next odometry message never comes.
+    void hold(Item& q) {
+        if (!history.empty()) q.odom = history.back().p;
+        q.resolved = true;
+    }
+
+    CObservation2DRangeScan::Ptr toScan(const sensor_msgs::LaserScan& m) const {
+        auto obs = std::make_shared<CObservation2DRangeScan>();
+        obs->sensorLabel = stripSlash(choice.scan_topic);
+        obs->timestamp = mrpt::Clock::fromDouble(m.header.stamp.toSec());
+        const std::size_t n = m.ranges.size();
+        obs->aperture = static_cast<float>(std::fabs(double(m.angle_max) - double(m.angle_min)));
+        obs->rightToLeft = m.angle_increment >= 0.0f;
+        obs->maxRange = m.range_max;
+        const double mid = 0.5 * (double(m.angle_min) + double(m.angle_max));
+        obs->sensorPose = mrpt::poses::CPose3D(choice.mount_x, choice.mount_y, 0.0,
+                                               choice.mount_yaw + mid, 0.0, 0.0);
+        obs->resizeScan(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const float r = m.ranges[i];
+            const bool ok = std::isfinite(r) && r >= m.range_min && r < m.range_max;
+            obs->setScanRange(i, std::isfinite(r) ? r : 0.0f);
+            obs->setScanRangeValidity(i, ok);
+        }
+        if (m.intensities.size() == n && n > 0) {
+            obs->setScanHasIntensity(true);
+            for (std::size_t i = 0; i < n; ++i)
+                obs->setScanIntensity(
+                    i, static_cast<int32_t>(
+                           std::lround(std::isfinite(m.intensities[i]) ? m.intensities[i] : 0.f)));
+        }
+        return obs;
+    }
+
+    // Reads one message into the queue; false at the end of the bag.
+    bool readOne() {
+        if (at_end) return false;
+        std::optional<rosbag::MessageInstance> m;
+        try {
+            if (it == view->end()) {
+                at_end = true;
+                return false;
+            }
+            m.emplace(*it);
+            Item item;
+            item.native = std::make_shared<NativeMessage>(*m);
+            item.record = m->getTime().toSec();
+            const std::string& topic = m->getTopic();
+            if (topic == choice.scan_topic) {
+                const auto ls = m->instantiate<sensor_msgs::LaserScan>();
+                if (!ls) throw BagError("not a " + std::string(kLaserScan));
+                item.scan = toScan(*ls);
+                item.stamp = ls->header.stamp.toSec();
+                if (choice.odometry != BagChoice::Odometry::None) {
+                    item.odom = odometryAt(item.stamp);
+                    item.resolved = item.odom.has_value();
+                }
+            } else if (choice.odometry == BagChoice::Odometry::Topic &&
+                       topic == choice.odom_topic) {
+                if (const auto od = m->instantiate<nav_msgs::Odometry>())
+                    onSample(od->header.stamp.toSec(),
+                             Pose2D{od->pose.pose.position.x, od->pose.pose.position.y,
+                                    yawOf(od->pose.pose.orientation)});
+            } else if (choice.odometry == BagChoice::Odometry::Tf && topic == choice.odom_topic) {
+                if (const auto tf = m->instantiate<tf2_msgs::TFMessage>())
+                    for (const auto& t : tf->transforms)
+                        if (stripSlash(t.header.frame_id) == choice.odom_frame &&
+                            stripSlash(t.child_frame_id) == choice.base_frame)
+                            onSample(t.header.stamp.toSec(),
+                                     Pose2D{t.transform.translation.x, t.transform.translation.y,
+                                            yawOf(t.transform.rotation)});
+            }
+            queue.push_back(std::move(item));
+            last_record = std::max(last_record, queue.back().record);
+            ++messages_read;
+            ++it;
+        } catch (const BagError& e) {
+            throw BagError(where(m ? &*m : nullptr) + ": " + e.what(), path);
+        } catch (const std::exception& e) {
+            throw BagError(
+                where(m ? &*m : nullptr) + ": corrupt or truncated bag (" + e.what() + ")", path);
+        }
+        // Bounded lookahead: a scan waits at most kLookaheadSeconds of bag time.
+        while (!queue.empty() && !queue.front().resolved &&
+               (last_record - queue.front().record > kLookaheadSeconds ||
+                queue.size() > kLookaheadMessages))
+            hold(queue.front());
+        return true;
+    }
+};
+
+BagSource::BagSource(const std::string& path, const SourceOptions& options)
+    : impl_(std::make_unique<Impl>(path, options)) {}
+BagSource::~BagSource() = default;
+
+bool BagSource::next(SourceEntry& e) {
+    Impl& d = *impl_;
+    while (d.queue.empty() || !d.queue.front().resolved) {
+        if (!d.readOne()) {
+            for (auto& q : d.queue)
+                if (!q.resolved) d.hold(q);
+            if (d.queue.empty()) {
+                if (d.entries == 0) throw BagError(d.path + ": the bag holds no messages", d.path);
+                return false;
+            }
+        }
+    }
+    Impl::Item& q = d.queue.front();
+    e = SourceEntry();
+    e.index = d.entries++;
+    e.objects_read = d.messages_read;
+    if (q.scan && q.odom && !q.odom_emitted) {  // the scan's odometry first
+        auto odo = std::make_shared<CObservationOdometry>();
+        odo->sensorLabel = "ODOMETRY";
+        odo->timestamp = q.scan->timestamp;
+        odo->odometry = mrpt::poses::CPose2D(q.odom->x, q.odom->y, q.odom->phi);
+        d.tracker.onObservation(*odo);
+        e.kind = SourceEntry::Kind::Observation;
+        e.observation = std::move(odo);
+        e.odometry = d.tracker.current();
+        q.odom_emitted = true;
+        return true;
+    }
+    if (q.scan) {
+        e.kind = SourceEntry::Kind::Observation;
+        e.observation = q.scan;
+        e.odometry = q.odom;
+    } else {
+        e.kind = SourceEntry::Kind::Native;
+        e.odometry = d.tracker.current();
+    }
+    e.native = std::move(q.native);
+    d.queue.pop_front();
+    return true;
+}
+
+const std::string& BagSource::path() const { return impl_->path; }
+std::uint64_t BagSource::bytesRead() const {
+    const Impl& d = *impl_;
+    return d.total_messages ? static_cast<std::uint64_t>(static_cast<double>(d.size) *
+                                                         static_cast<double>(d.messages_read) /
+                                                         static_cast<double>(d.total_messages))
+                            : 0;
+}
+std::uint64_t BagSource::bytesTotal() const { return impl_->size; }
+const BagChoice& BagSource::choice() const { return impl_->choice; }
+
+SourceListing listBag(const std::string& path, const SourceOptions& options) {
+    rosbag::Bag bag;
+    openBag(bag, path);
+    SourceListing l;
+    l.path = path;
+    l.format = LogFormat::Bag;
+    std::map<std::string, TopicInfo> topics;
+    try {
+        topics = topicsOf(bag);
+    } catch (const std::exception& e) {
+        throw BagError(path + ": cannot read the bag's index (" + e.what() + ")", path);
+    }
+    std::size_t total = 0;
+    for (const auto& [name, info] : topics) {
+        l.streams.push_back({name, info.type, info.count, info.first, info.last});
+        total += info.count;
+    }
+    l.detail = "ROS 1 bag, " + std::to_string(topics.size()) + " topics, " + std::to_string(total) +
+               " messages";
+    try {
+        const BagChoice c = choose(bag, topics, options);
+        l.choices = c.notes;
+    } catch (const BagError& e) {
+        l.choices.push_back(std::string("cannot use as it is: ") + e.what());
+    } catch (const std::exception& e) {
+        l.choices.push_back(std::string("cannot read the first messages: ") + e.what());
+    }
+    return l;
+}
+
+}  // namespace kfd
