@@ -20,7 +20,8 @@ also simulated again with seed K + 1.
   kfd-compare diagnose OUT --modes kfd odometry@kfd   # where the drops cost: diagnose.md
 
 Logs: a dataset folder name under --datasets (NAME/NAME.rawlog with NAME.relations) or a path
-to a .rawlog (NAME.relations and NAME.gt.tum beside it are used when present), or
+to any log kfd-icp-slam reads: a .rawlog, a ROS 1 bag or a CARMEN log (NAME.relations and
+NAME.gt.tum beside it are used when present; for aces.orig.bag also aces.relations), or
 sim:WORLD:SENSOR:SPEED[:DURATION] (kfd-simulate; ground truth .gt.tum). Modes: any of
 `kfd-icp-slam --list-modes`, with `@MODE` to drop as many scans as MODE does on the same run
 (odometry@kfd, decimate@kfd) and `+lo` for a laser-only run (no odometry to the pre-filter or
@@ -64,6 +65,18 @@ class CompareError(Exception):
 
 # --- logs, modes, jobs ----------------------------------------------------------------------
 
+# The logs kfd-icp-slam reads (by content; these extensions mark a spec as a path).
+LOG_EXTENSIONS = (".rawlog", ".bag", ".clf", ".log", ".clf.gz", ".log.gz")
+
+
+def log_stem(filename):
+    """aces.orig.bag -> aces.orig; intel.clf.gz -> intel."""
+    for ext in sorted(LOG_EXTENSIONS, key=len, reverse=True):
+        if filename.endswith(ext):
+            return filename[:-len(ext)]
+    return filename
+
+
 def resolve_log(spec, datasets):
     """A log spec -> dict(name, kind, rawlog, relations, gt, max_dt, sim settings)."""
     if spec.startswith("sim:"):
@@ -75,21 +88,24 @@ def resolve_log(spec, datasets):
                                                                    if duration else ""),
                 "kind": "sim", "world": world, "sensor": sensor, "speed": speed,
                 "duration": duration, "max_dt": 1e-3}
-    if spec.endswith(".rawlog") or os.path.sep in spec:
+    if spec.endswith(LOG_EXTENSIONS) or os.path.sep in spec:
         rawlog = os.path.abspath(spec)
-        name = os.path.basename(rawlog)[:-len(".rawlog")] if rawlog.endswith(".rawlog") \
-            else os.path.basename(rawlog)
+        name = log_stem(os.path.basename(rawlog))
     else:
         rawlog = os.path.abspath(os.path.join(datasets, spec, spec + ".rawlog"))
         name = spec
     if not os.path.isfile(rawlog):
         raise CompareError("log not found: %s (%s)" % (spec, rawlog))
-    stem = rawlog[:-len(".rawlog")] if rawlog.endswith(".rawlog") else rawlog
-    rel = stem + ".relations"
-    gt = stem + ".gt.tum"
-    return {"name": name, "kind": "file", "rawlog": rawlog,
-            "relations": rel if os.path.isfile(rel) else None,
-            "gt": gt if os.path.isfile(gt) else None, "max_dt": MAX_DT.get(name, 1e-3)}
+    # NAME.relations / NAME.gt.tum beside the log: for aces/aces.orig.bag, aces.orig.* or aces.*
+    folder = os.path.dirname(rawlog)
+    stems = [log_stem(os.path.basename(rawlog))]
+    stems.append(stems[0].split(".")[0])
+    rel = next((os.path.join(folder, x + ".relations") for x in stems
+                if os.path.isfile(os.path.join(folder, x + ".relations"))), None)
+    gt = next((os.path.join(folder, x + ".gt.tum") for x in stems
+               if os.path.isfile(os.path.join(folder, x + ".gt.tum"))), None)
+    return {"name": name, "kind": "file", "rawlog": rawlog, "relations": rel, "gt": gt,
+            "max_dt": MAX_DT.get(stems[1], MAX_DT.get(name, 1e-3))}
 
 
 def parse_mode(spec):
@@ -463,7 +479,7 @@ def main(argv=None):
     report.add_argument("--no-plots", dest="plots", action="store_false")
     report.add_argument("-q", "--quiet", action="store_true")
     r = sub.add_parser("run", parents=[tools, report], help="run (or emit) every job, then collect")
-    r.add_argument("--logs", nargs="+", required=True, help="dataset names, .rawlog paths, sim:...")
+    r.add_argument("--logs", nargs="+", required=True, help="dataset names, log paths (.rawlog, .bag, .clf), sim:...")
     r.add_argument("--modes", nargs="+", default=["none", "kfd", "odometry@kfd", "keyframe"])
     r.add_argument("--configs", nargs="+", default=[DEFAULT_CONFIG], help="kfd-icp-slam .ini files")
     r.add_argument("--repeats", "-R", type=int, default=20)

@@ -18,6 +18,7 @@
 
 #include <mrpt/io/CFileGZInputStream.h>
 
+#include "test_bags.h"
 #include "test_files.h"
 
 namespace {
@@ -523,6 +524,98 @@ TEST(BadInputConfiguration, DuplicateKeysEmptyPipelinesAndHangingYamlAreErrors) 
     expectConfigRefused("hang.yaml",
                         fileBytes(std::string(KFD_SOURCE_DIR) + "/test/data/yaml-hang-4byte.yaml"),
                         "hang.yaml");
+}
+
+// --- ROS bags and CARMEN logs (issue 13) ----------------------------------------------------
+
+// A small bag: 40 scans of a 6 m x 4 m room with odometry, uncompressed.
+std::string writeBag(const Dir& d, const std::string& name) {
+    const std::string p = d / name;
+    kfd::test::BagBuilder b(p);
+    for (int i = 0; i < 40; ++i) {
+        b.odom("/odom", 1 + 0.2 * i, 0.05 * i, 0, 0);
+        std::vector<float> r(181);
+        for (std::size_t k = 0; k < r.size(); ++k) r[k] = 2.0f + 0.01f * static_cast<float>(k % 7);
+        b.scan("/scan", kfd::test::BagBuilder::scanMsg(1 + 0.2 * i + 0.1, r));
+    }
+    return p;
+}
+
+// kfd-filter (and kfd-icp-slam) on a bad log: exit 1, the first line names the file and says
+// `what`, nothing written, the input unchanged.
+void expectLogRefused(const Dir& d, const std::string& in, const std::vector<std::string>& extra,
+                      const std::string& what, const std::string& out = "out.bag") {
+    SCOPED_TRACE(in + " " + what);
+    const auto before = listing(d.path);
+    const Snapshot snap({in});
+    std::vector<std::string> args{"-q", "-i", in, "-o", d / out, "--stats", d / "s.csv"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    Result r = run(KFD_FILTER_EXE, args, d.path);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(r.first().rfind("kfd-filter: ", 0), 0u) << r.err;
+    EXPECT_NE(r.first().find(in), std::string::npos) << r.err;
+    EXPECT_NE(r.first().find(what), std::string::npos) << r.err;
+    args = {kSlamIni, in, "-o", d / "slam", "-q", "--no-map"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    r = run(KFD_ICP_SLAM_EXE, args, d.path);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.first().find(what), std::string::npos) << r.err;
+    EXPECT_EQ(listing(d.path), before);
+    snap.expectUnchanged();
+}
+
+TEST(BadInputLogs, TruncatedOrCorruptBagsAreRefused) {
+    Dir d;
+    const std::string bytes = fileBytes(writeBag(d, "good.bag"));
+    fs::remove(d / "good.bag");
+    const auto cut = d.write("cut.bag", bytes.substr(0, bytes.size() / 2));
+    expectLogRefused(d, cut, {}, "truncated");
+    std::string bad = bytes;
+    for (std::size_t i = bad.size() - 120; i < bad.size(); ++i) bad[i] ^= 0x5a;  // the index
+    const auto corrupt = d.write("corrupt.bag", bad);
+    expectLogRefused(d, corrupt, {}, ": byte ");
+    const auto text = d.write("text.bag", "not a bag\n");
+    expectLogRefused(d, text, {}, "not a ROS bag");
+}
+
+TEST(BadInputLogs, MissingTopicsAndUnsupportedTypesAreRefused) {
+    Dir d;
+    const auto bag = writeBag(d, "in.bag");
+    expectLogRefused(d, bag, {"--scan-topic", "/base_scan"},
+                     "--scan-topic /base_scan: no such topic");
+    expectLogRefused(d, bag, {"--scan-topic", "/odom"},
+                     "the topic holds nav_msgs/Odometry, not sensor_msgs/LaserScan");
+    expectLogRefused(d, bag, {"--odom-topic", "/scan"},
+                     "the topic holds sensor_msgs/LaserScan, not nav_msgs/Odometry");
+    const std::string odom_only = d / "odom.bag";
+    {
+        kfd::test::BagBuilder b(odom_only);
+        b.odom("/odom", 1, 0, 0, 0);
+    }
+    expectLogRefused(d, odom_only, {}, "no sensor_msgs/LaserScan topic");
+}
+
+TEST(BadInputLogs, CarmenLinesWithTheWrongFieldCountAreRefused) {
+    Dir d;
+    const auto clf =
+        d.write("x.clf", "FLASER 2 1 2 0 0 0 0 0 0 5.0 h 0\nFLASER 3 1 2 0 0 0 0 0 0 6.0 h 0\n");
+    expectLogRefused(d, clf, {}, clf + ":2: FLASER with 3 readings has 13 fields, expected 14",
+                     "out.rawlog");
+    const auto num = d.write("y.log", "ODOM 1 2 x 0 0 0 5.0 h 0\n");
+    expectLogRefused(d, num, {}, ":1: ODOM field 3 ('x') is not a number", "out.rawlog");
+}
+
+TEST(BadInputLogs, ABagOutputNeedsABagInput) {
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const Snapshot snap({in});
+    const Result r = run(KFD_FILTER_EXE, {"-q", "-i", in, "-o", d / "out.bag"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.first().find("a bag output (" + (d / "out.bag") + ") needs a ROS bag input"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
+    snap.expectUnchanged();
 }
 
 }  // namespace

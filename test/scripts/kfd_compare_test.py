@@ -99,6 +99,19 @@ class KfdCompare(unittest.TestCase):
         self.assertTrue(all(x["target_drop_pct"] > 0 for x in dec))
         self.assertTrue(all(abs(x["drop"] - x["target_drop_pct"]) < 0.5 for x in dec))
 
+    def test_bags_and_carmen_logs_find_their_relations(self):
+        sys.path.insert(0, os.path.join(ROOT, "share", "scripts"))
+        import kfd_compare
+        for rel in ("aces/aces.orig.bag", "mit-csail/mit-csail.clf", "intel/intel.reconstructed.clf.gz"):
+            path = os.path.join(DATASETS, rel)
+            if not os.path.isfile(path):
+                continue
+            log = kfd_compare.resolve_log(path, DATASETS)
+            folder = rel.split("/")[0]
+            self.assertEqual(log["relations"], os.path.join(DATASETS, folder, folder + ".relations"))
+        self.assertEqual(kfd_compare.log_stem("aces.orig.bag"), "aces.orig")
+        self.assertEqual(kfd_compare.log_stem("intel.clf.gz"), "intel")
+
     def test_bad_input_is_a_clear_error(self):
         out = os.path.join(self.tmp, "bad")
         r = compare("run", "--logs", "no-such-log", "--out", out, "--repeats", "1", *self.exe)

@@ -139,11 +139,18 @@ class Checker {
         if (!readAt(pos + 4, hb.data(), hlen) || !readAt(pos + 4 + hlen, len, 4))
             fail(pos, "read error");
         h = parseHeader(hb.data(), hlen, pos);
-        const std::uint64_t dlen = u32(len);
+        std::uint64_t dlen = u32(len);
         const std::uint64_t dpos = pos + 8 + hlen;
+        const std::uint8_t op = opOf(h, pos);
+        // Index data: rosbag_storage reads its count entries of 12 bytes and goes on from
+        // there, whatever the length field says (bags of 2010 announce 20 bytes an entry).
+        if (op == kIndexData) {
+            const std::uint64_t entries = 12ull * u32field(h, "count", pos);
+            if (entries > dlen) fail(pos, "index data shorter than its entries");
+            dlen = entries;
+        }
         if (dlen > size_ - dpos)
             fail(pos, "a record's data runs past the end of the file (truncated?)");
-        const std::uint8_t op = opOf(h, pos);
         if (op == kChunk || op == kIndexData) {  // the only data this check reads
             data.resize(dlen);
             if (dlen && !readAt(dpos, data.data(), dlen)) fail(pos, "read error");

@@ -272,7 +272,7 @@ struct CarmenSource::Impl {
                        kw[10] <= '2') {
                 rawlaser(true);
             } else if (kw == "ODOM") {
-                expectFields(10, "");
+                expectFields(10, "line");
                 pushOdometry(number(1), number(2), number(3), number(7));
             }  // other keywords: skipped
         }

@@ -1,0 +1,32 @@
+// libFuzzer target: the CARMEN source fed arbitrary bytes (written to a temporary file, plain
+// or gzip as the bytes say), read with CarmenSource::next() until the end, and listed.
+// kfd::Error (CarmenError, SourceError) is an accepted outcome; anything else is a finding.
+#include <unistd.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <fstream>
+#include <string>
+
+#include "kfd/core/error.h"
+#include "kfd/mrpt/carmen_source.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    static const std::string path = "/tmp/kfd-fuzz-carmen-" + std::to_string(getpid()) + ".clf";
+    {
+        std::ofstream f(path, std::ios::binary | std::ios::trunc);
+        f.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+    }
+    try {
+        kfd::CarmenSource source(path);
+        kfd::SourceEntry e;
+        for (int n = 0; n < 10000 && source.next(e); ++n) {
+        }
+    } catch (const kfd::Error&) {
+    }
+    try {
+        (void)kfd::listCarmen(path);
+    } catch (const kfd::Error&) {
+    }
+    return 0;
+}
