@@ -148,7 +148,16 @@ def job_args(a, log, config, mode, repeat):
             "--sim-exe", os.path.abspath(a.sim_exe), "--split-seconds", repr(a.split_seconds)]
     if a.maps:
         args.append("--map")
-    return args
+    return args + source_args(a)
+
+
+def source_args(a):
+    """kfd-icp-slam's bag flags given to kfd-compare (every log of the run gets them)."""
+    out = []
+    for flag in ("scan_topic", "odom_topic"):
+        if getattr(a, flag, None):
+            out += ["--" + flag.replace("_", "-"), getattr(a, flag)]
+    return out
 
 
 def simulated_log(a, log, repeat):
@@ -179,7 +188,7 @@ def run_job(a):
         rawlog, gt = simulated_log(a, log, a.repeat)
         seed = a.repeat + 1
     cmd = [a.exe, a.config, rawlog, "-o", folder, "-m", mode, "-q", "--skip-scans",
-           str(a.repeat), "--split-seconds", repr(a.split_seconds)]
+           str(a.repeat), "--split-seconds", repr(a.split_seconds)] + source_args(a)
     if not a.map:
         cmd.append("--no-map")
     if rel:
@@ -266,7 +275,8 @@ def cmd_run(a):
         log, config, mode, k = j
         ns = argparse.Namespace(out=a.out, log=log, datasets=a.datasets, config=config,
                                 mode=mode, repeat=k, exe=a.exe, sim_exe=a.sim_exe,
-                                split_seconds=a.split_seconds, map=a.maps)
+                                split_seconds=a.split_seconds, map=a.maps,
+                                scan_topic=a.scan_topic, odom_topic=a.odom_topic)
         return run_job(ns)
 
     with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
@@ -473,6 +483,8 @@ def main(argv=None):
     tools.add_argument("--sim-exe", default=DEFAULT_SIM, help="kfd-simulate")
     tools.add_argument("--split-seconds", type=float, default=10.0,
                        help="relations over at most S s are local (default 10)")
+    tools.add_argument("--scan-topic", help="bags: kfd-icp-slam --scan-topic (default: automatic)")
+    tools.add_argument("--odom-topic", help="bags: kfd-icp-slam --odom-topic TOPIC|tf|none")
     report = argparse.ArgumentParser(add_help=False)  # how runs are compared: run and collect
     report.add_argument("--baseline", default="none")
     report.add_argument("--pairs", nargs="*", default=[], help="more pairs A:B")

@@ -1,6 +1,7 @@
 """kfd-compare end to end: a small run (2 logs x 2 modes x 3 repeats) through the real
 kfd-icp-slam, and the emitted job list run through GNU parallel, then collected.
 Usage: kfd_compare_test.py BUILD_APPS_DIR DATASETS_DIR"""
+import csv
 import json
 import os
 import shutil
@@ -111,6 +112,23 @@ class KfdCompare(unittest.TestCase):
             self.assertEqual(log["relations"], os.path.join(DATASETS, folder, folder + ".relations"))
         self.assertEqual(kfd_compare.log_stem("aces.orig.bag"), "aces.orig")
         self.assertEqual(kfd_compare.log_stem("intel.clf.gz"), "intel")
+        # A laser-only bag through kfd-icp-slam, the topic passed on (also to emitted jobs).
+        bag = os.path.join(DATASETS, "ccny-urg", "demo.bag")
+        if not os.path.isfile(bag):
+            return
+        out = os.path.join(self.tmp, "bag")
+        r = compare("run", "--logs", bag, "--modes", "none", "kfd", "--repeats", "2", "--out",
+                    out, "--scan-topic", "/scan", "--no-plots", "-q", *self.exe)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(out, "runs.csv")) as f:
+            runs = list(csv.DictReader(f))
+        self.assertEqual(len(runs), 4)
+        self.assertEqual(sorted(int(x["scans_in"]) for x in runs), [359, 359, 360, 360])
+        jobs = os.path.join(self.tmp, "jobs.txt")
+        r = compare("run", "--logs", bag, "--modes", "kfd", "--repeats", "1", "--out", out + "2",
+                    "--scan-topic", "/scan", "--emit-jobs", jobs, *self.exe)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("--scan-topic /scan", open(jobs).read())
 
     def test_bad_input_is_a_clear_error(self):
         out = os.path.join(self.tmp, "bad")
