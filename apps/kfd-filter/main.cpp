@@ -119,9 +119,11 @@ int main(int argc, char** argv) {
         ->type_name("FILE");
     kfd::app::addSourceOptions(cli, opts.source, list);
     cli.option("--removed-as", removed_as, "bag output: removed points as nan or inf (REP 117)")
+        ->type_name("MARK")
         ->check(CLI::IsMember({"nan", "inf"}))
         ->capture_default_str();
     cli.option("--bag-compression", compression, "bag output: none, lz4 or bz2")
+        ->type_name("C")
         ->check(CLI::IsMember({"none", "lz4", "bz2"}))
         ->capture_default_str();
     cli.option("-c,--config", config,

@@ -109,7 +109,7 @@ int main(int argc, char** argv) {
         kfd::writeIcpSlamReport(result);
         const auto& s = result.summary;
         std::printf("kfd-icp-slam summary (mode %s)\n", kfd::toString(s.mode));
-        std::printf("  rawlog     %s\n  output     %s\n", s.rawlog.c_str(), s.output_dir.c_str());
+        std::printf("  input      %s\n  output     %s\n", s.rawlog.c_str(), s.output_dir.c_str());
         std::printf("  scans      in %zu, kept %zu, dropped %.1f %%\n", s.scans_in, s.scans_kept,
                     s.dropped_pct);
         std::printf("  points     removed %zu of %zu\n", s.points_removed, s.points_in);
