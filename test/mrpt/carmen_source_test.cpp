@@ -135,6 +135,16 @@ TEST(CarmenSource, ParamOffsetsGiveTheMountAndGzipReadsLikePlain) {
     EXPECT_NEAR(s->sensorPose.y(), -0.1, 1e-12);
     EXPECT_EQ(as<Scan2D>(gz[1])->getScanRange(1), s->getScanRange(1));
     EXPECT_EQ(kfd::detectFormat(d / "m.log.gz"), kfd::LogFormat::Carmen);
+    // No resolution PARAM: 361 beams are 0.5 deg each (carmen2rawlog's 180.5 deg aperture),
+    // 180 beams 1 deg (180 deg, where a fixed 0.5 deg would give 90).
+    auto flaser = [](std::size_t n) {
+        std::string l = "FLASER " + std::to_string(n);
+        for (std::size_t i = 0; i < n; ++i) l += " 1";
+        return l + " 0 0 0 0 0 0 1.0 h 0\n";
+    };
+    EXPECT_NEAR(as<Scan2D>(readAll(d.write("361.clf", flaser(361)))[1])->aperture,
+                180.5 * M_PI / 180, 1e-6);
+    EXPECT_NEAR(as<Scan2D>(readAll(d.write("180.clf", flaser(180)))[1])->aperture, M_PI, 1e-6);
     EXPECT_EQ(kfd::detectFormat(d / "m.log"), kfd::LogFormat::Carmen);
 }
 

@@ -90,10 +90,21 @@ std::vector<std::string_view> tokenize(const std::string& line) {
 // The laser of FLASER (front) or RLASER (rear) lines: its PARAMs.
 struct LaserParams {
     double max_range = 81.0;      // robot_*_laser_max
-    double resolution_deg = 0.5;  // laser_*_laser_resolution
+    double resolution_deg = 0.0;  // laser_*_laser_resolution; 0 = not given (defaultResolution)
     bool offset_given = false;    // robot_*laser_offset and friends
     double offset_x = 0.0, offset_side = 0.0, offset_angle = 0.0;
 };
+
+// A FLASER line covers 180 degrees (CARMEN's convention). Without a resolution PARAM: the SICK
+// resolution (1, 0.5 or 0.25 deg) within 1 % of 180 / n, else 180 / n. For the 0.5 deg mode
+// (361 beams) this is MRPT carmen2rawlog's fixed default of 0.5 deg; for 180 beams that
+// default would give a 90 deg aperture, this gives 180.
+double defaultResolution(std::size_t n) {
+    const double r = 180.0 / static_cast<double>(std::max<std::size_t>(n, 1));
+    for (const double sick : {1.0, 0.5, 0.25})
+        if (std::fabs(r - sick) <= 0.01 * sick) return sick;
+    return r;
+}
 
 }  // namespace
 
@@ -217,7 +228,8 @@ struct CarmenSource::Impl {
         const double ox = number(k + 3), oy = number(k + 4), oth = number(k + 5);
         const double stamp = number(k + 6);
         auto s = scanOf(2, n, p.max_range, stamp);
-        s->aperture = static_cast<float>(p.resolution_deg * static_cast<double>(n) * kDeg);
+        const double res = p.resolution_deg > 0.0 ? p.resolution_deg : defaultResolution(n);
+        s->aperture = static_cast<float>(res * static_cast<double>(n) * kDeg);
         if (p.offset_given)
             s->sensorPose =
                 mrpt::poses::CPose3D(p.offset_x, p.offset_side, 0.0, p.offset_angle, 0.0, 0.0);

@@ -22,8 +22,11 @@ class CarmenError : public SourceError {
 ///    Observation entry with a CObservationOdometry (label "ODOMETRY", the odom_* pose), then
 ///    one with the scan (label "FLASER" / "RLASER"). As MRPT's carmen2rawlog converts them, so
 ///    that the log and its rawlog give the same scans: aperture = resolution x n (PARAM
-///    laser_front_laser_resolution / laser_rear_laser_resolution, default 0.5 deg), max range
-///    from PARAM robot_front_laser_max / robot_rear_laser_max (default 81 m), a beam valid
+///    laser_front_laser_resolution / laser_rear_laser_resolution; without it the SICK
+///    resolution of 1, 0.5 or 0.25 deg within 1 % of 180 deg / n, else 180 deg / n: 0.5 deg
+///    for 361 beams as carmen2rawlog, 1 deg for 180 beams where carmen2rawlog's fixed 0.5 deg
+///    gives 90 deg), max range from PARAM robot_front_laser_max / robot_rear_laser_max
+///    (default 81 m), a beam valid
 ///    when 0 < r < max, sensor pose = the laser pose x y theta in the frame of the odometry
 ///    pose (unless PARAM robot_frontlaser_offset / robot_rearlaser_offset give the mount).
 ///  - RAWLASER1..4 (laser_type start_angle fov resolution max_range accuracy remission_mode n
