@@ -98,13 +98,13 @@ def resolve_log(spec, datasets):
         raise CompareError("log not found: %s (%s)" % (spec, rawlog))
     # NAME.relations / NAME.gt.tum beside the log: for aces/aces.orig.bag, aces.orig.* or aces.*
     folder = os.path.dirname(rawlog)
-    stems = [log_stem(os.path.basename(rawlog))]
-    stems.append(stems[0].split(".")[0])
-    rel = next((os.path.join(folder, x + ".relations") for x in stems
-                if os.path.isfile(os.path.join(folder, x + ".relations"))), None)
-    gt = next((os.path.join(folder, x + ".gt.tum") for x in stems
-               if os.path.isfile(os.path.join(folder, x + ".gt.tum"))), None)
-    return {"name": name, "kind": "file", "rawlog": rawlog, "relations": rel, "gt": gt,
+    stems = [name, name.split(".")[0]]  # name is the log's file name without its extension
+
+    def beside(ext):
+        return next((p for p in (os.path.join(folder, x + ext) for x in stems)
+                     if os.path.isfile(p)), None)
+    return {"name": name, "kind": "file", "rawlog": rawlog, "relations": beside(".relations"),
+            "gt": beside(".gt.tum"),
             "max_dt": MAX_DT.get(stems[1], MAX_DT.get(name, 1e-3))}
 
 

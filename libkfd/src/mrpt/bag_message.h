@@ -3,6 +3,9 @@
 #pragma once
 
 #include <rosbag/message_instance.h>
+#include <sensor_msgs/LaserScan.h>
+
+#include <cmath>
 
 #include "kfd/mrpt/source.h"
 
@@ -13,5 +16,11 @@ struct NativeMessage {
     /// Valid while the BagSource that read it is alive (it refers to the open bag).
     rosbag::MessageInstance message;
 };
+
+/// The one beam validity rule of a LaserScan (the source's and the writer's): finite and
+/// range_min <= r < range_max (r = range_max is "no return", as in MRPT's rawlogs and CARMEN).
+inline bool validRange(const sensor_msgs::LaserScan& m, float r) {
+    return std::isfinite(r) && r >= m.range_min && r < m.range_max;
+}
 
 }  // namespace kfd

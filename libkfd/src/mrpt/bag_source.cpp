@@ -115,6 +115,14 @@ std::string pickTopic(const std::map<std::string, TopicInfo>& topics, const std:
     return {};
 }
 
+// The first message of `topic` as a T, or null (none, or not a T).
+template <class T>
+boost::shared_ptr<T> firstMessage(rosbag::Bag& bag, const std::string& topic) {
+    rosbag::View v(bag, rosbag::TopicQuery(topic));
+    for (const rosbag::MessageInstance& m : v) return m.instantiate<T>();
+    return nullptr;
+}
+
 // The first transform in /tf whose parent is `odom_frame` (its child is the base frame).
 std::string baseFrameFromTf(rosbag::Bag& bag, const std::string& tf_topic,
                             const std::string& odom_frame) {
@@ -136,14 +144,8 @@ struct Edge {
 };
 
 void chooseMount(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topics, BagChoice& c) {
-    {
-        rosbag::View v(bag, rosbag::TopicQuery(c.scan_topic));
-        for (const rosbag::MessageInstance& m : v) {
-            if (const auto s = m.instantiate<sensor_msgs::LaserScan>())
-                c.laser_frame = stripSlash(s->header.frame_id);
-            break;
-        }
-    }
+    if (const auto s = firstMessage<sensor_msgs::LaserScan>(bag, c.scan_topic))
+        c.laser_frame = stripSlash(s->header.frame_id);
     std::map<std::string, Edge> edges;  // child -> parent
     for (const char* topic : {"/tf_static", "tf_static"}) {
         const auto it = topics.find(topic);
@@ -193,6 +195,7 @@ BagChoice choose(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topic
     for (const char* t : {"/tf", "tf"})
         if (topics.count(t) && topics.at(t).type == kTfMessage) tf_topic = t;
     const std::string mode = o.odom_topic;
+    std::string tf_child;  // the child of the odom frame in /tf, once looked up
     if (mode == "none") {
         c.notes.push_back("odometry: none (--odom-topic none): laser only");
     } else if (mode == "tf") {
@@ -201,9 +204,11 @@ BagChoice choose(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topic
     } else {
         c.odom_topic = pickTopic(topics, mode, kOdometry, {"/odom", "odom"}, "odometry",
                                  "--odom-topic", c.notes, false);
+        if (c.odom_topic.empty() && !tf_topic.empty())
+            tf_child = baseFrameFromTf(bag, tf_topic, c.odom_frame);
         if (!c.odom_topic.empty()) {
             c.odometry = BagChoice::Odometry::Topic;
-        } else if (!tf_topic.empty() && !baseFrameFromTf(bag, tf_topic, c.odom_frame).empty()) {
+        } else if (!tf_child.empty()) {
             c.odometry = BagChoice::Odometry::Tf;
         } else {
             c.notes.push_back("odometry: none (no " + std::string(kOdometry) + " topic, no " +
@@ -212,18 +217,15 @@ BagChoice choose(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topic
     }
     if (c.odometry == BagChoice::Odometry::Topic) {
         c.base_frame = stripSlash(o.base_frame);
-        if (c.base_frame.empty()) {
-            rosbag::View v(bag, rosbag::TopicQuery(c.odom_topic));
-            for (const rosbag::MessageInstance& m : v) {
-                if (const auto od = m.instantiate<nav_msgs::Odometry>())
-                    c.base_frame = stripSlash(od->child_frame_id);
-                break;
-            }
-        }
+        if (c.base_frame.empty())
+            if (const auto od = firstMessage<nav_msgs::Odometry>(bag, c.odom_topic))
+                c.base_frame = stripSlash(od->child_frame_id);
     } else if (c.odometry == BagChoice::Odometry::Tf) {
         c.odom_topic = tf_topic;
         c.base_frame = stripSlash(o.base_frame);
-        if (c.base_frame.empty()) c.base_frame = baseFrameFromTf(bag, tf_topic, c.odom_frame);
+        if (c.base_frame.empty())
+            c.base_frame =
+                !tf_child.empty() ? tf_child : baseFrameFromTf(bag, tf_topic, c.odom_frame);
         if (c.base_frame.empty())
             throw BagError("--odom-topic tf: no transform from the " + c.odom_frame +
                            " frame in the first " + std::to_string(kTfProbe) +
@@ -271,6 +273,7 @@ struct BagSource::Impl {
     rosbag::Bag bag;
     std::map<std::string, TopicInfo> topics;
     BagChoice choice;
+    std::string label;  // the scans' sensor label: the scan topic without its leading '/'
     std::unique_ptr<rosbag::View> view;
     rosbag::View::iterator it;
     bool at_end = false;
@@ -286,6 +289,7 @@ struct BagSource::Impl {
         try {
             topics = topicsOf(bag);
             choice = choose(bag, topics, o);
+            label = stripSlash(choice.scan_topic);
             view = std::make_unique<rosbag::View>(bag);
             total_messages = view->size();
             it = view->begin();
@@ -345,7 +349,7 @@ struct BagSource::Impl {
 
     CObservation2DRangeScan::Ptr toScan(const sensor_msgs::LaserScan& m) const {
         auto obs = std::make_shared<CObservation2DRangeScan>();
-        obs->sensorLabel = stripSlash(choice.scan_topic);
+        obs->sensorLabel = label;
         obs->timestamp = mrpt::Clock::fromDouble(m.header.stamp.toSec());
         const std::size_t n = m.ranges.size();
         obs->aperture = static_cast<float>(std::fabs(double(m.angle_max) - double(m.angle_min)));
@@ -357,9 +361,8 @@ struct BagSource::Impl {
         obs->resizeScan(n);
         for (std::size_t i = 0; i < n; ++i) {
             const float r = m.ranges[i];
-            const bool ok = std::isfinite(r) && r >= m.range_min && r < m.range_max;
             obs->setScanRange(i, std::isfinite(r) ? r : 0.0f);
-            obs->setScanRangeValidity(i, ok);
+            obs->setScanRangeValidity(i, validRange(m, r));
         }
         if (m.intensities.size() == n && n > 0) {
             obs->setScanHasIntensity(true);

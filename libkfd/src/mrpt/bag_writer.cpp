@@ -3,7 +3,7 @@
 #include <rosbag/bag.h>
 #include <sensor_msgs/LaserScan.h>
 
-#include <cmath>
+#include <algorithm>
 #include <limits>
 
 #include "bag_message.h"
@@ -85,9 +85,7 @@ std::size_t BagWriter::writeScan(const NativeMessage& original,
     std::size_t marked = 0;
     const std::size_t n = std::min(ls->ranges.size(), cleaned.getScanSize());
     for (std::size_t i = 0; i < n; ++i) {
-        const float r = ls->ranges[i];
-        const bool was_valid = std::isfinite(r) && r >= ls->range_min && r < ls->range_max;
-        if (was_valid && !cleaned.getScanRangeValidity(i)) {
+        if (validRange(*ls, ls->ranges[i]) && !cleaned.getScanRangeValidity(i)) {
             ls->ranges[i] = mark;
             ++marked;
         }

@@ -26,8 +26,12 @@ constexpr double kDeg = kPi / 180.0;
 // Reads a (plain or gzip) file line by line through detail::GzReader.
 class LineReader {
   public:
-    explicit LineReader(const std::string& path) : in_(path), path_(path) {}
-    bool isOpen() const { return in_.isOpen(); }
+    /// CarmenError when `path` is not a readable file.
+    explicit LineReader(const std::string& path) : in_(path), path_(path) {
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(path, ec) || !in_.isOpen())
+            throw CarmenError(path + ": cannot open the CARMEN log", path);
+    }
     // The next line without its end of line; false at the end of the file. Throws CarmenError
     // when the stream is broken (a cut or corrupt gzip).
     bool next(std::string& line) {
@@ -118,11 +122,7 @@ struct CarmenSource::Impl {
     std::string line;
     std::vector<std::string_view> tok;
 
-    explicit Impl(const std::string& p) : path(p), lines(p) {
-        std::error_code ec;
-        if (!std::filesystem::is_regular_file(p, ec) || !lines.isOpen())
-            throw CarmenError(p + ": cannot open the CARMEN log", p);
-    }
+    explicit Impl(const std::string& p) : path(p), lines(p) {}
 
     [[noreturn]] void fail(const std::string& what) const {
         throw CarmenError(path + ":" + std::to_string(lines.number()) + ": " + what, path);
@@ -316,9 +316,6 @@ std::size_t CarmenSource::line() const { return impl_->lines.number(); }
 
 SourceListing listCarmen(const std::string& path) {
     LineReader lines(path);
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec) || !lines.isOpen())
-        throw CarmenError(path + ": cannot open the CARMEN log", path);
     SourceListing l;
     l.path = path;
     l.format = LogFormat::Carmen;

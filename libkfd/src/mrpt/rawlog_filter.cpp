@@ -32,6 +32,20 @@ using mrpt::obs::CObservation2DRangeScan;
 using mrpt::obs::CSensoryFrame;
 using mrpt::poses::CPose2D;
 
+// Runs fn; the errors of the sources and of the bag writer (SourceError, BagError,
+// CarmenError) come out as RawlogError, the class RawlogFilter reports (a RawlogError as it
+// is). `field`: the path the error is about, when it is not the error's own (the output).
+template <class Fn>
+decltype(auto) asRawlogError(Fn&& fn, const std::string& field = {}) {
+    try {
+        return fn();
+    } catch (const RawlogError&) {
+        throw;
+    } catch (const SourceError& e) {
+        throw RawlogError(e.what(), field.empty() ? e.field() : field);
+    }
+}
+
 class CsvWriter {
   public:
     void open(const fs::path& path, const std::string& final_path) {
@@ -276,24 +290,18 @@ void Run::execute() {
         throw RawlogError(e.what(), e.field());
     }
 
-    std::unique_ptr<Source> source;
-    try {
-        sum_.input_format = detectFormat(opts_.input);
-        const std::string& o = opts_.output;
-        sum_.output_format = o.size() > 4 && o.compare(o.size() - 4, 4, ".bag") == 0
-                                 ? LogFormat::Bag
-                                 : LogFormat::Rawlog;
-        if (sum_.output_format == LogFormat::Bag && sum_.input_format != LogFormat::Bag)
-            throw RawlogError("a bag output (" + o + ") needs a ROS bag input; " + opts_.input +
-                                  " is read as: " + toString(sum_.input_format) +
-                                  " (write a .rawlog instead)",
-                              o);
-        source = openSource(opts_.input, opts_.source);
-    } catch (const RawlogError&) {
-        throw;
-    } catch (const SourceError& e) {  // reported like every other input problem of this class
-        throw RawlogError(e.what(), e.field());
-    }
+    const std::string& o = opts_.output;
+    sum_.output_format = o.size() > 4 && o.compare(o.size() - 4, 4, ".bag") == 0
+                             ? LogFormat::Bag
+                             : LogFormat::Rawlog;
+    sum_.input_format = asRawlogError([&] { return detectFormat(opts_.input); });
+    if (sum_.output_format == LogFormat::Bag && sum_.input_format != LogFormat::Bag)
+        throw RawlogError("a bag output (" + o + ") needs a ROS bag input; " + opts_.input +
+                              " is read as: " + toString(sum_.input_format) +
+                              " (write a .rawlog instead)",
+                          o);
+    const auto source =
+        asRawlogError([&] { return openSource(opts_.input, sum_.input_format, opts_.source); });
     const std::uint64_t total = source->bytesTotal();
     if (const auto* bag = dynamic_cast<const BagSource*>(source.get())) {
         const BagChoice& c = bag->choice();
@@ -309,11 +317,7 @@ void Run::execute() {
     TempOutputFile tmp(opts_.output);
     std::optional<TempOutputFile> tmp_csv;
     if (sum_.output_format == LogFormat::Bag) {
-        try {
-            bag_.emplace(tmp.path().string(), opts_.bag);
-        } catch (const SourceError& e) {
-            throw RawlogError(e.what(), opts_.output);
-        }
+        asRawlogError([&] { bag_.emplace(tmp.path().string(), opts_.bag); }, opts_.output);
     } else {
         if (!out_.open(tmp.path().string(), opts_.compress_level))
             throw RawlogError("cannot write the output next to " + opts_.output, opts_.output);
@@ -328,14 +332,7 @@ void Run::execute() {
     progress.bytes_total = total;
     const std::size_t every = std::max<std::size_t>(1, opts_.progress_every);
     SourceEntry e;
-    for (;;) {
-        try {
-            if (!source->next(e)) break;
-        } catch (const RawlogError&) {
-            throw;
-        } catch (const SourceError& err) {
-            throw RawlogError(err.what(), err.field());
-        }
+    while (asRawlogError([&] { return source->next(e); })) {
         throwIfCancelled();
         const std::size_t before = sum_.objects_in;
         sum_.objects_in = e.objects_read;
@@ -363,7 +360,8 @@ void Run::execute() {
                 } else if (!bag_) {
                     write(*scan);
                 } else if (e.native) {
-                    sum_.points_marked += bag_->writeScan(*e.native, *scan);
+                    sum_.points_marked += asRawlogError(
+                        [&] { return bag_->writeScan(*e.native, *scan); }, opts_.output);
                     ++sum_.objects_out;
                 }
                 break;
@@ -374,7 +372,7 @@ void Run::execute() {
                 break;
             case SourceEntry::Kind::Native:  // another topic of a bag
                 if (bag_) {
-                    bag_->copy(*e.native);
+                    asRawlogError([&] { bag_->copy(*e.native); }, opts_.output);
                     ++sum_.objects_out;
                 }
                 break;
@@ -400,11 +398,7 @@ void Run::execute() {
     }
     arch_.reset();
     if (bag_) {
-        try {
-            bag_->close();
-        } catch (const SourceError& err) {
-            throw RawlogError(err.what(), opts_.output);
-        }
+        asRawlogError([&] { bag_->close(); }, opts_.output);
     } else {
         out_.close();
     }

@@ -2,12 +2,8 @@
 
 #include <mrpt/io/CStream.h>
 #include <mrpt/serialization/CArchive.h>
-#include <zlib.h>
 
 #include <algorithm>
-#include <array>
-#include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <vector>
 

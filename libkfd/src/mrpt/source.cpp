@@ -122,7 +122,12 @@ LogFormat detectFormat(const std::string& path) {
 }
 
 std::unique_ptr<Source> openSource(const std::string& path, const SourceOptions& options) {
-    switch (detectFormat(path)) {
+    return openSource(path, detectFormat(path), options);
+}
+
+std::unique_ptr<Source> openSource(const std::string& path, LogFormat format,
+                                   const SourceOptions& options) {
+    switch (format) {
         case LogFormat::Bag:
             return std::make_unique<BagSource>(path, options);
         case LogFormat::Carmen:

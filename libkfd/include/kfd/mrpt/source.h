@@ -170,6 +170,10 @@ LogFormat detectFormat(const std::string& path);
 /// Opens the log at `path` with the source for its format (detectFormat). Throws SourceError
 /// when it cannot be opened, naming the file and the reason.
 std::unique_ptr<Source> openSource(const std::string& path, const SourceOptions& options = {});
+/// The same with the format already known (from detectFormat), for callers that decide on it
+/// before opening (kfd-filter's bag output).
+std::unique_ptr<Source> openSource(const std::string& path, LogFormat format,
+                                   const SourceOptions& options = {});
 
 /// What a log holds, for `--list`: its streams (a bag's topics, a CARMEN log's line kinds, a
 /// rawlog's object classes and sensor labels) and, for a bag, what a source would use.
@@ -182,9 +186,10 @@ struct SourceListing {
     };
     std::string path;
     LogFormat format = LogFormat::Rawlog;
-    std::string detail;  // e.g. "bz2-compressed, 22125 messages"
+    std::string detail;  // e.g. "ROS 1 bag, 4 topics, 22125 messages"
     std::vector<Stream> streams;
-    std::vector<std::string> choices;  // "scans: /scan (sensor_msgs/LaserScan, auto)", ...
+    std::vector<std::string> choices;  // "scans: /scan (the only sensor_msgs/LaserScan
+                                       // topic)", ...; a CARMEN log's PARAMs
 };
 
 /// Reads the log at `path` once (a bag only through its index) and lists it. Throws
