@@ -12,7 +12,7 @@ import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
-COMPARE = os.path.join(ROOT, "share", "scripts", "kfd-compare")
+COMPARE = os.path.join(ROOT, "scripts", "kfd-compare")
 OFFICE = os.path.join(ROOT, "rawlogs", "office-mit-0.752.rawlog")
 APPS = DATASETS = None
 
@@ -101,8 +101,7 @@ class KfdCompare(unittest.TestCase):
         self.assertTrue(all(abs(x["drop"] - x["target_drop_pct"]) < 0.5 for x in dec))
 
     def test_bags_and_carmen_logs_find_their_relations(self):
-        sys.path.insert(0, os.path.join(ROOT, "share", "scripts"))
-        import kfd_compare
+        from kfd_tools import compare as kfd_compare
         for rel in ("aces/aces.orig.bag", "mit-csail/mit-csail.clf", "intel/intel.reconstructed.clf.gz"):
             path = os.path.join(DATASETS, rel)
             if not os.path.isfile(path):

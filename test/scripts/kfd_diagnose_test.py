@@ -5,15 +5,14 @@ import math
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 import unittest
 
+from kfd_tools import diagnose as kfd_diagnose
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
-COMPARE = os.path.join(ROOT, "share", "scripts", "kfd-compare")
-sys.path.insert(0, os.path.join(ROOT, "share", "scripts"))
-import kfd_diagnose  # noqa: E402
+COMPARE = os.path.join(ROOT, "scripts", "kfd-compare")
 
 N = 60
 

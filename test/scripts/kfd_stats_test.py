@@ -1,11 +1,8 @@
 """kfd_stats (kfd-compare's statistics) against values computed by hand."""
 import math
-import os
-import sys
 import unittest
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "share", "scripts"))
-import kfd_stats as st  # noqa: E402
+from kfd_tools import stats as st
 
 
 class Summaries(unittest.TestCase):

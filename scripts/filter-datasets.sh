@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Runs kfd-filter with one preset on the five Freiburg benchmark logs and prints a Markdown
 # table (the source of the kfd-filter table in docs/RESULTS.md).
-# Usage: bash share/scripts/filter-datasets.sh [CONFIG] [DATASETS_DIR]
+# Usage: bash scripts/filter-datasets.sh [CONFIG] [DATASETS_DIR]
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cfg="${1:-$root/share/kfd/default.ini}"
 data="${2:-$root/../shared/datasets}"
 exe="$root/build/apps/kfd-filter"
-[ -x "$exe" ] || { echo "build kfd-filter first (bash share/scripts/demo.sh)" >&2; exit 1; }
+[ -x "$exe" ] || { echo "build kfd-filter first (bash scripts/demo.sh)" >&2; exit 1; }
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 echo "Preset: \`$(realpath --relative-to="$root" "$cfg")\`"

@@ -4,13 +4,13 @@
 Simulates the office world (MIT sensor class, 40 Hz, 1081 beams) at three noise levels, runs
 every denoiser on every scan (no keyframe stage) with kfd-denoise-eval, and prints a Markdown
 table: precision, recall, F1, true points kept, recall per noise kind, time per scan.
-Usage: python3 share/scripts/denoise_quality.py [--duration S] [--out DIR]
+Usage: python3 scripts/denoise_quality.py [--duration S] [--out DIR]
 """
 import argparse
 import os
 import subprocess
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BIN = os.path.join(ROOT, "build", "apps")
 LEVELS = {"low": 0.5, "medium": 1.0, "high": 2.0}  # x the default rates
 DEFAULT_RATES = {"isolated": 0.005, "clustered": 0.05, "edge": 0.3}

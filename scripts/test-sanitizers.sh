@@ -4,17 +4,17 @@
 # fails its test) in build-asan/, with the libFuzzer targets (their corpus replay is part of
 # ctest) and without the benchmarks, then runs the whole test suite through ctest.
 # Leak reports are suppressed only for third-party code, listed with reasons in
-# share/scripts/lsan.supp. Prints the time the job took.
+# scripts/lsan.supp. Prints the time the job took.
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 start=$(date +%s)
-bash "$root/share/scripts/install-deps.sh"
+bash "$root/scripts/install-deps.sh"
 build="$root/build-asan"
 # Fast (frame-pointer) unwinding on malloc, ASan's default: the slow unwinder calls libgcc's
 # _Unwind_Find_FDE, which mallocs, and deadlocks against OSMesa's llvmpipe threads (the render
 # tests hung idle at 0 % CPU with fast_unwind_on_malloc=0).
 export ASAN_OPTIONS="detect_leaks=1:check_initialization_order=1"
-export LSAN_OPTIONS="suppressions=$root/share/scripts/lsan.supp:print_suppressions=0"
+export LSAN_OPTIONS="suppressions=$root/scripts/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 # Warnings are not errors here: clang's -Wconversion also warns of sign conversions that the
 # GCC build (the one with -Werror) does not check.

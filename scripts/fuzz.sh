@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs one libFuzzer target for N minutes: share/scripts/fuzz.sh TARGET MINUTES
+# Runs one libFuzzer target for N minutes: scripts/fuzz.sh TARGET MINUTES
 #   TARGET: pipeline, ini, yaml, rawlog, carmen or bag (test/fuzz/fuzz_TARGET.cpp)
 # Builds the fuzzers in build-fuzz/ (clang, KFD_BUILD_FUZZERS=ON) when needed, starts from
 # the committed corpus test/fuzz/corpus/TARGET/ (new inputs go to build-fuzz/corpus/TARGET/,
@@ -7,7 +7,7 @@
 # and keeps going after a crash (-fork=1 -ignore_crashes=1): every crash, timeout or
 # out-of-memory input is kept in build-fuzz/artifacts/TARGET/. Exit status 1 when any was kept.
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 if [ $# -ne 2 ]; then
   echo "usage: $0 TARGET MINUTES   (TARGET: pipeline, ini, yaml, rawlog, carmen, bag)" >&2
   exit 2
@@ -27,7 +27,7 @@ mkdir -p "$corpus" "$artifacts"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 # Full malloc stacks so that the third-party leak suppressions match.
 export ASAN_OPTIONS="fast_unwind_on_malloc=0"
-export LSAN_OPTIONS="suppressions=$root/share/scripts/lsan.supp:print_suppressions=0"
+export LSAN_OPTIONS="suppressions=$root/scripts/lsan.supp:print_suppressions=0"
 rc=0
 "$build/test/fuzz/fuzz_$target" -max_total_time=$((minutes * 60)) -timeout=2 -rss_limit_mb=2048 \
   -fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 -print_final_stats=1 \

@@ -13,7 +13,7 @@ import json
 import math
 import os
 
-from kfd_stats import median, quantile
+from .stats import median, quantile
 
 STATIONARY_M, STATIONARY_DEG = 0.005, 0.3
 TRANS_BINS = [(0.0, 0.15), (0.15, 0.3), (0.3, float("inf"))]

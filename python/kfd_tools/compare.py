@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """kfd-compare: repeated, paired ICP-SLAM runs that tell signal from noise.
 
 For logs x configs x modes x R repeats it runs kfd-icp-slam, then reports per (log, config,
@@ -34,20 +33,37 @@ import json
 import math
 import os
 import shlex
+import shutil
 import subprocess
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import kfd_diagnose  # noqa: E402
-import kfd_stats  # noqa: E402
+from . import diagnose as kfd_diagnose
+from . import stats as kfd_stats
 
+# The package is python/kfd_tools in the source tree (tools in build/apps) or, installed,
+# DATADIR/kfd/python/kfd_tools (tools in the prefix's bin, else on PATH).
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SELF = os.path.abspath(__file__)
-DEFAULT_EXE = os.path.join(ROOT, "build", "apps", "kfd-icp-slam")
-DEFAULT_SIM = os.path.join(ROOT, "build", "apps", "kfd-simulate")
-DEFAULT_DATASETS = os.path.join(ROOT, "..", "shared", "datasets")
-DEFAULT_CONFIG = os.path.join(ROOT, "share", "kfd-icp-slam", "sick-180-5hz.ini")
+if os.path.isfile(os.path.join(ROOT, "CMakeLists.txt")):
+    DEFAULT_EXE = os.path.join(ROOT, "build", "apps", "kfd-icp-slam")
+    DEFAULT_SIM = os.path.join(ROOT, "build", "apps", "kfd-simulate")
+    DEFAULT_DATASETS = os.path.join(ROOT, "..", "shared", "datasets")
+    DEFAULT_CONFIG = os.path.join(ROOT, "share", "kfd-icp-slam", "sick-180-5hz.ini")
+else:
+    _DATADIR = os.path.dirname(ROOT)
+
+    def _installed_tool(name):
+        beside = os.path.join(os.path.dirname(_DATADIR), "bin", name)
+        return beside if os.access(beside, os.X_OK) else shutil.which(name) or name
+
+    DEFAULT_EXE = _installed_tool("kfd-icp-slam")
+    DEFAULT_SIM = _installed_tool("kfd-simulate")
+    DEFAULT_DATASETS = "datasets"
+    DEFAULT_CONFIG = os.path.join(_DATADIR, "kfd-icp-slam", "sick-180-5hz.ini")
+# An emitted job runs the launcher that ran this (scripts/kfd-compare, bin/kfd-compare), else
+# this module with this interpreter (the package then has to be importable where jobs run).
+JOB_COMMAND = ([os.environ["KFD_COMPARE_LAUNCHER"]] if os.environ.get("KFD_COMPARE_LAUNCHER")
+               else [sys.executable, "-m", "kfd_tools.compare"])
 MAX_DT = {"mit-killian": 0.22}  # estimated stamps (its PROVENANCE.md)
 # (metric key, label, unit): what every table and plot reports
 METRICS = [("local", "relations error, local", "m"), ("long", "relations error, long", "m"),
@@ -142,10 +158,11 @@ def run_dir(out, log_name, config, mode, repeat):
 
 
 def job_args(a, log, config, mode, repeat):
-    args = [sys.executable, SELF, "job", "--out", os.path.abspath(a.out), "--log", log,
-            "--datasets", os.path.abspath(a.datasets), "--config", os.path.abspath(config),
-            "--mode", mode, "--repeat", str(repeat), "--exe", os.path.abspath(a.exe),
-            "--sim-exe", os.path.abspath(a.sim_exe), "--split-seconds", repr(a.split_seconds)]
+    args = JOB_COMMAND + [
+        "job", "--out", os.path.abspath(a.out), "--log", log,
+        "--datasets", os.path.abspath(a.datasets), "--config", os.path.abspath(config),
+        "--mode", mode, "--repeat", str(repeat), "--exe", os.path.abspath(a.exe),
+        "--sim-exe", os.path.abspath(a.sim_exe), "--split-seconds", repr(a.split_seconds)]
     if a.maps:
         args.append("--map")
     return args + source_args(a)
@@ -256,7 +273,7 @@ def cmd_run(a):
         if not os.path.isfile(c):
             raise CompareError("config not found: " + c)
     if not os.access(a.exe, os.X_OK):
-        raise CompareError("kfd-icp-slam not found: %s (build it: bash share/scripts/test.sh)"
+        raise CompareError("kfd-icp-slam not found: %s (build it: bash scripts/test.sh)"
                            % a.exe)
     check_modes(a.exe, a.modes)
     jobs = plan(a)

@@ -3,15 +3,15 @@
 # "On real scans with injected noise"): kfd-inject adds noise to each real log (seed 2), then
 # kfd-denoise-eval scores every method on the noisy copy and on the clean log. Every method
 # runs alone (pipeline = the method), with share/kfd/default.ini's parameters.
-# Usage: bash share/scripts/denoise-real.sh [LOG ...]   (default: all six; after demo.sh built)
+# Usage: bash scripts/denoise-real.sh [LOG ...]   (default: all six; after demo.sh built)
 # Output: out/denoise-real/LOG-METHOD-{noisy,clean}.txt
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 data="${KFD_DATASETS_DIR:-$root/../shared/datasets}"
 bin="$root/build/apps"
 out="$root/out/denoise-real"
 for t in kfd-inject kfd-denoise-eval; do
-  [ -x "$bin/$t" ] || { echo "build $t first (bash share/scripts/demo.sh)" >&2; exit 1; }
+  [ -x "$bin/$t" ] || { echo "build $t first (bash scripts/demo.sh)" >&2; exit 1; }
 done
 mkdir -p "$out"
 cd "$out"

@@ -1,15 +1,15 @@
 #!/usr/bin/env python3
 """Renders the benchmark chart of docs/RESULTS.md (docs/figures/time-per-stage.png) from
-out/bench/stages.json (share/scripts/bench.sh), with kfd-chart (MRPT's 2D canvas: no display).
+out/bench/stages.json (scripts/bench.sh), with kfd-chart (MRPT's 2D canvas: no display).
 The SLAM comparisons draw their own box plots (kfd-compare).
-Usage: python3 share/scripts/charts.py
+Usage: python3 scripts/charts.py
 """
 import json
 import os
 import subprocess
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CHART = os.path.join(ROOT, "build", "apps", "kfd-chart")
 FIG = os.path.join(ROOT, "docs", "figures")
 
@@ -27,7 +27,7 @@ def chart(rows, out, title, ylabel, log=False):
 
 def main():
     os.makedirs(FIG, exist_ok=True)
-    bench = os.path.join(ROOT, "out", "bench", "stages.json")  # from share/scripts/bench.sh
+    bench = os.path.join(ROOT, "out", "bench", "stages.json")  # from scripts/bench.sh
     if os.path.exists(bench):
         names = {"BM_DistanceFilter": "distance", "BM_Histogram": "histogram",
                  "BM_KeyframeDecision": "keyframe decision", "BM_DenoiseReference": "denoise ref",

@@ -3,13 +3,13 @@
 # (or IN.rawlog) runs kfd-filter (its summary; the filtered rawlog opens in RawLogViewer) and
 # kfd-icp-slam with the kfd pre-filter, which writes report.md, map_figure.png and
 # summary.json; and renders one scan's clusters (kfd-render, when OSMesa is available).
-# Usage: bash share/scripts/demo.sh [IN.rawlog [FILTER_CONFIG [SLAM_CONFIG]]]
+# Usage: bash scripts/demo.sh [IN.rawlog [FILTER_CONFIG [SLAM_CONFIG]]]
 #   defaults: rawlogs/office-mit-0.752.rawlog, share/kfd/kfd-40hz.ini,
 #   share/kfd-icp-slam/lidar-40hz.ini (for a 5 Hz log: share/kfd/default.ini and
 #   share/kfd-icp-slam/sick-180-5hz.ini). IN.gt.tum beside the log, when present, gives the ATE.
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
-bash "$root/share/scripts/install-deps.sh"
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+bash "$root/scripts/install-deps.sh"
 cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 targets=(kfd-filter kfd-icp-slam)
 cmake --build "$root/build" --target help | grep -q ' kfd-render$' && targets+=(kfd-render)

@@ -3,7 +3,7 @@
 # repeated runs, callgrind instruction counts per scan, kfd-filter's peak memory on logs of
 # growing size, and the issue-4 targets (the source of "Benchmarks" in docs/RESULTS.md).
 #
-# Usage: bash share/scripts/bench.sh
+# Usage: bash scripts/bench.sh
 # Environment:
 #   KFD_BENCH_BUILD_DIR   build directory (default: build-bench; RelWithDebInfo)
 #   KFD_BENCH_OUT         where JSON, callgrind output and the report go (default: out/bench)
@@ -11,14 +11,14 @@
 #   KFD_BENCH_REPETITIONS repetitions per benchmark (default: 5)
 #   KFD_BENCH_CALLS       counted calls per case under callgrind (default: 160)
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${KFD_BENCH_BUILD_DIR:-$root/build-bench}"
 out="${KFD_BENCH_OUT:-$root/out/bench}"
 data="${KFD_DATASETS_DIR:-$root/../shared/datasets}"
 reps="${KFD_BENCH_REPETITIONS:-5}"
 calls="${KFD_BENCH_CALLS:-160}"
 
-bash "$root/share/scripts/install-deps.sh"
+bash "$root/scripts/install-deps.sh"
 if ! command -v valgrind >/dev/null; then  # bench-only dependency
   SUDO=""
   [ "$(id -u)" -eq 0 ] || SUDO="sudo"
