@@ -4,7 +4,7 @@
 
 #include "common/cli.h"
 #include "kfd/core/cancel.h"
-#include "kfd/render/bar_chart.h"
+#include "kfd/plot/bar_chart.h"
 
 int main(int argc, char** argv) {
     kfd::app::Cli cli("kfd-chart", "CSV -o OUT.png [--title T] [--ylabel L] [--log] [--size W H]",

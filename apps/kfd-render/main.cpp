@@ -14,6 +14,7 @@
 #include "kfd/core/denoiser.h"
 #include "kfd/core/distance_filter.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/source.h"
 #include "kfd/render/cluster_figure.h"

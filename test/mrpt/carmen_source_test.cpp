@@ -11,6 +11,7 @@
 
 #include "kfd/mrpt/carmen_source.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/rawlog_source.h"
 #include "kfd/mrpt/stream_filter.h"
 #include "test_files.h"

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "kfd/mrpt/allocation_limit.h"
+#include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/rawlog_source.h"
 #include "kfd/mrpt/scan_adapter.h"
 #include "test_files.h"

@@ -1,11 +1,11 @@
-// kfd/render/bar_chart.h: bars where the values say, errors on bad input.
+// kfd/plot/bar_chart.h: bars where the values say, errors on bad input.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 
-#include "kfd/render/bar_chart.h"
+#include "kfd/plot/bar_chart.h"
 
 namespace {
 

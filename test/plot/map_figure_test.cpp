@@ -1,9 +1,9 @@
-// kfd/render/map_figure.h: trajectories land on the right pixels of the grid image.
+// kfd/plot/map_figure.h: trajectories land on the right pixels of the grid image.
 #include <gtest/gtest.h>
 
 #include <array>
 
-#include "kfd/render/map_figure.h"
+#include "kfd/plot/map_figure.h"
 
 namespace {
 

@@ -13,9 +13,16 @@
 #include <filesystem>
 #include <string>
 
-#include "kfd/mrpt/rawlog_source.h"
+#include "kfd/mrpt/source.h"
 
 namespace kfd::detail {
+
+// A misuse of the reader (a write or a seek): it only reads forward. A SourceError, so that
+// the sources' callers catch it like their own errors.
+class GzError : public SourceError {
+  public:
+    using SourceError::SourceError;
+};
 
 // Reads a plain or gzip file (told apart by the gzip magic bytes) through zlib's inflate, so
 // that the end of the gzip stream is checked: inflate (windowBits 15 + 16) verifies the
@@ -105,12 +112,8 @@ class GzReader : public mrpt::io::CStream {
         position_ += done;
         return done;
     }
-    size_t Write(const void*, size_t) override {
-        throw RawlogError("a rawlog source is read only");
-    }
-    uint64_t Seek(int64_t, TSeekOrigin) override {
-        throw RawlogError("a rawlog source cannot seek");
-    }
+    size_t Write(const void*, size_t) override { throw GzError("a rawlog source is read only"); }
+    uint64_t Seek(int64_t, TSeekOrigin) override { throw GzError("a rawlog source cannot seek"); }
     uint64_t getTotalBytesCount() const override { return size_; }
     uint64_t getPosition() const override { return position_; }  // decoded bytes
     std::string getStreamDescription() const override { return "kfd::RawlogSource"; }

@@ -19,6 +19,7 @@
 #include "kfd/core/output_paths.h"
 
 #include "kfd/core/denoiser.h"
+#include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/scan_check.h"
 

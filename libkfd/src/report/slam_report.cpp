@@ -14,7 +14,7 @@
 #include "kfd/baselines/decimate_stage.h"
 #include "kfd/baselines/motion_stage.h"
 #include "kfd/core/cancel.h"
-#include "kfd/render/map_figure.h"
+#include "kfd/plot/map_figure.h"
 
 namespace kfd {
 namespace {

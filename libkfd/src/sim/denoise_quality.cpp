@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/source.h"
 #include "kfd/mrpt/stream_filter.h"
 #include "kfd/sim/world.h"

@@ -11,6 +11,7 @@
 
 #include "kfd/core/cancel.h"
 #include "kfd/core/output_paths.h"
+#include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/scan_check.h"
 #include "kfd/mrpt/source.h"

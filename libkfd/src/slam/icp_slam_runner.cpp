@@ -21,6 +21,7 @@
 #include "kfd/core/cancel.h"
 #include "kfd/eval/ate.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_check.h"
 #include "kfd/mrpt/source.h"
 #include "kfd/mrpt/stream_filter.h"

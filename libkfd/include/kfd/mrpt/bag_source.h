@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "kfd/mrpt/source.h"
+#include "kfd/mrpt/source_listing.h"
 
 namespace kfd {
 

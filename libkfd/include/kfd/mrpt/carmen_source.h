@@ -5,6 +5,7 @@
 #include <string>
 
 #include "kfd/mrpt/source.h"
+#include "kfd/mrpt/source_listing.h"
 
 namespace kfd {
 

@@ -1,4 +1,6 @@
-// The input layer: a sensor log read entry by entry, whatever its file format.
+// The input layer: a sensor log read entry by entry, whatever its file format. The base of the
+// sources: it includes none of them (kfd/mrpt/open_source.h opens a log with the source for its
+// format, kfd/mrpt/source_listing.h lists one).
 #pragma once
 
 #include <mrpt/obs/CActionCollection.h>
@@ -13,7 +15,6 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <vector>
 
 #include "kfd/core/error.h"
 #include "kfd/core/scan.h"
@@ -126,8 +127,9 @@ struct SourceEntry {
 };
 
 /// A log read entry by entry, never loaded whole. Implementations: RawlogSource (MRPT
-/// rawlogs), BagSource (ROS 1 bags, kfd/mrpt/bag_source.h), CarmenSource (CARMEN logs,
-/// kfd/mrpt/carmen_source.h).
+/// rawlogs, kfd/mrpt/rawlog_source.h), BagSource (ROS 1 bags, kfd/mrpt/bag_source.h),
+/// CarmenSource (CARMEN logs, kfd/mrpt/carmen_source.h); openSource
+/// (kfd/mrpt/open_source.h) picks one by the log's content.
 class Source {
   public:
     virtual ~Source() = default;
@@ -159,42 +161,5 @@ struct SourceOptions {
     std::string base_frame;  // the robot frame; auto: the Odometry's child_frame_id, else the
                              // child of odom in /tf, else "base_link"
 };
-
-/// The format of the file at `path`, by content: a ROS bag starts "#ROSBAG V2.0"; a CARMEN log
-/// (plain or gzip) is text whose first non-comment line starts with a CARMEN keyword (PARAM,
-/// FLASER, ODOM, ...); anything else is read as a rawlog. The extension decides only for a
-/// text file of comments alone (.clf/.log: CARMEN). Throws SourceError when the file is
-/// missing or unreadable, or is a bag of another version.
-LogFormat detectFormat(const std::string& path);
-
-/// Opens the log at `path` with the source for its format (detectFormat). Throws SourceError
-/// when it cannot be opened, naming the file and the reason.
-std::unique_ptr<Source> openSource(const std::string& path, const SourceOptions& options = {});
-/// The same with the format already known (from detectFormat), for callers that decide on it
-/// before opening (kfd-filter's bag output).
-std::unique_ptr<Source> openSource(const std::string& path, LogFormat format,
-                                   const SourceOptions& options = {});
-
-/// What a log holds, for `--list`: its streams (a bag's topics, a CARMEN log's line kinds, a
-/// rawlog's object classes and sensor labels) and, for a bag, what a source would use.
-struct SourceListing {
-    struct Stream {
-        std::string name;  // topic, line keyword, or "Class[label]"
-        std::string type;  // message type, or what kfd makes of it
-        std::size_t count = 0;
-        double first_stamp = 0.0, last_stamp = 0.0;  // seconds; 0 when unknown
-    };
-    std::string path;
-    LogFormat format = LogFormat::Rawlog;
-    std::string detail;  // e.g. "ROS 1 bag, 4 topics, 22125 messages"
-    std::vector<Stream> streams;
-    std::vector<std::string> choices;  // "scans: /scan (the only sensor_msgs/LaserScan
-                                       // topic)", ...; a CARMEN log's PARAMs
-};
-
-/// Reads the log at `path` once (a bag only through its index) and lists it. Throws
-/// SourceError like openSource (and for a bag, the errors of BagSource's topic choice are
-/// reported as choices, not thrown).
-SourceListing listSource(const std::string& path, const SourceOptions& options = {});
 
 }  // namespace kfd

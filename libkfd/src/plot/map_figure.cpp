@@ -1,4 +1,4 @@
-#include "kfd/render/map_figure.h"
+#include "kfd/plot/map_figure.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "kfd/render/bar_chart.h"
+#include "kfd/plot/bar_chart.h"
 
 #include <algorithm>
 #include <cmath>

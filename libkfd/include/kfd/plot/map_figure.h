@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "kfd/eval/trajectory.h"
-#include "kfd/render/bar_chart.h"  // PlotError
+#include "kfd/plot/bar_chart.h"  // PlotError
 
 namespace kfd {
 
