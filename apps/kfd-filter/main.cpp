@@ -132,9 +132,10 @@ int main(int argc, char** argv) {
                "the paper's exact method: share/kfd/paper-mit-*.ini")
         ->type_name("FILE");
     cli.option("--stats", opts.stats_csv,
-               "per-scan CSV (timestamp, sensor, keyframe, reason, P_common,\n"
-               "clusters, points removed, microseconds, view change,\n"
-               "changed fraction, degeneracy, corridor)")
+               "per-scan CSV, kfd-icp-slam's scans.csv columns: index, timestamp,\n"
+               "sensor, kept, reason, P_common, points and clusters removed,\n"
+               "microseconds, view change, degeneracy, corridor, odometry\n"
+               "(docs/USAGE.md lists them)")
         ->type_name("FILE");
     cli.option("--compress", opts.compress_level, "gzip level of the output, 0-9")
         ->type_name("N")

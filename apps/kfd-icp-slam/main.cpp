@@ -93,19 +93,18 @@ int main(int argc, char** argv) {
             return kfd::app::printListing(log, o.source);
         }
         if (o.config_file.empty()) throw kfd::app::UsageError("no configuration (CONFIG.ini)");
-        const bool matchable =
-            o.mode == kfd::PrefilterMode::Odometry || o.mode == kfd::PrefilterMode::Decimate;
-        if ((o.odometry_target_drop_pct || o.match_drop_of) && !matchable)
-            throw kfd::app::UsageError(
-                "--match-drop and --match-drop-of apply to --mode odometry or decimate only");
-        if (o.odometry_target_drop_pct && o.match_drop_of)
-            throw kfd::app::UsageError("give --match-drop or --match-drop-of, not both");
         if (no_map) o.write_map = false;
         if (auto* progress = cli.progress())
             o.on_progress = [progress](const kfd::IcpSlamProgress& p) {
                 progress->update(p.fraction, p.scans_in, p.scans_kept);
             };
-        const auto result = kfd::IcpSlamRunner().run(o);
+        const auto result = [&] {
+            try {
+                return kfd::IcpSlamRunner().run(o);
+            } catch (const kfd::SlamOptionError& e) {  // options that contradict: usage
+                throw kfd::app::UsageError(e.what());
+            }
+        }();
         kfd::writeIcpSlamReport(result);
         const auto& s = result.summary;
         std::printf("kfd-icp-slam summary (mode %s)\n", kfd::toString(s.mode));

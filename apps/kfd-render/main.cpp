@@ -12,11 +12,11 @@
 #include "common/source_cli.h"
 #include "kfd/core/cancel.h"
 #include "kfd/core/denoiser.h"
-#include "kfd/core/distance_filter.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/source.h"
+#include "kfd/mrpt/stream_filter.h"
 #include "kfd/render/cluster_figure.h"
 
 int main(int argc, char** argv) {
@@ -87,30 +87,42 @@ int main(int argc, char** argv) {
             });
         }
         if (chosen.empty()) throw std::runtime_error("no such scan in " + in);
-        const kfd::DistanceFilter distance(p.get<kfd::DistanceStage>());
-        kfd::Denoiser den(p.get<kfd::DenoiseStage>());
-        kfd::Scan scan, work;
-        kfd::Denoiser::Result r;
+        // Through the one door, as every tool: the distance filter and the denoiser, every scan
+        // kept (no keyframe stage), so the history scans are the denoiser's previous ones.
+        kfd::Pipeline::Params drawn = p;
+        drawn.stages = {"distance", "denoise"};
+        kfd::StreamFilter door(drawn);
+        kfd::StreamResult r;
         for (const Seen& seen : chosen) {
-            kfd::toCore(*seen.scan, scan);
-            scan.odometry = seen.odometry;
-            distance.filter(scan);
-            work = scan;
-            r = den.filter(work);
+            r = door.process(*seen.scan, seen.odometry);
+            if (r.skipped != kfd::ScanSkipReason::None)
+                throw std::runtime_error(std::string("scan at ") +
+                                         std::to_string(kfd::stampOf(*seen.scan)) +
+                                         " cannot be used: " + kfd::toString(r.skipped));
         }
+        // Drawn: every clustered point of the scan (the denoiser's input; noise in red).
+        const auto& last = *chosen.back().scan;
+        const kfd::Clusters* clusters = door.lastClusters(last.sensorLabel);
+        if (!clusters) throw std::runtime_error("no clusters for the scan");
+        kfd::Scan scan;
+        kfd::toCore(last, scan);
+        for (std::size_t i = 0; i < scan.size() && i < clusters->label.size(); ++i)
+            if (clusters->label[i] >= 0) scan.valid[i] = 1;
+        const auto den = r.report.findOrDefault<kfd::Denoiser::Result>();
         kfd::ClusterFigureOptions o;
         o.width = o.height = size;
         o.half_extent_m = extent;
         o.ring_r_max =
-            p.get<kfd::DenoiseStage>().variant == kfd::DenoiseVariant::Reference ? r.r_max : 0.0;
+            p.get<kfd::DenoiseStage>().variant == kfd::DenoiseVariant::Reference ? den.r_max : 0.0;
         o.rings = p.get<kfd::DenoiseStage>().reference.rings.rings;
         kfd::ClusterFigure fig(o);
-        auto img = fig.render(scan, den.clusters());
+        auto img = fig.render(scan, *clusters);
         kfd::TempOutputFile tmp(out);  // written under a temporary name, renamed when complete
         if (!img.saveToFile(tmp.path().string())) throw std::runtime_error("cannot write " + out);
         kfd::throwIfCancelled();  // interrupted while drawing: nothing is moved into place
         tmp.commit();
         std::printf("kfd-render: scan at %.6f, %zu clusters, %zu noise points -> %s\n",
-                    kfd::stampOf(*chosen.back().scan), r.clusters, r.points_removed, out.c_str());
+                    kfd::stampOf(*chosen.back().scan), den.clusters, den.points_removed,
+                    out.c_str());
     });
 }

@@ -279,7 +279,8 @@ TEST(CliApps, BadUsageExitsTwoAndSaysWhatIsWrong) {
         {"kfd-filter", "-i a.bag -o b.bag --removed-as zero", "--removed-as"},
         {"kfd-filter", "-i a.bag -o b.bag --bag-compression zip", "--bag-compression"},
         {"kfd-icp-slam", "x.ini --match-drop 10",
-         "--match-drop and --match-drop-of apply to --mode odometry or decimate only"},
+         "a matched drop rate (--match-drop, --match-drop-of) applies to --mode odometry or "
+         "decimate only (not kfd)"},
         {"kfd-icp-slam", "x.ini --mode fast", "--mode: unknown pre-filter mode"},
         {"kfd-simulate", "-o x.rawlog --gridmap g", "--gridmap and --route"},
         {"kfd-chart", "in.csv -o out.png --size 640", "--size"},
@@ -315,7 +316,7 @@ TEST(CliApps, FilterVersionAndEarlyExits) {
     EXPECT_EQ(r.out.rfind("[KFD]", 0), 0u) << r.out;
 }
 
-// kfd-compare reads the mode list from here (share/scripts/kfd_compare.py): one line a
+// kfd-compare reads the mode list from here (python/kfd_tools/compare.py): one line a
 // mode, "name<TAB>stages<TAB>description", before the required CONFIG.ini is asked for.
 TEST(CliApps, IcpSlamListsEveryModeWithItsStages) {
     const Result r = runApp(KFD_ICP_SLAM_EXE, "--list-modes");

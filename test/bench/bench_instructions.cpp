@@ -7,7 +7,7 @@
 //
 // Each case first runs one untimed cycle over its scans (buffers sized, window filled), then
 // calls its kfd_ir_ function N times; instructions per scan = inclusive cost / N. Restoring the
-// valid flags between calls happens outside the counted functions. share/scripts/bench.sh does
+// valid flags between calls happens outside the counted functions. scripts/bench.sh does
 // all of this. Without valgrind the program just runs the cases (a smoke test).
 #include <cstdio>
 #include <cstdlib>
@@ -25,10 +25,35 @@
 #include "kfd/core/histogram.h"
 #include "kfd/core/keyframe_selector.h"
 #include "kfd/core/pipeline.h"
+#include "kfd/mrpt/stream_filter.h"
 
 namespace kb = kfd::bench;
 
 namespace {
+
+// kfd's default pipeline (distance, view keyframe, denoise) with the view selector's thresholds
+// out of reach: every dropped-set scan is dropped by the keyframe decision.
+kfd::Pipeline::Params viewDropParams() {
+    kfd::Pipeline::Params p;
+    p.get<kfd::DistanceStage>() = kb::paperParams().get<kfd::DistanceStage>();
+    p.get<kfd::KeyframeStage>() = kb::viewParamsThatDrop();
+    return p;
+}
+
+// The MRPT form of a core scan (what a driver gives the door).
+mrpt::obs::CObservation2DRangeScan toMrpt(const kfd::Scan& s) {
+    mrpt::obs::CObservation2DRangeScan o;
+    o.sensorLabel = "LASER";
+    o.aperture = static_cast<float>(s.geometry.aperture);
+    o.rightToLeft = s.geometry.right_to_left;
+    o.resizeScan(s.size());
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        o.setScanRange(i, s.range[i]);
+        o.setScanRangeValidity(i, s.valid[i] != 0);
+    }
+    o.timestamp = mrpt::Clock::fromDouble(s.timestamp);
+    return o;
+}
 
 struct Context {
     kb::Scenario sc = kb::makeScenario();
@@ -54,6 +79,9 @@ struct Context {
     kfd::Pipeline pipe_dropped{kb::paperParams()};
     kfd::Pipeline pipe_reference{kb::paperParams(kfd::DenoiseVariant::Reference)};
     kfd::Pipeline pipe_range_aware{kb::paperParams(kfd::DenoiseVariant::RangeAware)};
+    kfd::Pipeline pipe_view{viewDropParams()};  // kfd's default pipeline, dropping
+    kfd::StreamFilter door{viewDropParams()};   // the same behind the one door (MRPT scans)
+    std::vector<mrpt::obs::CObservation2DRangeScan> obs_dropped, obs_work;
     std::size_t sink = 0;       // results feed this so nothing is optimised away
     std::size_t surprises = 0;  // dropped-set scans kept or keyframe-set scans dropped
 
@@ -65,12 +93,20 @@ struct Context {
         view.filter(sc.prefix.back());
         view_lo.filter(kb::laserOnly(sc.prefix.back()));
         for (kfd::Scan s : sc.prefix) pipe_dropped.process(s);
+        kfd::Scan first = sc.prefix.back();
+        pipe_view.process(first);  // the keyframe every dropped-set scan is measured against
+        auto first_obs = toMrpt(sc.prefix.back());
+        door.process(first_obs, sc.prefix.back().odometry);
+        for (const auto& s : sc.dropped) obs_dropped.push_back(toMrpt(s));
+        obs_work = obs_dropped;
     }
 };
 
 }  // namespace
 
-// The counted calls: one scan each.
+// The counted calls: one scan each. pipeline_dropped_view is kfd's default pipeline on a
+// dropped scan (issue 20's target); door_dropped_view the same through StreamFilter::process
+// with an MRPT scan (the check and the MRPT adapter included).
 extern "C" {
 __attribute__((noinline)) void kfd_ir_histogram(Context& c, std::size_t k) {
     c.sink += c.histogram.compute(c.sc.keyframes[k], c.out);
@@ -116,6 +152,12 @@ __attribute__((noinline)) void kfd_ir_statistical_outlier(Context& c, std::size_
 __attribute__((noinline)) void kfd_ir_pipeline_dropped(Context& c, std::size_t k) {
     c.surprises += c.pipe_dropped.process(c.work_dropped[k]).keep;
 }
+__attribute__((noinline)) void kfd_ir_pipeline_dropped_view(Context& c, std::size_t k) {
+    c.surprises += c.pipe_view.process(c.work_dropped[k]).keep;
+}
+__attribute__((noinline)) void kfd_ir_door_dropped_view(Context& c, std::size_t k) {
+    c.surprises += c.door.process(c.obs_work[k], c.sc.dropped[k].odometry).keep;
+}
 __attribute__((noinline)) void kfd_ir_pipeline_keyframe_reference(Context& c, std::size_t k) {
     c.surprises += !c.pipe_reference.process(c.work[k]).keep;
 }
@@ -148,6 +190,8 @@ const Case kCases[] = {
     {"radius_outlier", kfd_ir_radius_outlier, false},
     {"statistical_outlier", kfd_ir_statistical_outlier, false},
     {"pipeline_dropped", kfd_ir_pipeline_dropped, true},
+    {"pipeline_dropped_view", kfd_ir_pipeline_dropped_view, true},
+    {"door_dropped_view", kfd_ir_door_dropped_view, true},
     {"pipeline_keyframe_reference", kfd_ir_pipeline_keyframe_reference, false},
     {"pipeline_keyframe_range_aware", kfd_ir_pipeline_keyframe_range_aware, false},
 };
@@ -178,6 +222,11 @@ void warmUp(Context& c, const Case& cs) {
         if (name == "radius_outlier") c.radius.filter(s);
         if (name == "statistical_outlier") c.sor.filter(s);
         if (name == "pipeline_dropped") c.pipe_dropped.process(s);
+        if (name == "pipeline_dropped_view") c.pipe_view.process(s);
+        if (name == "door_dropped_view") {
+            c.obs_work[k] = c.obs_dropped[k];
+            c.door.process(c.obs_work[k], c.sc.dropped[k].odometry);
+        }
         if (name == "pipeline_keyframe_reference") c.pipe_reference.process(s);
         if (name == "pipeline_keyframe_range_aware") c.pipe_range_aware.process(s);
     }
@@ -221,9 +270,10 @@ int main(int argc, char** argv) {
             const std::size_t k = static_cast<std::size_t>(i) % size;
             if (cs->loop_set)
                 kb::restoreValid(c.sc.loop_keyframes[k], c.work_loop[k]);
-            else if (cs->dropped_set)
+            else if (cs->dropped_set) {
                 kb::restoreValid(c.sc.dropped[k], c.work_dropped[k]);
-            else
+                c.obs_work[k] = c.obs_dropped[k];  // assigned in place: no allocation
+            } else
                 kb::restoreValid(c.sc.keyframes[k], c.work[k]);
             cs->call(c, k);
         }

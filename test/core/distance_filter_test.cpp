@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <stdexcept>
 #include <vector>
 
@@ -111,6 +112,62 @@ TEST(DistanceFilter, EmptyScan) {
     const auto res = makeFilter(0.1, 30.0).filter(scan);
     EXPECT_EQ(res.valid_in, 0u);
     EXPECT_EQ(res.valid_out, 0u);
+}
+
+// The filter compares float ranges with float limits chosen to decide exactly as the double
+// comparison of Algorithm 1 does; checked against that plain reference on random scans whose
+// ranges sit on, just inside and just outside limits that floats cannot represent.
+TEST(DistanceFilter, MatchesThePlainDoubleReferenceOnRandomScans) {
+    std::mt19937 rng(20);
+    std::uniform_real_distribution<double> limit(0.0, 40.0);
+    for (int trial = 0; trial < 200; ++trial) {
+        double lo = limit(rng), hi = limit(rng);
+        if (trial % 3 == 0) lo = 0.1, hi = 29.999999;  // neither is a float
+        if (trial % 7 == 0) lo = 0.0;
+        if (lo > hi) std::swap(lo, hi);
+        if (!(hi > lo)) continue;
+        const float edges[] = {static_cast<float>(lo),
+                               static_cast<float>(hi),
+                               std::nextafter(static_cast<float>(lo), -kInf),
+                               std::nextafter(static_cast<float>(lo), kInf),
+                               std::nextafter(static_cast<float>(hi), -kInf),
+                               std::nextafter(static_cast<float>(hi), kInf),
+                               kNaN,
+                               kInf,
+                               -kInf,
+                               -0.0f,
+                               0.0f,
+                               -1.0f};
+        std::uniform_int_distribution<std::size_t> pick(0, std::size(edges) + 3);
+        Scan scan = makeScan(std::vector<float>(257, 1.0f));
+        for (std::size_t i = 0; i < scan.size(); ++i) {
+            const std::size_t k = pick(rng);
+            scan.range[i] =
+                k < std::size(edges) ? edges[k] : static_cast<float>(limit(rng) * 1.2 - 2.0);
+            scan.valid[i] = (rng() % 5) != 0;
+        }
+        const Scan before = scan;
+        const auto res = makeFilter(lo, hi).filter(scan);
+        std::size_t in = 0, non_finite = 0, outside = 0;
+        for (std::size_t i = 0; i < scan.size(); ++i) {
+            const float r = before.range[i];
+            bool keep = before.valid[i] != 0;
+            if (keep) {
+                ++in;
+                if (!std::isfinite(r)) {
+                    ++non_finite;
+                    keep = false;
+                } else if (r < lo || r > hi) {  // Algorithm 1, in double
+                    ++outside;
+                    keep = false;
+                }
+            }
+            EXPECT_EQ(scan.valid[i] != 0, keep) << "r " << r << " in [" << lo << ", " << hi << "]";
+        }
+        EXPECT_EQ(res.valid_in, in);
+        EXPECT_EQ(res.removed_non_finite, non_finite);
+        EXPECT_EQ(res.removed_out_of_range, outside);
+    }
 }
 
 TEST(DistanceFilter, DefaultsAreThePapersSensorLimits) {

@@ -159,12 +159,12 @@ TEST(RawlogFilter, SenaSampleActionsLayoutConservesEverything) {
     EXPECT_GT(progress_calls, 2u);
     checkConservation(kSena, o.output, s);
 
-    // One CSV row per input scan, plus the header; column 4 is the keyframe flag.
+    // One CSV row per input scan, plus the header; column 4 is the kept (keyframe) flag.
     std::ifstream csv(o.stats_csv);
     std::size_t lines = 0, kept = 0;
     std::string line;
     std::getline(csv, line);
-    EXPECT_EQ(line.rfind("index,timestamp,sensor,keyframe,", 0), 0u) << line;
+    EXPECT_EQ(line.rfind("index,timestamp,sensor,kept,", 0), 0u) << line;
     ++lines;
     while (std::getline(csv, line)) {
         ++lines;

@@ -105,12 +105,52 @@ TEST(ScanCheck, NonFiniteOdometryBecomesUnknownAndIsCounted) {
     EXPECT_TRUE(good.has_value());
 }
 
-TEST(StreamFilter, BadGeometryThrowsScanErrorBeforeAnyStage) {
+TEST(StreamFilter, BadGeometryIsSkippedBeforeAnyStageAndCounted) {
     kfd::StreamFilter f;
     auto s = room();
     s.aperture = 0.0f;
-    EXPECT_THROW(f.process(s), kfd::ScanError);
-    EXPECT_EQ(f.sensorCount(), 0u);  // no pipeline was even built for it
+    const auto r = f.process(s);
+    EXPECT_EQ(r.skipped, ScanSkipReason::BadAperture);
+    EXPECT_FALSE(r.keep);
+    EXPECT_EQ(r.report.stage_count, 0u);  // no stage ran
+    EXPECT_EQ(f.sensorCount(), 0u);       // no pipeline was even built for it
+    EXPECT_STREQ(r.record.reason, "skipped:bad_aperture");
+    EXPECT_EQ(r.record.points_in, s.getScanSize());
+    EXPECT_EQ(f.counters().scans_in, 1u);
+    EXPECT_EQ(f.counters().scans_skipped, 1u);
+    EXPECT_EQ(f.counters().scans_dropped, 0u);
+    EXPECT_EQ(f.counters().skipped_by_reason[static_cast<std::size_t>(ScanSkipReason::BadAperture)],
+              1u);
+    // The next good scan is the sensor's first: a keyframe, numbered after the skipped one.
+    auto good = room();
+    const auto g = f.process(good);
+    EXPECT_TRUE(g.keep);
+    EXPECT_EQ(g.record.index, 1u);
+    EXPECT_STREQ(g.record.reason, "first");
+}
+
+TEST(StreamFilter, CountersAddUpTheRecords) {
+    kfd::StreamFilter f;
+    std::size_t kept = 0, in = 0, removed = 0;
+    for (int k = 0; k < 6; ++k) {
+        auto s = room(0.01 * k);
+        if (k == 2) s.setScanRange(5, kNaNf);
+        const auto r = f.process(s, kfd::Pose2D{0.02 * k, 0.0, 0.0});
+        EXPECT_EQ(r.record.index, static_cast<std::size_t>(k));
+        EXPECT_EQ(r.record.kept, r.keep);
+        ASSERT_TRUE(r.record.odometry.has_value());
+        EXPECT_DOUBLE_EQ(r.record.odometry->x, 0.02 * k);
+        kept += r.keep;
+        in += r.record.points_in;
+        if (r.keep) removed += r.record.points_in - r.record.points_out;
+    }
+    const kfd::ScanCounters& c = f.counters();
+    EXPECT_EQ(c.scans_in, 6u);
+    EXPECT_EQ(c.scans_kept, kept);
+    EXPECT_EQ(c.scans_kept + c.scans_dropped, 6u);
+    EXPECT_EQ(c.points_in, in);
+    EXPECT_EQ(c.points_removed, removed);
+    EXPECT_EQ(c.beams_bad_range, 1u);
 }
 
 TEST(StreamFilter, BadRangesAndOdometryAreRepairedAndReported) {

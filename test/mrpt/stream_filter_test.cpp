@@ -60,7 +60,7 @@ TEST(StreamFilter, KeepsSeparateStatePerSensor) {
     const auto rb = f.process(b);
     EXPECT_TRUE(rb.keep);  // first scan of its own stream
     EXPECT_EQ(rb.report.findOrDefault<kfd::KeyframeDecision>().reason, kfd::KeyframeReason::First);
-    EXPECT_EQ(rb.sensor_label, "REAR");
+    EXPECT_EQ(rb.record.sensor, "REAR");
     EXPECT_EQ(f.sensorCount(), 2u);
 }
 
@@ -90,8 +90,9 @@ TEST(StreamFilter, ResetsWhenGeometryChanges) {
 TEST(StreamFilter, CleansInPlaceKeepingBeamsAndRanges) {
     kfd::StreamFilter f(paperParams());
     auto s = roomScan(361, M_PI, 3.0);
-    s.setScanRange(100, 1.0f);   // an isolated spike
-    s.setScanRange(200, 50.0f);  // beyond max_range
+    s.setScanRange(100, 1.0f);         // an isolated spike
+    s.setScanRange(200, 50.0f);        // beyond max_range
+    s.setScanRangeValidity(7, false);  // invalid on input: never made valid again
     const auto before = s;
     const auto r = f.process(s);
     ASSERT_TRUE(r.keep);
@@ -101,6 +102,10 @@ TEST(StreamFilter, CleansInPlaceKeepingBeamsAndRanges) {
     EXPECT_FALSE(s.getScanRangeValidity(100));
     EXPECT_FALSE(s.getScanRangeValidity(200));
     EXPECT_TRUE(s.getScanRangeValidity(150));
+    EXPECT_FALSE(s.getScanRangeValidity(7));
+    std::size_t invalid = 0;
+    for (std::size_t i = 0; i < s.getScanSize(); ++i) invalid += !s.getScanRangeValidity(i);
+    EXPECT_EQ(invalid, 1 + r.record.points_in - r.record.points_out);  // exactly those removed
     EXPECT_EQ(r.report.findOrDefault<kfd::DistanceFilter::Result>().removed_out_of_range, 1u);
     EXPECT_GE(r.report.findOrDefault<kfd::Denoiser::Result>().points_removed, 1u);
 }
@@ -124,10 +129,13 @@ TEST(StreamFilter, RotationInPlaceStillProducesKeyframes) {
     EXPECT_EQ(count_kept(15.0), 18u);  // guard on: every second scan (20 degrees >= 15)
 }
 
-TEST(StreamFilter, EmptyScanIsRejected) {
+TEST(StreamFilter, EmptyScanIsSkippedNotThrown) {
     kfd::StreamFilter f;
     mrpt::obs::CObservation2DRangeScan s;
-    EXPECT_THROW(f.process(s), kfd::ScanError);
+    const auto r = f.process(s);
+    EXPECT_EQ(r.skipped, kfd::ScanSkipReason::NoBeams);
+    EXPECT_FALSE(r.keep);
+    EXPECT_STREQ(r.record.reason, "skipped:no_beams");
 }
 
 TEST(StreamFilter, InvalidParametersAreRejectedUpFront) {
@@ -145,10 +153,4 @@ TEST(ScanAdapter, RoundTripKeepsGeometryAndValidity) {
     EXPECT_FALSE(core.valid[7]);
     for (std::size_t i : {0u, 90u, 180u})
         EXPECT_NEAR(core.geometry.angle(i), s.getScanAngle(i), 1e-6);
-    core.valid[9] = 0;
-    EXPECT_EQ(kfd::applyValidity(core, s), 1u);
-    EXPECT_FALSE(s.getScanRangeValidity(9));
-    core.valid[7] = 1;  // never re-validates a beam
-    kfd::applyValidity(core, s);
-    EXPECT_FALSE(s.getScanRangeValidity(7));
 }

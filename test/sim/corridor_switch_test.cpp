@@ -37,10 +37,13 @@ Filtered filterSimulated(const TempDir& dir, const std::string& world) {
     std::ifstream csv(f.stats_csv);
     std::string line, header;
     std::getline(csv, header);
-    EXPECT_NE(header.find(",view_change,changed_fraction,degeneracy,corridor"), std::string::npos);
+    EXPECT_NE(header.find(",view_change,changed_fraction,degeneracy,corridor,"), std::string::npos);
     while (std::getline(csv, line)) {
         ++r.rows;
-        const bool corridor = line.back() == '1';
+        std::stringstream fields(line);
+        std::string field;
+        for (int col = 0; col <= 18; ++col) std::getline(fields, field, ',');  // column 18
+        const bool corridor = field == "1";
         r.corridor_rows += corridor;
         r.corridor_keyframes += line.find(",1,corridor,") != std::string::npos;
     }

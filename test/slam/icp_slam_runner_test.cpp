@@ -5,12 +5,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "kfd/baselines/decimate_stage.h"
 #include "kfd/core/cancel.h"
 #include "kfd/eval/trajectory.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/default_stages.h"
+#include "kfd/mrpt/rawlog_filter.h"
 #include "kfd/report/slam_report.h"
 #include "kfd/sim/simulator.h"
 #include "kfd/slam/icp_slam_runner.h"
@@ -110,6 +112,58 @@ TEST(IcpSlamRunner, KfdOnMitCsailHasBoundedErrorAndAPoseForEveryScan) {
                             "\"points_removed\"", "\"prefilter_us_per_scan\"",
                             "\"icp_ms_per_scan\"", "\"cpu_s_total\"", "\"trans_mean_m\""})
         EXPECT_NE(json.find(key), std::string::npos) << key;
+}
+
+// kfd-icp-slam's scans.csv and kfd-filter's stats file are one writer's: the same columns,
+// the door's records, kfd-icp-slam adding the pose; both summaries come from the same counters.
+TEST(IcpSlamRunner, ScansCsvIsTheDoorsRecordWithThePose) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    const auto s = runAndReport(options(kSena, dir / "slam", kfd::PrefilterMode::Kfd));
+    kfd::RawlogFilterOptions fo;
+    fo.input = kSena;
+    fo.output = dir / "out.rawlog";
+    fo.stats_csv = dir / "stats.csv";
+    fo.pipeline = kfd::kfdDefaults();
+    const auto f = kfd::RawlogFilter().run(fo);
+    auto rows = [](const std::string& path) {
+        std::vector<std::vector<std::string>> out;
+        std::ifstream in(path);
+        std::string line;
+        while (std::getline(in, line)) {
+            std::vector<std::string> fields;
+            std::stringstream ss(line);
+            std::string field;
+            while (std::getline(ss, field, ',')) fields.push_back(field);
+            if (!line.empty() && line.back() == ',') fields.emplace_back();
+            out.push_back(fields);
+        }
+        return out;
+    };
+    const auto slam = rows(dir / "slam/scans.csv"), filter = rows(dir / "stats.csv");
+    ASSERT_FALSE(slam.empty());
+    ASSERT_FALSE(filter.empty());
+    EXPECT_EQ(slam[0], filter[0]);  // one column set
+    ASSERT_EQ(slam[0].size(), 25u);
+    EXPECT_EQ(slam[0][3], "kept");
+    EXPECT_EQ(slam[0][22], "x");
+    std::size_t kept = 0;
+    for (std::size_t i = 1; i < slam.size(); ++i) {
+        ASSERT_EQ(slam[i].size(), 25u) << i;
+        kept += slam[i][3] == "1";
+        EXPECT_FALSE(slam[i][22].empty()) << i;  // the SLAM pose
+    }
+    EXPECT_EQ(kept, s.scans_kept);
+    EXPECT_EQ(slam.size(), s.scans_in + 1);
+    for (std::size_t i = 1; i < filter.size(); ++i) {
+        ASSERT_EQ(filter[i].size(), 25u) << i;
+        EXPECT_TRUE(filter[i][22].empty()) << i;  // kfd-filter has no SLAM pose
+    }
+    EXPECT_EQ(filter.size(), f.scans_in + 1);
+    // The same counters: the scans both drivers gave the door add up alike.
+    EXPECT_EQ(s.scans_kept + s.scans_dropped + s.scans_skipped, s.scans_in);
+    EXPECT_EQ(f.scans_kept + f.scans_dropped + f.scans_skipped, f.scans_in);
+    EXPECT_EQ(s.points_removed, s.points_removed_range + s.points_removed_noise);
 }
 
 TEST(IcpSlamRunner, EveryModeRunsAndAccountsForEveryScan) {

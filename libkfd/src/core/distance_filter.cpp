@@ -1,6 +1,9 @@
 #include "kfd/core/distance_filter.h"
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
+
 #include "kfd/core/error.h"
 
 namespace kfd {
@@ -11,23 +14,32 @@ void DistanceFilter::initialize(const Params& p) {
     if (!(p.max_range > p.min_range) || !std::isfinite(p.max_range))
         throw ParameterError("max_range", "max_range must be finite and greater than min_range");
     params_ = p;
+    // The float nearest each limit, moved one step inwards when rounding went outwards.
+    lo_ = static_cast<float>(p.min_range);
+    if (static_cast<double>(lo_) < p.min_range)
+        lo_ = std::nextafter(lo_, std::numeric_limits<float>::infinity());
+    hi_ = static_cast<float>(p.max_range);
+    if (static_cast<double>(hi_) > p.max_range)
+        hi_ = std::nextafter(hi_, -std::numeric_limits<float>::infinity());
 }
 
 DistanceFilter::Result DistanceFilter::filter(Scan& scan) const {
     Result res;
     const std::size_t n = scan.range.size();
     scan.valid.resize(n, 0);  // no-op when sizes already match
+    const float* range = scan.range.data();
+    std::uint8_t* valid = scan.valid.data();
+    const float lo = lo_, hi = hi_;
     for (std::size_t i = 0; i < n; ++i) {
-        if (!scan.valid[i]) continue;
+        if (!valid[i]) continue;
         ++res.valid_in;
-        const float r = scan.range[i];
-        if (!std::isfinite(r)) {
-            scan.valid[i] = 0;
-            ++res.removed_non_finite;
-        } else if (r < params_.min_range || r > params_.max_range) {
-            scan.valid[i] = 0;
+        const float r = range[i];
+        if (r >= lo && r <= hi) continue;  // false for NaN and +-inf
+        valid[i] = 0;
+        if (std::isfinite(r))
             ++res.removed_out_of_range;
-        }
+        else
+            ++res.removed_non_finite;
     }
     res.valid_out = res.valid_in - res.removed_non_finite - res.removed_out_of_range;
     return res;

@@ -1,13 +1,35 @@
 #include "kfd/mrpt/stream_filter.h"
 
 #include <cmath>
-#include <stdexcept>
+#include <cstdint>
+#include <utility>
 
+#include "kfd/core/denoiser.h"
+#include "kfd/core/distance_filter.h"
+#include "kfd/core/keyframe_selector.h"
 #include "kfd/mrpt/default_stages.h"
-#include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/scan_check.h"
+#include "kfd/mrpt/source.h"
 
 namespace kfd {
+namespace {
+
+// "skipped:<why>" as static text (ScanRecord::reason).
+const char* skippedReason(ScanSkipReason r) {
+    switch (r) {
+        case ScanSkipReason::NoBeams:
+            return "skipped:no_beams";
+        case ScanSkipReason::TooManyBeams:
+            return "skipped:too_many_beams";
+        case ScanSkipReason::BadAperture:
+            return "skipped:bad_aperture";
+        case ScanSkipReason::None:
+            break;
+    }
+    return "ok";
+}
+
+}  // namespace
 
 StreamFilter::StreamFilter(const Pipeline::Params& params, StageFactory extra)
     : params_(params), extra_(std::move(extra)) {
@@ -27,31 +49,98 @@ StreamFilter::Sensor& StreamFilter::sensorFor(const std::string& label) {
 
 StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
                                    const std::optional<Pose2D>& odometry) {
-    std::optional<Pose2D> odo = odometry;
-    const ScanCheck check = checkScan(obs, &odo);
-    if (!check.ok())
-        throw ScanError(std::string("scan rejected: ") + toString(check.reject), "scan");
     StreamResult res;
+    ScanRecord& rec = res.record;
+    rec.index = counters_.scans_in++;
+    rec.sensor = obs.sensorLabel;
+    rec.odometry = odometry;
+    // The check converts into a spare buffer; the scan's sensor (and its pipeline) is looked up
+    // only once the scan is known to be usable, and takes the buffer by a swap (no copy).
+    const ScanCheck check = checkScan(obs, &rec.odometry, spare_scan_);
     res.bad_ranges = check.bad_ranges;
     res.bad_odometry = check.bad_odometry;
-    res.sensor_label = obs.sensorLabel;
+    counters_.beams_bad_range += check.bad_ranges;
+    counters_.odometry_bad += check.bad_odometry ? 1 : 0;
+    if (!check.ok()) {  // skipped: no stage runs
+        res.skipped = rec.skipped = check.reject;
+        rec.stamp = stampOf(obs);
+        rec.reason = skippedReason(check.reject);
+        rec.points_in = obs.getScanSize();
+        ++counters_.scans_skipped;
+        ++counters_.skipped_by_reason[static_cast<std::size_t>(check.reject)];
+        return res;
+    }
+
     Sensor& s = sensorFor(obs.sensorLabel);
-    const ScanGeometry g = geometryOf(obs);
+    std::swap(s.scan, spare_scan_);
+    const ScanGeometry g = s.scan.geometry;
     if (s.geometry.beams != 0 && g != s.geometry) {
         s.pipeline->reset();
         res.geometry_reset = true;
     }
     s.geometry = g;
-    toCore(obs, s.scan);
-    s.scan.odometry = odo;
+    s.scan.odometry = rec.odometry;
+    rec.stamp = s.scan.timestamp;  // kfd::stampOf, taken by the check's conversion
     if (std::isfinite(s.scan.timestamp)) {
         res.stamp_backwards = std::isfinite(s.last_stamp) && s.scan.timestamp < s.last_stamp;
         s.last_stamp = s.scan.timestamp;
     }
     res.report = s.pipeline->process(s.scan);
-    res.keep = res.report.keep;
-    applyValidity(s.scan, obs);
+    res.keep = rec.kept = res.report.keep;
+    // Written back: the beams the stages removed become invalid in the MRPT scan (ranges, beam
+    // count and angles kept; no beam made valid again). Only those beams are touched.
+    const std::uint8_t* valid = s.scan.valid.data();
+    for (std::size_t i = 0, n = s.scan.size(); i < n; ++i)
+        if (!valid[i] && obs.getScanRangeValidity(i)) obs.setScanRangeValidity(i, false);
+    record(res);
     return res;
+}
+
+// The record and the counters of a scan that ran through the pipeline.
+void StreamFilter::record(StreamResult& res) {
+    const ScanReport& rep = res.report;
+    ScanRecord& rec = res.record;
+    const auto* kf = rep.find<KeyframeDecision>();
+    const auto d = rep.findOrDefault<DistanceFilter::Result>();
+    const auto n = rep.findOrDefault<Denoiser::Result>();
+    if (kf) {
+        rec.reason = toString(kf->reason);
+        rec.p_common = kf->p_common;
+        rec.p_threshold = kf->p_threshold;
+        rec.references = kf->references;
+        rec.view_change = kf->view_change;
+        rec.changed_fraction = kf->changed_fraction;
+        rec.degeneracy = kf->degeneracy;
+        rec.corridor = kf->corridor;
+        rec.corridor_keyframe = kf->reason == KeyframeReason::Corridor;
+    } else {  // no keyframe stage: "kept", or the stage that dropped the scan
+        rec.reason = "kept";
+        for (const StageReport& sr : rep)
+            if (sr.dropped) rec.reason = sr.name;
+    }
+    rec.points_in = rep.points_in;
+    rec.removed_range = d.removed_non_finite + d.removed_out_of_range;
+    rec.clusters = n.clusters;
+    rec.noise_clusters = n.noise_clusters;
+    rec.removed_noise = rep.noiseRemoved();
+    rec.points_out = rep.points_out;
+    rec.microseconds = rep.microseconds;
+
+    ScanCounters& c = counters_;
+    c.stamps_backwards += res.stamp_backwards ? 1 : 0;
+    c.geometry_resets += res.geometry_reset ? 1 : 0;
+    c.scans_corridor += rec.corridor ? 1 : 0;
+    c.keyframes_corridor += rec.corridor_keyframe ? 1 : 0;
+    c.points_in += rep.points_in;
+    c.filter_seconds += rep.microseconds * 1e-6;
+    if (res.keep) {
+        ++c.scans_kept;
+        c.points_removed_range += rec.removed_range;
+        c.points_removed_noise += rec.removed_noise;
+        c.points_removed += rep.points_in - rep.points_out;
+    } else {
+        ++c.scans_dropped;
+    }
 }
 
 const Clusters* StreamFilter::lastClusters(const std::string& sensor_label) const {

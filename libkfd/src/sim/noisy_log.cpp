@@ -13,8 +13,8 @@
 #include "kfd/core/output_paths.h"
 #include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_adapter.h"
-#include "kfd/mrpt/scan_check.h"
 #include "kfd/mrpt/source.h"
+#include "kfd/mrpt/stream_filter.h"
 #include "kfd/sim/world.h"
 
 namespace kfd {
@@ -45,12 +45,17 @@ NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
     labels << "scan,timestamp,beam,kind,model\n";
 
     std::mt19937 rng(o.seed);
+    // The one door with no stage: it checks each scan (bad ranges marked invalid, bad geometry
+    // skipped) and changes nothing else.
+    Pipeline::Params check_only;
+    check_only.stages.clear();
+    StreamFilter door(check_only);
     Scan core;
     std::vector<NoiseKind> kinds;
     std::vector<NoiseModel> models;
     auto inject = [&](const mrpt::obs::CObservation2DRangeScan::Ptr& scan) {
         const std::size_t k = sum.scans++;
-        if (!checkScan(*scan, nullptr).ok()) return;  // unusable geometry: copied unchanged
+        if (door.process(*scan).skipped != ScanSkipReason::None) return;  // copied unchanged
         toCore(*scan, core);
         for (std::size_t i = 0; i < core.size(); ++i) sum.beams += core.valid[i] ? 1 : 0;
         noise.apply(core, kinds, models, rng);

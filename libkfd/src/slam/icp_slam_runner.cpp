@@ -23,6 +23,7 @@
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_check.h"
+#include "kfd/mrpt/scan_csv.h"
 #include "kfd/mrpt/source.h"
 #include "kfd/mrpt/stream_filter.h"
 
@@ -152,34 +153,30 @@ void forEachRunScan(const std::string& rawlog, const SourceOptions& options, std
 }
 
 // Timestamps and odometry of every scan after the skipped start (for matching the odometry
-// baseline's drop rate to a target before the real run).
+// baseline's drop rate to a target before the real run); a non-finite odometry is unknown
+// (kfd::checkOdometry, the door's rule).
 std::vector<ScanStamp> scanOdometry(const std::string& rawlog, const SourceOptions& options,
                                     std::size_t skip_scans, bool laser_only) {
     std::vector<ScanStamp> out;
     forEachRunScan(rawlog, options, skip_scans,
                    [&](const CObservation2DRangeScan& scan, std::optional<Pose2D> odo) {
-                       // non-finite: unknown, as checkScan does
-                       if (laser_only || (odo && !finitePose(odo->x, odo->y, odo->phi)))
-                           odo.reset();
+                       if (laser_only) odo.reset();
+                       checkOdometry(odo);
                        out.push_back({stampOf(scan), odo});
                    });
     return out;
 }
 
 // The drop rate (%) of a pre-filter over the log, as the real run would see it (the same
-// skipped start, the same checks, odometry or none): the pre-filter alone, no ICP.
+// skipped start, the same door, odometry or none): the pre-filter alone, no ICP.
 double pipelineDropPct(const std::string& rawlog, const SourceOptions& options,
                        const Pipeline::Params& pipeline, std::size_t skip_scans, bool laser_only) {
     StreamFilter filter(pipeline);
-    std::size_t in = 0, kept = 0;
     forEachRunScan(rawlog, options, skip_scans,
                    [&](CObservation2DRangeScan& scan, std::optional<Pose2D> odo) {
-                       if (laser_only) odo.reset();
-                       ++in;
-                       if (!checkScan(scan, &odo).ok()) return;
-                       kept += filter.process(scan, odo).keep ? 1 : 0;
+                       filter.process(scan, laser_only ? std::nullopt : odo);
                    });
-    return in ? 100.0 * static_cast<double>(in - kept) / static_cast<double>(in) : 0.0;
+    return filter.counters().notKeptPercent();
 }
 
 double dropPct(const std::vector<ScanStamp>& scans, const MotionFilter::Params& p) {
@@ -190,7 +187,8 @@ double dropPct(const std::vector<ScanStamp>& scans, const MotionFilter::Params& 
 }
 
 // Bisection on D (angle = 30 deg per metre of D): the drop rate grows with D.
-MotionFilter::Params matchDropRate(const std::vector<ScanStamp>& scans, double target_pct) {
+MotionFilter::Params motionParamsForDropRate(const std::vector<ScanStamp>& scans,
+                                             double target_pct) {
     MotionFilter::Params p;
     p.max_interval_s = 0.0;
     double lo = 0.0, hi = 5.0;
@@ -208,299 +206,346 @@ MotionFilter::Params matchDropRate(const std::vector<ScanStamp>& scans, double t
     return p;
 }
 
-}  // namespace
+// One kfd-icp-slam run, as steps: prepare (configuration, paths, pre-filter, pre-pass, ground
+// truth), the map builder, the output files, the loop over icp-slam's steps, evaluate.
+class Run {
+  public:
+    explicit Run(const IcpSlamOptions& o) : opts_(o), sum_(res_.summary) {}
 
-IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) {
-    const auto wall0 = std::chrono::steady_clock::now();
-    const std::clock_t cpu0 = std::clock();
-    IcpSlamResult res;
-    IcpSlamSummary& sum = res.summary;
-    sum.mode = opts.mode;
-
-    std::error_code ec;
-    if (!fs::is_regular_file(opts.config_file, ec))
-        throw SlamError("configuration file not found: " + opts.config_file);
-    mrpt::config::CConfigFile cfg(opts.config_file);
-    sum.rawlog = !opts.rawlog.empty() ? opts.rawlog : cfg.read_string(kSect, "rawlog_file", "");
-    sum.output_dir =
-        !opts.output_dir.empty() ? opts.output_dir : cfg.read_string(kSect, "logOutput_dir", "");
-    if (sum.rawlog.empty()) throw SlamError("no rawlog given (option or rawlog_file)");
-    if (!fs::is_regular_file(sum.rawlog, ec)) throw SlamError("rawlog not found: " + sum.rawlog);
-    if (sum.output_dir.empty()) throw SlamError("no output folder given (option or logOutput_dir)");
-    // Every input readable before the run starts, and no output file is (or aliases) one.
-    checkReadable("rawlog", sum.rawlog);
-    checkReadable("relations file", opts.relations);
-    checkReadable("ground-truth trajectory", opts.ground_truth_tum);
-    {
-        const std::vector<NamedPath> inputs = {{"configuration", opts.config_file},
-                                               {"rawlog", sum.rawlog},
-                                               {"relations file", opts.relations},
-                                               {"ground-truth trajectory", opts.ground_truth_tum}};
-        std::vector<NamedPath> outputs;
-        for (const char* name : kIcpSlamOutputFiles)
-            outputs.push_back(
-                {std::string("output ") + name, (fs::path(sum.output_dir) / name).string()});
-        checkOutputPaths(inputs, outputs);
-        for (const NamedPath& in : inputs)
-            if (samePath(sum.output_dir, in.path))
-                throw PathError(
-                    "the output folder " + sum.output_dir + " is the " + in.role + " " + in.path,
-                    sum.output_dir);
+    IcpSlamResult execute() {
+        const auto wall0 = std::chrono::steady_clock::now();
+        const std::clock_t cpu0 = std::clock();
+        checkOptions();
+        prepare();
+        matchDropRate();
+        readGroundTruth();
+        StreamFilter prefilter(sum_.pipeline);
+        prefilter_ = &prefilter;
+        initBuilder();
+        openOutputs();
+        loop();
+        closeOutputs();
+        evaluate();
+        sum_.cpu_s_total = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+        sum_.wall_s_total =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+        return std::move(res_);
     }
+
+  private:
+    void checkOptions();
+    void prepare();
+    void matchDropRate();
+    void readGroundTruth();
+    void initBuilder();
+    void openOutputs();
+    void loop();
+    void step(IcpSlamStep& step, const SourceEntry& e);
+    bool prefilterScan(CObservation2DRangeScan& scan, const SourceEntry& e);
+    mrpt::obs::CActionCollection* actionFor(const IcpSlamStep& step);
+    void writeStep();
+    void closeOutputs();
+    void evaluate();
+
+    const IcpSlamOptions& opts_;
+    IcpSlamResult res_;
+    IcpSlamSummary& sum_;
+    std::optional<mrpt::config::CConfigFile> cfg_;
+    Pipeline::Params kfd_params_;  // [KFD], or kfd's defaults
+    std::vector<Relation> relations_;
+    StreamFilter* prefilter_ = nullptr;
+    mrpt::slam::CMetricMapBuilderICP builder_;
+    std::size_t rawlog_offset_ = 0;
+    std::ofstream f_path_;  // log_estimated_path.txt
+    ScanCsvWriter csv_;     // scans.csv
+    std::unique_ptr<Source> source_;
+    double builder_s_ = 0.0;
+    std::size_t step_no_ = 0;
+    std::vector<ScanRecord> step_scans_;        // the scans of the current step, in order
+    mrpt::obs::CActionCollection no_odometry_;  // laser_only: what the builder gets (empty)
+    mrpt::obs::CActionCollection finite_actions_;
+};
+
+// Options that contradict each other, before anything is read.
+void Run::checkOptions() {
+    const bool matchable =
+        opts_.mode == PrefilterMode::Odometry || opts_.mode == PrefilterMode::Decimate;
+    if ((opts_.odometry_target_drop_pct || opts_.match_drop_of) && !matchable)
+        throw SlamOptionError(
+            std::string("a matched drop rate (--match-drop, --match-drop-of) applies to --mode "
+                        "odometry or decimate only (not ") +
+                toString(opts_.mode) + ")",
+            "mode");
+    if (opts_.odometry_target_drop_pct && opts_.match_drop_of)
+        throw SlamOptionError("give --match-drop or --match-drop-of, not both", "match_drop_of");
+}
+
+// The configuration, the paths (every input readable, no output aliases one) and the pre-filter.
+void Run::prepare() {
+    sum_.mode = opts_.mode;
+    std::error_code ec;
+    if (!fs::is_regular_file(opts_.config_file, ec))
+        throw SlamError("configuration file not found: " + opts_.config_file);
+    cfg_.emplace(opts_.config_file);
+    sum_.rawlog =
+        !opts_.rawlog.empty() ? opts_.rawlog : cfg_->read_string(kSect, "rawlog_file", "");
+    sum_.output_dir = !opts_.output_dir.empty() ? opts_.output_dir
+                                                : cfg_->read_string(kSect, "logOutput_dir", "");
+    if (sum_.rawlog.empty()) throw SlamError("no rawlog given (option or rawlog_file)");
+    if (!fs::is_regular_file(sum_.rawlog, ec)) throw SlamError("rawlog not found: " + sum_.rawlog);
+    if (sum_.output_dir.empty())
+        throw SlamError("no output folder given (option or logOutput_dir)");
+    checkReadable("rawlog", sum_.rawlog);
+    checkReadable("relations file", opts_.relations);
+    checkReadable("ground-truth trajectory", opts_.ground_truth_tum);
+    const std::vector<NamedPath> inputs = {{"configuration", opts_.config_file},
+                                           {"rawlog", sum_.rawlog},
+                                           {"relations file", opts_.relations},
+                                           {"ground-truth trajectory", opts_.ground_truth_tum}};
+    std::vector<NamedPath> outputs;
+    for (const char* name : kIcpSlamOutputFiles)
+        outputs.push_back(
+            {std::string("output ") + name, (fs::path(sum_.output_dir) / name).string()});
+    checkOutputPaths(inputs, outputs);
+    for (const NamedPath& in : inputs)
+        if (samePath(sum_.output_dir, in.path))
+            throw PathError(
+                "the output folder " + sum_.output_dir + " is the " + in.role + " " + in.path,
+                sum_.output_dir);
 
     // Pre-filter configuration: [KFD] when present, else kfd's defaults (share/kfd/default.ini).
-    Pipeline::Params kfd_params = kfdDefaults();
-    if (cfg.sectionExists("KFD")) kfd_params = loadIni(cfg, "KFD");
-    sum.pipeline = pipelineForMode(opts.mode, kfd_params);
-    sum.laser_only = opts.laser_only;
-    if (!(opts.split_seconds >= 0.0) || !std::isfinite(opts.split_seconds))
+    kfd_params_ = cfg_->sectionExists("KFD") ? loadIni(*cfg_, "KFD") : kfdDefaults();
+    sum_.pipeline = pipelineForMode(opts_.mode, kfd_params_);
+    sum_.laser_only = opts_.laser_only;
+    if (!(opts_.split_seconds >= 0.0) || !std::isfinite(opts_.split_seconds))
         throw SlamError("the local/long split must be finite and >= 0 s (got " +
-                            std::to_string(opts.split_seconds) + ")",
+                            std::to_string(opts_.split_seconds) + ")",
                         "split_seconds");
-    sum.split_seconds = opts.split_seconds;
-    const bool matchable =
-        opts.mode == PrefilterMode::Odometry || opts.mode == PrefilterMode::Decimate;
-    if ((opts.odometry_target_drop_pct || opts.match_drop_of) && !matchable)
-        throw SlamError(
-            std::string("a matched drop rate needs the odometry or decimate mode (not ") +
-                toString(opts.mode) + ")",
-            "mode");
-    if (opts.odometry_target_drop_pct && opts.match_drop_of)
-        throw SlamError("give a drop rate or a mode to match, not both", "match_drop_of");
-    if (opts.match_drop_of) {
-        const std::clock_t m0 = std::clock();
-        sum.target_drop_pct = pipelineDropPct(sum.rawlog, opts.source,
-                                              pipelineForMode(*opts.match_drop_of, kfd_params),
-                                              opts.skip_scans, opts.laser_only);
-        sum.cpu_s_match = static_cast<double>(std::clock() - m0) / CLOCKS_PER_SEC;
-    } else if (opts.odometry_target_drop_pct) {
-        sum.target_drop_pct = *opts.odometry_target_drop_pct;
-    }
-    if (sum.target_drop_pct) {
-        const double target = *sum.target_drop_pct;
-        if (!(target >= 0.0 && target < 100.0))
-            throw SlamError("the target drop rate must be in [0, 100)");
-        if (opts.mode == PrefilterMode::Odometry)
-            sum.pipeline.get<MotionStage>() = matchDropRate(
-                scanOdometry(sum.rawlog, opts.source, opts.skip_scans, opts.laser_only), target);
-        else
-            sum.pipeline.get<DecimateStage>().keep_fraction = 1.0 - target / 100.0;
-    }
-    StreamFilter prefilter(sum.pipeline);
-
-    if (!(opts.relations_max_dt >= 0.0) || !std::isfinite(opts.relations_max_dt))
+    sum_.split_seconds = opts_.split_seconds;
+    if (!(opts_.relations_max_dt >= 0.0) || !std::isfinite(opts_.relations_max_dt))
         throw SlamError("the stamp matching tolerance must be finite and >= 0 (got " +
-                            std::to_string(opts.relations_max_dt) + " s)",
+                            std::to_string(opts_.relations_max_dt) + " s)",
                         "relations_max_dt");
-    std::vector<Relation> relations;
-    if (!opts.relations.empty()) {
-        relations = readRelations(opts.relations);  // EvalError
-        if (relations.empty()) throw SlamError("no relation in " + opts.relations, opts.relations);
+}
+
+// Odometry and decimate modes with a target: the drop rate to match (given, or measured by a
+// pre-pass of another mode's pre-filter), then the thresholds or share that reach it.
+void Run::matchDropRate() {
+    if (opts_.match_drop_of) {
+        const std::clock_t m0 = std::clock();
+        sum_.target_drop_pct = pipelineDropPct(sum_.rawlog, opts_.source,
+                                               pipelineForMode(*opts_.match_drop_of, kfd_params_),
+                                               opts_.skip_scans, opts_.laser_only);
+        sum_.cpu_s_match = static_cast<double>(std::clock() - m0) / CLOCKS_PER_SEC;
+    } else if (opts_.odometry_target_drop_pct) {
+        sum_.target_drop_pct = *opts_.odometry_target_drop_pct;
     }
-    if (!opts.ground_truth_tum.empty()) {  // read before the run: a bad file fails at once
-        res.ground_truth = readTum(opts.ground_truth_tum);  // EvalError
-        sortByTime(res.ground_truth);
+    if (!sum_.target_drop_pct) return;
+    const double target = *sum_.target_drop_pct;
+    if (!(target >= 0.0 && target < 100.0))
+        throw SlamError("the target drop rate must be in [0, 100)");
+    if (opts_.mode == PrefilterMode::Odometry)
+        sum_.pipeline.get<MotionStage>() = motionParamsForDropRate(
+            scanOdometry(sum_.rawlog, opts_.source, opts_.skip_scans, opts_.laser_only), target);
+    else
+        sum_.pipeline.get<DecimateStage>().keep_fraction = 1.0 - target / 100.0;
+}
+
+// The relations and the ground truth, read before the run: a bad file fails at once.
+void Run::readGroundTruth() {
+    if (!opts_.relations.empty()) {
+        relations_ = readRelations(opts_.relations);  // EvalError
+        if (relations_.empty())
+            throw SlamError("no relation in " + opts_.relations, opts_.relations);
     }
+    if (!opts_.ground_truth_tum.empty()) {
+        res_.ground_truth = readTum(opts_.ground_truth_tum);  // EvalError
+        sortByTime(res_.ground_truth);
+    }
+}
 
-    // The map builder, configured exactly as icp-slam does.
-    mrpt::slam::CMetricMapBuilderICP builder;
-    builder.setVerbosityLevel(mrpt::system::LVL_ERROR);
-    builder.ICP_options.loadFromConfigFile(cfg, kSect);
-    builder.ICP_params.loadFromConfigFile(cfg, "ICP");
-    builder.initialize();
-    builder.options.alwaysInsertByClass.fromString(
-        cfg.read_string(kSect, "alwaysInsertByClass", ""));
-    const std::size_t rawlog_offset =
-        static_cast<std::size_t>(std::max(0, cfg.read_int(kSect, "rawlog_offset", 0)));
+// The map builder, configured exactly as icp-slam does.
+void Run::initBuilder() {
+    builder_.setVerbosityLevel(mrpt::system::LVL_ERROR);
+    builder_.ICP_options.loadFromConfigFile(*cfg_, kSect);
+    builder_.ICP_params.loadFromConfigFile(*cfg_, "ICP");
+    builder_.initialize();
+    builder_.options.alwaysInsertByClass.fromString(
+        cfg_->read_string(kSect, "alwaysInsertByClass", ""));
+    rawlog_offset_ =
+        static_cast<std::size_t>(std::max(0, cfg_->read_int(kSect, "rawlog_offset", 0)));
+}
 
-    // Everything is written into a staging folder; writeIcpSlamReport() (or
-    // result.output->commit()) moves it into place, and on failure it is removed.
-    res.output = std::make_shared<StagedOutputFolder>(sum.output_dir);
-    const fs::path out = res.output->path();
-    std::ofstream f_path(out / "log_estimated_path.txt"), f_csv(out / "scans.csv");
-    if (!f_path || !f_csv) throw SlamError("cannot write into " + sum.output_dir);
-    f_csv << "index,timestamp,sensor,kept,reason,p_common,points_in,points_removed,prefilter_us,"
-             "x,y,phi,view_change,degeneracy,corridor\n";
+// Everything is written into a staging folder; writeIcpSlamReport() (or
+// result.output->commit()) moves it into place, and on failure it is removed.
+void Run::openOutputs() {
+    res_.output = std::make_shared<StagedOutputFolder>(sum_.output_dir);
+    const fs::path out = res_.output->path();
+    f_path_.open(out / "log_estimated_path.txt");
+    if (!f_path_) throw SlamError("cannot write into " + sum_.output_dir);
+    try {
+        csv_.open((out / "scans.csv").string(), (fs::path(sum_.output_dir) / "scans.csv").string());
+    } catch (const ScanCsvError&) {
+        throw SlamError("cannot write into " + sum_.output_dir);
+    }
+    source_ = openLog(sum_.rawlog, opts_.source);
+}
 
-    auto source = openLog(sum.rawlog, opts.source);
+// icp-slam's steps over the log, after rawlog_offset and the skipped start.
+void Run::loop() {
     const double total_bytes =
-        static_cast<double>(std::max<std::uint64_t>(1, source->bytesTotal()));
-
-    Trajectory& traj = res.trajectory;
-    double prefilter_us = 0.0, builder_s = 0.0;
-    std::size_t step_no = 0;
-    char buf[256];
-    struct Pending {
-        double t;
-        std::string sensor;
-        StreamResult r;
-        std::optional<Pose2D> odometry;                 // after kfd::checkScan
-        ScanSkipReason skipped = ScanSkipReason::None;  // not None: never reached ICP
+        static_cast<double>(std::max<std::uint64_t>(1, source_->bytesTotal()));
+    auto progress = [&](double fraction) {
+        const ScanCounters& c = prefilter_->counters();
+        opts_.on_progress({sum_.entries, c.scans_in, c.scans_kept, fraction});
     };
-    std::vector<Pending> entry_scans;
     SourceEntry e;
     IcpSlamSteps steps;
-    IcpSlamStep step;
+    IcpSlamStep st;
+    StartSkipper skipper(opts_.skip_scans);
+    while (nextEntry(*source_, e)) {
+        throwIfCancelled();
+        if (!steps.feed(e, st) || e.objects_read < rawlog_offset_ || skipper.skip(st)) continue;
+        step(st, e);
+        writeStep();
+        ++step_no_;
+        ++sum_.entries;
+        if (opts_.on_progress && step_no_ % 500 == 0)
+            progress(static_cast<double>(source_->bytesRead()) / total_bytes);
+    }
+    if (sum_.entries == 0) throw SlamError("no entries in " + sum_.rawlog + ": not a rawlog?");
+    if (opts_.on_progress) progress(1.0);
+    sum_.scans_skipped_start = skipper.skipped();
+}
 
-    // Every scan is checked first, in every mode (`none` included): a bad geometry skips it (it
-    // never reaches a stage nor the map builder), bad ranges are marked invalid, non-finite
-    // odometry becomes unknown.
-    auto prefilterScan = [&](CObservation2DRangeScan& scan) {
-        std::optional<Pose2D> odo = opts.laser_only ? std::nullopt : e.odometry;
-        const ScanCheck check = checkScan(scan, &odo);
-        sum.beams_bad_range += check.bad_ranges;
-        sum.odometry_bad += check.bad_odometry ? 1 : 0;
-        if (!check.ok()) {
-            ++sum.scans_in;
-            ++sum.scans_skipped;
-            ++sum.skipped_by_reason[static_cast<std::size_t>(check.reject)];
-            StreamResult r;
-            r.keep = false;
-            r.sensor_label = scan.sensorLabel;
-            entry_scans.push_back(
-                {stampForOutput(stampOf(scan)), scan.sensorLabel, std::move(r), odo, check.reject});
-            return false;
-        }
-        StreamResult r = prefilter.process(scan, odo);
-        ++sum.scans_in;
-        sum.scans_kept += r.keep;
-        sum.points_in += r.report.points_in;
-        if (r.keep) sum.points_removed += r.report.points_in - r.report.points_out;
-        prefilter_us += r.report.microseconds;
-        entry_scans.push_back({stampForOutput(stampOf(scan)), scan.sensorLabel, std::move(r), odo});
-        return entry_scans.back().r.keep;
-    };
+// One step: its scans through the door (every mode, `none` included), the kept ones and the
+// odometry to the map builder.
+void Run::step(IcpSlamStep& st, const SourceEntry& e) {
+    step_scans_.clear();
     auto timed = [&](auto&& process) {
         const auto t0 = std::chrono::steady_clock::now();
         process();
-        builder_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        builder_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     };
-
-    StartSkipper skipper(opts.skip_scans);
-    mrpt::obs::CActionCollection no_odometry;  // laser_only: what the builder gets (empty)
-    while (nextEntry(*source, e)) {
-        throwIfCancelled();
-        if (!steps.feed(e, step) || e.objects_read < rawlog_offset || skipper.skip(step)) continue;
-        entry_scans.clear();
-        if (step.observation) {
-            bool process = true;
-            if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(step.observation))
-                process = prefilterScan(*scan);
-            else if (const auto* odo = dynamic_cast<const mrpt::obs::CObservationOdometry*>(
-                         step.observation.get()))
-                process = !opts.laser_only &&
-                          finitePose(odo->odometry.x(), odo->odometry.y(), odo->odometry.phi());
-            if (process) timed([&] { builder.processObservation(step.observation); });
-        } else {
-            for (auto it = step.frame->begin(); it != step.frame->end();) {
-                auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(*it);
-                if (scan && !prefilterScan(*scan))
-                    it = step.frame->erase(it);
-                else
-                    ++it;
-            }
-            // odometry kept even if the frame is empty; a non-finite odometry action is left out
-            // (the map builder then matches without a motion prior)
-            mrpt::obs::CActionCollection* action =
-                opts.laser_only ? &no_odometry : step.action.get();
-            mrpt::obs::CActionCollection finite_actions;
-            if (auto mv = action->getBestMovementEstimation()) {
-                const auto d = mv->rawOdometryIncrementReading;
-                const auto m = mv->poseChange ? mv->poseChange->getMeanVal() : d;
-                if (!finitePose(d.x(), d.y(), d.phi()) || !finitePose(m.x(), m.y(), m.phi())) {
-                    for (std::size_t k = 0; k < action->size(); ++k)
-                        if (action->get(k).get() != mv.get())
-                            finite_actions.insert(*action->get(k));
-                    action = &finite_actions;
-                }
-            }
-            timed([&] { builder.processActionObservation(*action, *step.frame); });
-        }
-        const auto pose = builder.getCurrentPoseEstimation()->getMeanVal();
-        std::snprintf(buf, sizeof(buf), "%i %f %f %f\n", static_cast<int>(step_no), pose.x(),
-                      pose.y(), pose.yaw());
-        f_path << buf;
-        for (const auto& s : entry_scans) {
-            if (s.r.keep) res.keyframes.push_back(traj.size());
-            if (s.odometry) res.odometry.push_back(StampedPose{s.t, *s.odometry});
-            traj.push_back(StampedPose{s.t, Pose2D{pose.x(), pose.y(), pose.yaw()}});
-            const auto& rep = s.r.report;
-            const auto* kf = rep.find<KeyframeDecision>();
-            if (kf && kf->corridor) {
-                res.corridor.push_back(traj.size());
-                ++sum.scans_corridor;
-            }
-            const std::string skipped = s.skipped != ScanSkipReason::None
-                                            ? std::string("skipped:") + toString(s.skipped)
-                                            : std::string();
-            std::snprintf(buf, sizeof(buf),
-                          "%zu,%.6f,%s,%d,%s,%.6f,%zu,%zu,%.2f,%.6f,%.6f,%.6f,%.4f,%.4f,%d\n",
-                          traj.size() - 1, s.t, s.sensor.c_str(), s.r.keep ? 1 : 0,
-                          !skipped.empty() ? skipped.c_str()
-                          : kf             ? toString(kf->reason)
-                                           : (s.r.keep ? "kept" : rep.dropped_by.c_str()),
-                          kf ? kf->p_common : 0.0, rep.points_in, rep.points_in - rep.points_out,
-                          rep.microseconds, pose.x(), pose.y(), pose.yaw(),
-                          kf ? kf->view_change : 0.0, kf ? kf->degeneracy : 1.0,
-                          kf && kf->corridor ? 1 : 0);
-            f_csv << buf;
-        }
-        ++step_no;
-        ++sum.entries;
-        if (opts.on_progress && step_no % 500 == 0)
-            opts.on_progress({sum.entries, sum.scans_in, sum.scans_kept,
-                              static_cast<double>(source->bytesRead()) / total_bytes});
+    if (st.observation) {
+        bool process = true;
+        if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(st.observation))
+            process = prefilterScan(*scan, e);
+        else if (const auto* odo =
+                     dynamic_cast<const mrpt::obs::CObservationOdometry*>(st.observation.get()))
+            process = !opts_.laser_only &&
+                      finitePose(odo->odometry.x(), odo->odometry.y(), odo->odometry.phi());
+        if (process) timed([&] { builder_.processObservation(st.observation); });
+        return;
     }
-    if (sum.entries == 0) throw SlamError("no entries in " + sum.rawlog + ": not a rawlog?");
-    if (opts.on_progress) opts.on_progress({sum.entries, sum.scans_in, sum.scans_kept, 1.0});
-    f_path.close();
-    f_csv.close();
-    if (f_path.fail() || f_csv.fail()) throw SlamError("cannot write into " + out.string());
-    writeTum((out / "trajectory.tum").string(), traj);
-
-    if (!opts.ground_truth_tum.empty()) {
-        Trajectory sorted = traj;
-        sortByTime(sorted);
-        sum.ate_rmse = computeAte(sorted, res.ground_truth, opts.relations_max_dt).rmse;
+    for (auto it = st.frame->begin(); it != st.frame->end();) {
+        auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(*it);
+        if (scan && !prefilterScan(*scan, e))
+            it = st.frame->erase(it);
+        else
+            ++it;
     }
-    if (opts.write_map) {
-        res.map.emplace();
-        builder.getCurrentlyBuiltMap(*res.map);
-    }
-
-    sum.dropped_pct = sum.scans_in ? 100.0 * static_cast<double>(sum.scans_in - sum.scans_kept) /
-                                         static_cast<double>(sum.scans_in)
-                                   : 0.0;
-    sum.prefilter_us_per_scan = sum.scans_in ? prefilter_us / static_cast<double>(sum.scans_in) : 0;
-    sum.icp_ms_per_scan = sum.scans_in ? 1e3 * builder_s / static_cast<double>(sum.scans_in) : 0;
-    sum.icp_ms_per_kept_scan =
-        sum.scans_kept ? 1e3 * builder_s / static_cast<double>(sum.scans_kept) : 0;
-    if (!relations.empty()) {
-        Trajectory sorted = traj;
-        sortByTime(sorted);
-        // EvalError when no relation matched (never a perfect 0.0)
-        sum.relations = evaluateRelations(sorted, relations, opts.relations_max_dt);
-        sum.relations_file = opts.relations;
-        // Local and long relations; a subset that is empty or matched nothing stays absent.
-        const RelationsByLength split = splitRelations(relations, opts.split_seconds);
-        sum.relations_local_count = split.local.size();
-        sum.relations_long_count = split.far.size();
-        auto subset = [&](const std::vector<Relation>& r) -> std::optional<RelationsError> {
-            if (r.empty()) return std::nullopt;
-            try {
-                return evaluateRelations(sorted, r, opts.relations_max_dt);
-            } catch (const EvalError&) {
-                return std::nullopt;  // none of this subset matched
-            }
-        };
-        sum.relations_local = subset(split.local);
-        sum.relations_long = subset(split.far);
-    }
-    sum.scans_skipped_start = skipper.skipped();
-    sum.cpu_s_total = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
-    sum.wall_s_total =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    return res;
+    // odometry kept even if the frame is empty
+    mrpt::obs::CActionCollection* action = actionFor(st);
+    timed([&] { builder_.processActionObservation(*action, *st.frame); });
 }
+
+// A scan through the door; true when it goes on to ICP. Its record waits for the step's pose.
+bool Run::prefilterScan(CObservation2DRangeScan& scan, const SourceEntry& e) {
+    StreamResult r = prefilter_->process(scan, opts_.laser_only ? std::nullopt : e.odometry);
+    step_scans_.push_back(std::move(r.record));
+    return r.keep;
+}
+
+// The step's odometry action as the builder gets it: none with laser_only; a non-finite
+// movement left out (the map builder then matches without a motion prior).
+mrpt::obs::CActionCollection* Run::actionFor(const IcpSlamStep& st) {
+    mrpt::obs::CActionCollection* action = opts_.laser_only ? &no_odometry_ : st.action.get();
+    if (auto mv = action->getBestMovementEstimation()) {
+        const auto d = mv->rawOdometryIncrementReading;
+        const auto m = mv->poseChange ? mv->poseChange->getMeanVal() : d;
+        if (!finitePose(d.x(), d.y(), d.phi()) || !finitePose(m.x(), m.y(), m.phi())) {
+            finite_actions_ = mrpt::obs::CActionCollection();
+            for (std::size_t k = 0; k < action->size(); ++k)
+                if (action->get(k).get() != mv.get()) finite_actions_.insert(*action->get(k));
+            action = &finite_actions_;
+        }
+    }
+    return action;
+}
+
+// The step's pose (icp-slam's log line) and, for each of its scans, the trajectory, odometry,
+// keyframe and corridor entries and the scans.csv row.
+void Run::writeStep() {
+    const auto pose = builder_.getCurrentPoseEstimation()->getMeanVal();
+    char buf[256];
+    std::snprintf(buf, sizeof(buf), "%i %f %f %f\n", static_cast<int>(step_no_), pose.x(), pose.y(),
+                  pose.yaw());
+    f_path_ << buf;
+    const Pose2D p{pose.x(), pose.y(), pose.yaw()};
+    Trajectory& traj = res_.trajectory;
+    for (const ScanRecord& s : step_scans_) {
+        if (s.kept) res_.keyframes.push_back(traj.size());
+        if (s.corridor) res_.corridor.push_back(traj.size());
+        const double t = stampForOutput(s.stamp);
+        if (s.odometry) res_.odometry.push_back(StampedPose{t, *s.odometry});
+        traj.push_back(StampedPose{t, p});
+        csv_.write(s, p);
+    }
+}
+
+void Run::closeOutputs() {
+    f_path_.close();
+    bool failed = f_path_.fail();
+    try {
+        csv_.close();
+    } catch (const ScanCsvError&) {
+        failed = true;
+    }
+    if (failed) throw SlamError("cannot write into " + res_.output->path().string());
+    writeTum((res_.output->path() / "trajectory.tum").string(), res_.trajectory);
+}
+
+// The summary from the door's counters, the map, ATE and the relations error (local and long).
+void Run::evaluate() {
+    static_cast<ScanCounters&>(sum_) = prefilter_->counters();
+    sum_.dropped_pct = sum_.notKeptPercent();
+    const double scans_in = static_cast<double>(sum_.scans_in);
+    sum_.prefilter_us_per_scan = sum_.scans_in ? 1e6 * sum_.filter_seconds / scans_in : 0;
+    sum_.icp_ms_per_scan = sum_.scans_in ? 1e3 * builder_s_ / scans_in : 0;
+    sum_.icp_ms_per_kept_scan =
+        sum_.scans_kept ? 1e3 * builder_s_ / static_cast<double>(sum_.scans_kept) : 0;
+    if (opts_.write_map) {
+        res_.map.emplace();
+        builder_.getCurrentlyBuiltMap(*res_.map);
+    }
+    if (opts_.ground_truth_tum.empty() && relations_.empty()) return;
+    Trajectory sorted = res_.trajectory;
+    sortByTime(sorted);
+    if (!opts_.ground_truth_tum.empty())
+        sum_.ate_rmse = computeAte(sorted, res_.ground_truth, opts_.relations_max_dt).rmse;
+    if (relations_.empty()) return;
+    // EvalError when no relation matched (never a perfect 0.0)
+    sum_.relations = evaluateRelations(sorted, relations_, opts_.relations_max_dt);
+    sum_.relations_file = opts_.relations;
+    // Local and long relations; a subset that is empty or matched nothing stays absent.
+    const RelationsByLength split = splitRelations(relations_, opts_.split_seconds);
+    sum_.relations_local_count = split.local.size();
+    sum_.relations_long_count = split.far.size();
+    auto subset = [&](const std::vector<Relation>& r) -> std::optional<RelationsError> {
+        if (r.empty()) return std::nullopt;
+        try {
+            return evaluateRelations(sorted, r, opts_.relations_max_dt);
+        } catch (const EvalError&) {
+            return std::nullopt;  // none of this subset matched
+        }
+    };
+    sum_.relations_local = subset(split.local);
+    sum_.relations_long = subset(split.far);
+}
+
+}  // namespace
+
+IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) { return Run(opts).execute(); }
 
 }  // namespace kfd

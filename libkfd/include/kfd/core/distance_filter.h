@@ -36,6 +36,9 @@ class DistanceFilter {
 
   private:
     Params params_;
+    // The range limits as floats that compare with a float range exactly as the doubles do:
+    // r >= min_range <=> r >= lo_, r <= max_range <=> r <= hi_ (the loop runs in float).
+    float lo_ = 0.1f, hi_ = 30.0f;
 };
 
 }  // namespace kfd

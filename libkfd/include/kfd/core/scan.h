@@ -128,11 +128,11 @@ struct Scan {
     Pose2D sensor_pose;              // the sensor on the robot (MRPT's sensorPose), m and rad
 
     std::size_t size() const { return range.size(); }
-    std::size_t countValid() const {
-        std::size_t n = 0;
-        for (const auto v : valid) n += (v != 0);
-        return n;
-    }
+    /// Beams whose valid flag is set (vectorised: a few hundred instructions for 1081 beams).
+    std::size_t countValid() const { return countNonZero(valid.data(), valid.size()); }
+
+    /// How many of the n bytes at p are not 0.
+    static std::size_t countNonZero(const std::uint8_t* p, std::size_t n);
 };
 
 }  // namespace kfd

@@ -8,6 +8,7 @@
 #include "kfd/core/pipeline.h"
 #include "kfd/mrpt/bag_writer.h"
 #include "kfd/mrpt/rawlog_source.h"
+#include "kfd/mrpt/scan_record.h"
 #include "kfd/mrpt/stream_filter.h"
 
 namespace kfd {
@@ -26,7 +27,7 @@ struct RawlogFilterOptions {
                             // Written to a temporary file, renamed on success
     SourceOptions source;   // a bag's topics and frames
     BagWriterOptions bag;   // a bag output's compression and removed-point mark
-    std::string stats_csv;  // optional per-scan CSV
+    std::string stats_csv;  // optional per-scan CSV (kfd/mrpt/scan_csv.h)
     Pipeline::Params pipeline;
     int compress_level = 1;  // gzip level of the output (0 = store, 9 = smallest)
     /// Called about every `progress_every` objects and once at the end.
@@ -48,7 +49,9 @@ struct SensorSummary {
     bool odometry = false;       // the log carries odometry (temporal evidence uses it)
 };
 
-struct RawlogFilterSummary {
+/// kfd-filter's summary: the door's counters (ScanCounters: scans in, kept, dropped, skipped by
+/// reason, bad ranges and odometry, corridor scans, points) and what the file layer adds.
+struct RawlogFilterSummary : ScanCounters {
     std::string layout;  // "actions+sensory-frames", "observations", or "mixed";
                          // for a bag or CARMEN input, what was read from it
     LogFormat input_format = LogFormat::Rawlog;
@@ -58,29 +61,9 @@ struct RawlogFilterSummary {
     std::size_t objects_out = 0;      // top-level objects written
     std::size_t objects_dropped = 0;  // sensory frames / observations dropped whole
     std::size_t actions_merged = 0;   // odometry actions composed into a later kept action
-    std::size_t scans_in = 0;
-    std::size_t scans_kept = 0;
-    std::size_t scans_dropped = 0;
-    std::size_t scans_corridor = 0;      // scans the corridor switch found degenerate
-    std::size_t keyframes_corridor = 0;  // keyframes the switch made (odometry or time)
-    /// Scans skipped by kfd::checkScan (bad geometry, kfd/mrpt/scan_check.h): not run through
-    /// the pipeline and dropped from the output like a non-keyframe (not in scans_dropped).
-    std::size_t scans_skipped = 0;
-    std::size_t skipped_by_reason[kScanSkipReasons] = {};  // indexed by ScanSkipReason
-    std::size_t beams_bad_range = 0;   // beams marked invalid: NaN, +-inf, negative, huge range
-    std::size_t odometry_bad = 0;      // scans whose odometry was not finite (used as unknown)
-    std::size_t stamps_backwards = 0;  // scans stamped before their sensor's previous scan
-    std::size_t geometry_resets = 0;
     std::size_t sensors = 0;
-    SensorSummary sensor;                  // the first sensor, as measured from its scans
-    std::size_t points_in = 0;             // valid beams in all input scans
-    std::size_t points_removed_range = 0;  // by Algorithm 1, in kept scans
-    std::size_t points_removed_noise = 0;  // by the denoising stages, in kept scans
-    double filter_seconds = 0.0;           // time inside the pipeline
-    double wall_seconds = 0.0;             // whole run, I/O included
-    double droppedPercent() const {
-        return scans_in ? 100.0 * static_cast<double>(scans_dropped) / scans_in : 0.0;
-    }
+    SensorSummary sensor;       // the first sensor, as measured from its scans
+    double wall_seconds = 0.0;  // whole run, I/O included
 };
 
 /// Reads `input` object by object (never loading it whole), runs every 2D range scan through a
@@ -91,11 +74,11 @@ struct RawlogFilterSummary {
 /// order, except the dropped scans; a kept scan keeps every field, its removed points written
 /// as NaN or +Inf (BagWriterOptions::removed, REP 117). Non-keyframe scans are
 /// removed; a sensory frame left empty is dropped and its odometry action is composed into the
-/// next kept action, so the output's odometry still adds up. A scan that kfd::checkScan rejects
-/// (beam count outside [2, 65 536], aperture not finite, <= 0 or > 2*pi) never reaches a stage:
-/// it is removed from the output exactly like a non-keyframe, counted in scans_skipped and
-/// skipped_by_reason, and its stats row has reason "skipped:<reason>" (points_in = its beam
-/// count, zeros elsewhere); the run goes on. Beams with a NaN, infinite, negative or huge range
+/// next kept action, so the output's odometry still adds up. Every scan goes through the one
+/// door (StreamFilter::process); a scan it skips (beam count outside [2, 65 536], aperture not
+/// finite, <= 0 or > 2*pi) is removed from the output exactly like a non-keyframe, counted in
+/// scans_skipped and skipped_by_reason, and its stats row has reason "skipped:<reason>"; the
+/// run goes on. Beams with a NaN, infinite, negative or huge range
 /// are marked invalid in the output (counted in beams_bad_range). The input is never modified;
 /// on any error no output file is left behind: the output and the stats CSV are written under
 /// temporary names beside them and renamed at the end. Before anything is written, an output or

@@ -14,9 +14,4 @@ ScanGeometry geometryOf(const mrpt::obs::CObservation2DRangeScan& obs);
 /// once sized). Odometry is left as it is.
 void toCore(const mrpt::obs::CObservation2DRangeScan& obs, Scan& out);
 
-/// Writes the core scan's valid flags back: beams the filters removed become invalid. Ranges,
-/// beam count and angles are untouched, and no beam is ever made valid again.
-/// Returns the number of beams newly invalidated.
-std::size_t applyValidity(const Scan& scan, mrpt::obs::CObservation2DRangeScan& obs);
-
 }  // namespace kfd

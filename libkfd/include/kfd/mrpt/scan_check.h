@@ -10,9 +10,10 @@
 
 namespace kfd {
 
-/// Skip reasons are kfd::ScanSkipReason (kfd/core/scan.h). A skipped scan never reaches a stage
-/// nor the map builder; it is counted per reason (RawlogFilterSummary, kfd-filter's stats CSV,
-/// kfd-icp-slam's summary.json and scans.csv, reason column "skipped:<reason>").
+/// The check of the one door: StreamFilter::process (kfd/mrpt/stream_filter.h) runs it on every
+/// scan before any stage, and nothing else does. Skip reasons are kfd::ScanSkipReason
+/// (kfd/core/scan.h). A skipped scan never reaches a stage nor the map builder; it is counted
+/// per reason (ScanCounters, the per-scan CSV's reason "skipped:<reason>").
 
 /// What checkScan() found.
 struct ScanCheck {
@@ -35,5 +36,14 @@ struct ScanCheck {
 /// it, StreamResult::stamp_backwards).
 ScanCheck checkScan(mrpt::obs::CObservation2DRangeScan& obs,
                     std::optional<Pose2D>* odometry = nullptr);
+/// The same, converting the scan into `core` on the way (kfd::toCore; the door's form: one
+/// pass over the beams, buffers reused). `core` is left as it was when the scan is rejected.
+ScanCheck checkScan(mrpt::obs::CObservation2DRangeScan& obs, std::optional<Pose2D>* odometry,
+                    Scan& core);
+
+/// The odometry rule of checkScan alone: a pose with a non-finite x, y or phi is reset to
+/// unknown. Returns true when it was (for readers of odometry without a scan, such as
+/// kfd-icp-slam's motion-filter pre-pass).
+bool checkOdometry(std::optional<Pose2D>& odometry);
 
 }  // namespace kfd

@@ -1,4 +1,6 @@
-// The streaming API: one call per scan, state kept per sensor.
+// The one door for a scan: every driver (kfd-filter, kfd-icp-slam and its pre-pass, kfd-render,
+// the simulator's tools, a live node) gives its scans to StreamFilter::process, one call per
+// scan, state kept per sensor.
 #pragma once
 
 #include <functional>
@@ -11,18 +13,22 @@
 #include <mrpt/obs/CObservation2DRangeScan.h>
 
 #include "kfd/core/pipeline.h"
+#include "kfd/mrpt/scan_record.h"
 
 namespace kfd {
 
 /// What StreamFilter::process() decided for one scan.
 struct StreamResult {
-    bool keep = true;             // false: not a keyframe, drop the scan
-    bool geometry_reset = false;  // this sensor's geometry changed: its state was reset first
-    std::string sensor_label;
-    std::size_t bad_ranges = 0;    // beams marked invalid by checkScan (NaN, inf, < 0, huge)
+    bool keep = false;  // a keyframe: the scan goes on; false: dropped or skipped
+    /// Not None: the scan's geometry is unusable (kfd/mrpt/scan_check.h); no stage ran and the
+    /// scan is unchanged but for its bad ranges. Callers leave it out like a dropped scan.
+    ScanSkipReason skipped = ScanSkipReason::None;
+    bool geometry_reset = false;   // this sensor's geometry changed: its state was reset first
+    std::size_t bad_ranges = 0;    // beams marked invalid by the check (NaN, inf, < 0, huge)
     bool bad_odometry = false;     // the odometry given was not finite: used as unknown
     bool stamp_backwards = false;  // this scan's stamp is before the sensor's previous one
     ScanReport report;             // every stage's diagnostics and the time spent
+    ScanRecord record;             // the scan's row of the per-scan CSV (kfd/mrpt/scan_csv.h)
 };
 
 /// Holds the state of a scan stream: one Pipeline per sensor label, so two lasers on one robot
@@ -30,7 +36,7 @@ struct StreamResult {
 /// front end:
 ///
 ///     kfd::StreamFilter kfd(kfd::loadConfigFile("share/kfd/default.ini"));
-///     auto r = kfd.process(*scan, odometryPose);  // cleans `scan` in place
+///     auto r = kfd.process(*scan, odometryPose);  // checks and cleans `scan` in place
 ///     if (r.keep) slam.processScan(scan);
 ///
 /// When a sensor's geometry (beam count, aperture or direction) changes, its state is reset
@@ -42,16 +48,20 @@ class StreamFilter {
 
     explicit StreamFilter(const Pipeline::Params& params = {}, StageFactory extra = {});
 
-    /// Runs the pipeline on `scan`. Noise and out-of-range beams are marked invalid in place
+    /// The one door: checks the scan (kfd::checkScan, the only place it runs), then runs the
+    /// pipeline. A scan with a bad geometry is skipped (StreamResult::skipped says why; nothing
+    /// runs, nothing is thrown); bad ranges are marked invalid and non-finite odometry becomes
+    /// unknown, and the scan goes on. Noise and out-of-range beams are marked invalid in place
     /// (ranges, beam count and angles are kept). `odometry` (absolute, robot frame) feeds the
-    /// motion guards. The scan is first checked by kfd::checkScan (kfd/mrpt/scan_check.h): bad
-    /// ranges become invalid, non-finite odometry becomes unknown, and a scan with a bad
-    /// geometry (beam count, aperture) throws kfd::ScanError before any stage runs — callers
-    /// that skip such scans call checkScan themselves first (RawlogFilter, IcpSlamRunner).
+    /// motion guards. Every call fills the result's record and adds to counters().
     StreamResult process(mrpt::obs::CObservation2DRangeScan& scan,
                          const std::optional<Pose2D>& odometry = std::nullopt);
 
-    /// Forgets every sensor.
+    /// What every call so far added up to (the figures of kfd-filter's and kfd-icp-slam's
+    /// summaries).
+    const ScanCounters& counters() const { return counters_; }
+
+    /// Forgets every sensor (the counters stay).
     void reset() { sensors_.clear(); }
     std::size_t sensorCount() const { return sensors_.size(); }
     const Pipeline::Params& params() const { return params_; }
@@ -66,11 +76,14 @@ class StreamFilter {
         double last_stamp = std::numeric_limits<double>::quiet_NaN();
     };
     Sensor& sensorFor(const std::string& label);
+    void record(StreamResult& r);
 
     Pipeline::Params params_;
     StageFactory extra_;
     std::unique_ptr<Pipeline> spare_;  // built (and validated) by the constructor
     std::map<std::string, Sensor> sensors_;
+    Scan spare_scan_;  // the next scan's buffer (swapped with its sensor's)
+    ScanCounters counters_;
 };
 
 }  // namespace kfd

@@ -15,6 +15,7 @@
 #include "kfd/core/pipeline.h"
 #include "kfd/eval/relations.h"
 #include "kfd/eval/trajectory.h"
+#include "kfd/mrpt/scan_record.h"
 #include "kfd/mrpt/source.h"
 #include "kfd/slam/prefilter_modes.h"
 
@@ -60,20 +61,14 @@ struct IcpSlamOptions {
     std::function<void(const IcpSlamProgress&)> on_progress;
 };
 
-struct IcpSlamSummary {
+/// kfd-icp-slam's summary: the door's counters (ScanCounters: scans in, kept, skipped by reason
+/// — a skipped scan never reaches ICP and its pose is propagated like a dropped scan's —, bad
+/// ranges and odometry, corridor scans, points) and what the SLAM run adds.
+struct IcpSlamSummary : ScanCounters {
     PrefilterMode mode = PrefilterMode::Kfd;
     std::string rawlog, output_dir;
     std::size_t entries = 0;
-    std::size_t scans_in = 0, scans_kept = 0;
-    std::size_t scans_corridor = 0;  // scans the corridor switch found degenerate
-    /// Scans skipped by kfd::checkScan (bad geometry): in scans_in, never reached ICP; scans.csv
-    /// reason "skipped:<reason>"; their pose is propagated like a dropped scan's.
-    std::size_t scans_skipped = 0;
-    std::size_t skipped_by_reason[kScanSkipReasons] = {};  // indexed by ScanSkipReason
-    std::size_t beams_bad_range = 0;  // beams marked invalid: NaN, +-inf, negative, huge range
-    std::size_t odometry_bad = 0;     // scans whose odometry was not finite (used as unknown)
-    double dropped_pct = 0.0;
-    std::size_t points_in = 0, points_removed = 0;
+    double dropped_pct = 0.0;             // scans not kept (dropped or skipped), % of scans_in
     double prefilter_us_per_scan = 0.0;   // mean over input scans
     double icp_ms_per_scan = 0.0;         // map-builder time / input scans
     double icp_ms_per_kept_scan = 0.0;    // map-builder time / kept scans
@@ -120,15 +115,23 @@ class SlamError : public Error {
     using Error::Error;
 };
 
+/// Options that contradict each other (a matched drop rate without a mode that can match, two
+/// targets): the caller's usage error (kfd-icp-slam exits 2).
+class SlamOptionError : public SlamError {
+  public:
+    using SlamError::SlamError;
+};
+
 /// Runs CMetricMapBuilderICP over a rawlog exactly like MRPT's icp-slam (same config sections,
 /// same call sequence), with the pre-filter deciding which scans reach scan matching. A dropped
 /// scan in an actions+sensory-frames log is removed from its frame and the frame's odometry
 /// action is still processed; in an observations log the scan is skipped and odometry
 /// observations are still processed. Every input scan gets a pose (the map builder's estimate,
-/// propagated with odometry for dropped scans). Every scan is checked by kfd::checkScan first,
-/// in every mode (`none` included): a bad geometry skips it (counted, never reaches ICP), bad
-/// ranges are marked invalid, and a non-finite odometry reading is left out of the map builder's
-/// input. Relations given but none matched, or a negative relations_max_dt, are errors.
+/// propagated with odometry for dropped scans). Every scan enters through the one door
+/// (StreamFilter::process), in every mode (`none` included): a bad geometry skips it (counted,
+/// never reaches ICP), bad ranges are marked invalid, and a non-finite odometry reading is left
+/// out of the map builder's input. Relations given but none matched, or a negative
+/// relations_max_dt, are errors (SlamError); contradicting options are a SlamOptionError.
 ///
 /// Checks first that the configuration, the rawlog, the relations and the ground truth are
 /// readable (the ground truth and relations are parsed before the run) and that no output file
@@ -136,7 +139,8 @@ class SlamError : public Error {
 /// kfd::requestCancel(). Writes into a staging folder (kfd::StagedOutputFolder: beside a new
 /// output folder, inside an existing one, whose other files are left alone), held by
 /// IcpSlamResult::output: trajectory.tum (one pose per input scan, TUM format),
-/// log_estimated_path.txt (icp-slam's "step x y phi", one per rawlog entry) and scans.csv.
+/// log_estimated_path.txt (icp-slam's "step x y phi", one per rawlog entry) and scans.csv (the
+/// door's per-scan records with the scan's pose, kfd/mrpt/scan_csv.h).
 /// summary.json, final_map.simplemap, map.png, map_figure.png and report.md are written from
 /// the result by writeIcpSlamReport() (kfd/report/slam_report.h).
 class IcpSlamRunner {

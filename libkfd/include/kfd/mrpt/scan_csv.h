@@ -1,0 +1,49 @@
+// The one per-scan CSV writer: kfd-filter's --stats file and kfd-icp-slam's scans.csv.
+#pragma once
+
+#include <fstream>
+#include <optional>
+#include <string>
+
+#include "kfd/core/error.h"
+#include "kfd/mrpt/scan_record.h"
+
+namespace kfd {
+
+/// A per-scan CSV that cannot be written (the message names the file).
+class ScanCsvError : public Error {
+  public:
+    using Error::Error;
+};
+
+/// Writes ScanRecords as CSV rows, one per scan, under this header (the one column set):
+///
+///     index,timestamp,sensor,kept,reason,p_common,p_threshold,references,points_in,
+///     removed_range,clusters,noise_clusters,removed_noise,points_out,microseconds,
+///     view_change,changed_fraction,degeneracy,corridor,odom_x,odom_y,odom_phi,x,y,phi
+///
+/// index, timestamp (s, 0 when unknown), sensor, kept (1/0) and reason as in ScanRecord;
+/// p_common, p_threshold, references: the keyframe stage's Formula 3 values (0 without it);
+/// points_in, removed_range, clusters, noise_clusters, removed_noise, points_out: beams and
+/// clusters; microseconds: the pipeline's time; view_change, changed_fraction, degeneracy,
+/// corridor (1/0): the view selector and corridor switch; odom_x, odom_y, odom_phi: the odometry
+/// the scan came with (m, m, rad; empty when unknown or --laser-only); x, y, phi: the SLAM's pose
+/// of the scan (kfd-icp-slam; empty in kfd-filter). A skipped scan's reason is
+/// "skipped:<why>", its points_in its beam count, its other numbers 0 and degeneracy 1.
+class ScanCsvWriter {
+  public:
+    /// Opens `path` for writing and writes the header; `name` is the file users know (e.g. the
+    /// final name of a temporary file). ScanCsvError when it cannot be written.
+    void open(const std::string& path, const std::string& name);
+    bool isOpen() const { return out_.is_open(); }
+    /// One row; `pose` fills x, y, phi.
+    void write(const ScanRecord& r, const std::optional<Pose2D>& pose = std::nullopt);
+    /// Flushes and closes; ScanCsvError when anything failed to be written.
+    void close();
+
+  private:
+    std::ofstream out_;
+    std::string name_;
+};
+
+}  // namespace kfd

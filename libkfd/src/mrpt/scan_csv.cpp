@@ -1,0 +1,57 @@
+#include "kfd/mrpt/scan_csv.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "kfd/mrpt/source.h"
+
+namespace kfd {
+namespace {
+
+// "%.6f,%.6f,%.6f" of a pose, or ",," when there is none. Finite values only are written
+// with %f (a 1e300 coordinate would need 300 digits): others as %.17g.
+void appendPose(std::string& line, const std::optional<Pose2D>& p) {
+    if (!p) {
+        line += ",,,";
+        return;
+    }
+    char buf[96];
+    for (const double v : {p->x, p->y, p->phi}) {
+        std::snprintf(buf, sizeof(buf), std::abs(v) < 1e15 ? ",%.6f" : ",%.17g", v);
+        line += buf;
+    }
+}
+
+}  // namespace
+
+void ScanCsvWriter::open(const std::string& path, const std::string& name) {
+    name_ = name;
+    out_.open(path);
+    if (!out_) throw ScanCsvError("cannot write the per-scan file " + name, name);
+    out_ << "index,timestamp,sensor,kept,reason,p_common,p_threshold,references,points_in,"
+            "removed_range,clusters,noise_clusters,removed_noise,points_out,microseconds,"
+            "view_change,changed_fraction,degeneracy,corridor,odom_x,odom_y,odom_phi,x,y,phi\n";
+}
+
+void ScanCsvWriter::write(const ScanRecord& r, const std::optional<Pose2D>& pose) {
+    char buf[512];
+    std::snprintf(buf, sizeof(buf),
+                  "%zu,%.6f,%s,%d,%s,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu,%zu,%zu,%.2f,%.4f,%.4f,%.4f,%d",
+                  r.index, stampForOutput(r.stamp), r.sensor.c_str(), r.kept ? 1 : 0, r.reason,
+                  r.p_common, r.p_threshold, r.references, r.points_in, r.removed_range, r.clusters,
+                  r.noise_clusters, r.removed_noise, r.points_out, r.microseconds, r.view_change,
+                  r.changed_fraction, r.degeneracy, r.corridor ? 1 : 0);
+    std::string line = buf;
+    appendPose(line, r.odometry);
+    appendPose(line, pose);
+    line += '\n';
+    out_ << line;
+}
+
+void ScanCsvWriter::close() {
+    if (!out_.is_open()) return;
+    out_.close();
+    if (out_.fail()) throw ScanCsvError("failed writing the per-scan file " + name_, name_);
+}
+
+}  // namespace kfd
