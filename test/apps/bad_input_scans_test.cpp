@@ -13,6 +13,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bad_logs.h"
@@ -151,6 +152,74 @@ TEST(BadInputScans, IcpSlamInEveryModeSkipsBadScansAndWritesFinitePoses) {
             }
             EXPECT_EQ(poses, 30u);
         }
+}
+
+// ---------------------------------------------------------------------------------------------
+// coordinates (issue 21, item 2): odometry and poses anywhere a double holds them.
+// ---------------------------------------------------------------------------------------------
+
+// The width and height of a PNG file (its IHDR chunk).
+std::pair<unsigned, unsigned> pngSize(const std::string& path) {
+    const std::string b = fileBytes(path);
+    if (b.size() < 24 || b.compare(1, 3, "PNG") != 0) return {0, 0};
+    auto be32 = [&](std::size_t i) {
+        return (unsigned(static_cast<unsigned char>(b[i])) << 24) |
+               (unsigned(static_cast<unsigned char>(b[i + 1])) << 16) |
+               (unsigned(static_cast<unsigned char>(b[i + 2])) << 8) |
+               unsigned(static_cast<unsigned char>(b[i + 3]));
+    };
+    return {be32(16), be32(20)};
+}
+
+TEST(BadInputCoordinates, IcpSlamWithOdometryFarFromTheOriginWritesEveryOutput) {
+    // Before: UTM-like odometry segfaulted in the map image after the whole run (3.7 GB), 1e20
+    // aborted on an MRPT assertion, a pose of 1e250 overflowed trajectory.tum's line buffer.
+    TempDir dir;
+    for (const double far : {4.52e5, 5.411e6, 1e20, 1e250}) {
+        SCOPED_TRACE(far);
+        const std::string in = dir / "far.rawlog";
+        kfd::test::writeRoomObservationLog(in, 30, {}, [&](int, mrpt::poses::CPose2D& p) {
+            p = mrpt::poses::CPose2D(p.x() + far, p.y() - far, p.phi());
+        });
+        const std::string before = fileBytes(in);
+        const std::string out = dir / "out";
+        fs::remove_all(out);
+        const Result r =
+            run(KFD_ICP_SLAM_EXE, "-q " + q(kIcpConfig) + " " + q(in) + " -o " + q(out));
+        ASSERT_EQ(r.status, 0) << r.err;
+        EXPECT_EQ(fileBytes(in), before);
+        EXPECT_EQ(listing(dir.path),
+                  (std::vector<std::string>{"far.rawlog", "out"}));  // no staging
+        for (const char* f :
+             {"trajectory.tum", "log_estimated_path.txt", "scans.csv", "summary.json",
+              "final_map.simplemap", "map.png", "map_figure.png", "report.md"})
+            EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
+        // The images are bounded by the map, not by the distance to the origin.
+        for (const char* f : {"map.png", "map_figure.png"}) {
+            const auto [w, h] = pngSize(out + "/" + f);
+            EXPECT_GT(w, 0u) << f;
+            EXPECT_LE(w, 6000u) << f;
+            EXPECT_LE(h, 6000u) << f;
+        }
+        // One full line per scan in the log's frame: every number written whole, and where a
+        // double still resolves the walk (UTM), the estimate follows the odometry.
+        std::ifstream tum(out + "/trajectory.tum");
+        std::string line;
+        std::size_t poses = 0;
+        while (std::getline(tum, line)) {
+            if (line.empty() || line[0] == '#') continue;
+            std::istringstream ss(line);
+            double t = 0, x = 0, y = 0;
+            ASSERT_TRUE(ss >> t >> x >> y) << line;
+            EXPECT_NEAR(x / far, 1.0, 1e-5) << line;
+            EXPECT_NEAR(y / far, -1.0, 1e-5) << line;
+            if (far < 1e7) {
+                EXPECT_NEAR(x - far, 0.05 * static_cast<double>(poses), 0.1) << line;
+            }
+            ++poses;
+        }
+        EXPECT_EQ(poses, 30u);
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -60,6 +61,19 @@ TEST(Trajectory, TumRoundTrip) {
         expectPose(back[i].pose, t[i].pose, 1e-6);
     }
     std::filesystem::remove(f);
+}
+
+TEST(Trajectory, TumLinesHoldAnyDouble) {
+    // A pose of 1e250 m needs 250 digits in %f: written whole, read back exactly as printed.
+    const std::string path = ::testing::TempDir() + "kfd_far.tum";
+    kfd::writeTum(path, {{1.5, {1e250, -4.52e5, 0.25}}, {2.5, {-1e300, 5.411e6, -0.5}}});
+    const auto back = kfd::readTum(path);
+    ASSERT_EQ(back.size(), 2u);
+    EXPECT_DOUBLE_EQ(back[0].pose.x, 1e250);
+    EXPECT_DOUBLE_EQ(back[0].pose.y, -4.52e5);
+    EXPECT_DOUBLE_EQ(back[1].pose.x, -1e300);
+    EXPECT_NEAR(back[1].pose.phi, -0.5, 1e-9);
+    std::remove(path.c_str());
 }
 
 TEST(Trajectory, MalformedTumNamesTheLine) {

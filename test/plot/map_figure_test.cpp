@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
+#include <limits>
 
 #include "kfd/plot/map_figure.h"
 
@@ -70,4 +72,34 @@ TEST(MapFigure, DegenerateScansAreMarkedOrange) {
     EXPECT_FALSE(orange(-1.0));
     in.corridor = {99};  // out of range: ignored
     EXPECT_NO_THROW(kfd::renderMapFigure(in));
+}
+
+TEST(MapFigure, PointsFarOutsideTheGridOrNotFiniteAreClampedNotCastBeyondAnInt) {
+    mrpt::maps::COccupancyGridMap2D grid(-5, 5, -5, 5, 0.05f);
+    for (const double v : {1e12, -1e12, 1e300, std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::quiet_NaN()}) {
+        const auto p = kfd::mapFigurePixel(grid, v, v);
+        EXPECT_LE(std::abs(p.first), 1000000 + 200) << v;
+        EXPECT_LE(std::abs(p.second), 1000000 + 200) << v;
+    }
+    // A track that jumps a terametre away is drawn (clipped), not a crash.
+    kfd::MapFigureInput in;
+    in.grid = &grid;
+    in.estimate = {{0.0, {0.0, 0.0, 0.0}}, {1.0, {1e12, 1e12, 0.0}}, {2.0, {1.0, 1.0, 0.0}}};
+    EXPECT_EQ(kfd::renderMapFigure(in).getWidth(), 200u);
+}
+
+TEST(MapFigure, TheScaleBarGrowsWithCoarseCells) {
+    for (const float res : {0.05f, 0.2f, 1.0f}) {
+        mrpt::maps::COccupancyGridMap2D grid(-100 * res, 100 * res, -100 * res, 100 * res, res);
+        kfd::MapFigureInput in;
+        in.grid = &grid;
+        const auto img = kfd::renderMapFigure(in);
+        // The bar is drawn black at the bottom left, from x = 8: at least 19 px long.
+        const int y = static_cast<int>(img.getHeight()) - 12;
+        int len = 0;
+        while (rgbAt(img, 8 + len, y) == (std::array<std::uint8_t, 3>{0, 0, 0})) ++len;
+        EXPECT_GE(len, 19) << res;
+        EXPECT_LE(len, 60) << res;
+    }
 }

@@ -7,6 +7,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "kfd/core/format.h"
+
 namespace kfd {
 
 void readNumericRows(const std::string& path, const std::string& what, std::size_t n,
@@ -54,12 +56,9 @@ void writeTum(const std::string& path, const Trajectory& traj) {
     std::ofstream f(path);
     if (!f) throw EvalError("cannot write trajectory " + path);
     f << "# timestamp x y z qx qy qz qw\n";
-    char buf[256];
-    for (const auto& p : traj) {
-        std::snprintf(buf, sizeof(buf), "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", p.t, p.pose.x, p.pose.y,
-                      std::sin(0.5 * p.pose.phi), std::cos(0.5 * p.pose.phi));
-        f << buf;
-    }
+    for (const auto& p : traj)  // any coordinates: no fixed buffer (kfd::format)
+        f << format("%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", p.t, p.pose.x, p.pose.y,
+                    std::sin(0.5 * p.pose.phi), std::cos(0.5 * p.pose.phi));
     if (!f) throw EvalError("failed writing " + path);
 }
 

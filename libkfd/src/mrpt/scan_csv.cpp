@@ -1,25 +1,15 @@
 #include "kfd/mrpt/scan_csv.h"
 
-#include <cmath>
-#include <cstdio>
+#include "kfd/core/format.h"
 
 #include "kfd/mrpt/source.h"
 
 namespace kfd {
 namespace {
 
-// "%.6f,%.6f,%.6f" of a pose, or ",," when there is none. Finite values only are written
-// with %f (a 1e300 coordinate would need 300 digits): others as %.17g.
+// ",x,y,phi" of a pose (%.6f, any size), or ",,," when there is none.
 void appendPose(std::string& line, const std::optional<Pose2D>& p) {
-    if (!p) {
-        line += ",,,";
-        return;
-    }
-    char buf[96];
-    for (const double v : {p->x, p->y, p->phi}) {
-        std::snprintf(buf, sizeof(buf), std::abs(v) < 1e15 ? ",%.6f" : ",%.17g", v);
-        line += buf;
-    }
+    line += p ? format(",%.6f,%.6f,%.6f", p->x, p->y, p->phi) : std::string(",,,");
 }
 
 }  // namespace
@@ -34,14 +24,12 @@ void ScanCsvWriter::open(const std::string& path, const std::string& name) {
 }
 
 void ScanCsvWriter::write(const ScanRecord& r, const std::optional<Pose2D>& pose) {
-    char buf[512];
-    std::snprintf(buf, sizeof(buf),
-                  "%zu,%.6f,%s,%d,%s,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu,%zu,%zu,%.2f,%.4f,%.4f,%.4f,%d",
-                  r.index, stampForOutput(r.stamp), r.sensor.c_str(), r.kept ? 1 : 0, r.reason,
-                  r.p_common, r.p_threshold, r.references, r.points_in, r.removed_range, r.clusters,
-                  r.noise_clusters, r.removed_noise, r.points_out, r.microseconds, r.view_change,
-                  r.changed_fraction, r.degeneracy, r.corridor ? 1 : 0);
-    std::string line = buf;
+    std::string line =
+        format("%zu,%.6f,%s,%d,%s,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu,%zu,%zu,%.2f,%.4f,%.4f,%.4f,%d",
+               r.index, stampForOutput(r.stamp), r.sensor.c_str(), r.kept ? 1 : 0, r.reason,
+               r.p_common, r.p_threshold, r.references, r.points_in, r.removed_range, r.clusters,
+               r.noise_clusters, r.removed_noise, r.points_out, r.microseconds, r.view_change,
+               r.changed_fraction, r.degeneracy, r.corridor ? 1 : 0);
     appendPose(line, r.odometry);
     appendPose(line, pose);
     line += '\n';

@@ -1,8 +1,10 @@
 #include "kfd/plot/map_figure.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
+#include "kfd/core/format.h"
 #include "kfd/eval/ate.h"
 
 namespace kfd {
@@ -22,11 +24,16 @@ void path(mrpt::img::CImage& img, const mrpt::maps::COccupancyGridMap2D& g, cons
 }  // namespace
 
 std::pair<int, int> mapFigurePixel(const mrpt::maps::COccupancyGridMap2D& g, double x, double y) {
-    // getAsImage(verticalFlip = true) puts the grid's last row (largest y) at the top.
+    // getAsImage(verticalFlip = true) puts the grid's last row (largest y) at the top. A point
+    // far outside the image (a track lost far away, NaN) is clamped well outside it: lines
+    // towards it are clipped by the canvas, and no double is cast beyond an int's range.
     const double res = g.getResolution();
-    const int col = static_cast<int>(std::floor((x - g.getXMin()) / res));
-    const int row =
-        static_cast<int>(g.getSizeY()) - 1 - static_cast<int>(std::floor((y - g.getYMin()) / res));
+    auto cell = [](double v) {
+        constexpr double kFar = 1.0e6;  // pixels; images are at most a few thousand wide
+        return static_cast<int>(std::isnan(v) ? -kFar : std::clamp(std::floor(v), -kFar, kFar));
+    };
+    const int col = cell((x - g.getXMin()) / res);
+    const int row = static_cast<int>(g.getSizeY()) - 1 - cell((y - g.getYMin()) / res);
     return {col, row};
 }
 
@@ -80,10 +87,14 @@ mrpt::img::CImage renderMapFigure(const MapFigureInput& in) {
     if (!gt.empty()) entry(green, "ground truth (aligned)");
     if (!odo.empty()) entry(grey, "odometry");
     if (!in.corridor.empty()) entry(orange, "corridor switch: degenerate scans");
-    const int bar = static_cast<int>(std::lround(1.0 / g.getResolution()));
+    // Scale bar: 1, 2 or 5 times a power of ten metres, at least 20 pixels long.
+    double metres = 1.0;
+    for (int k = 0; metres / g.getResolution() < 19.5 && k < 60; ++k)  // 0.05f is > 0.05
+        metres *= (k % 3 == 1) ? 2.5 : 2.0;                            // 1, 2, 5, 10, 20, 50, ...
+    const int bar = static_cast<int>(std::lround(metres / g.getResolution()));
     const int by = static_cast<int>(img.getHeight()) - 12;
     img.line(8, by, 8 + bar, by, black, 2);
-    img.textOut(12 + bar, by - 8, "1 m", black);
+    img.textOut(12 + bar, by - 8, format("%g m", metres), black);
     return img;
 }
 

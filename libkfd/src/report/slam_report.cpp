@@ -2,8 +2,11 @@
 
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
+#include <mrpt/poses/CPose3D.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +17,7 @@
 #include "kfd/baselines/decimate_stage.h"
 #include "kfd/baselines/motion_stage.h"
 #include "kfd/core/cancel.h"
+#include "kfd/core/format.h"
 #include "kfd/plot/map_figure.h"
 
 namespace kfd {
@@ -31,28 +35,19 @@ void writeText(const fs::path& path, const std::string& text) {
 std::string reportMarkdown(const IcpSlamSummary& sum) {
     std::string r = "# kfd-icp-slam report\n\n";
     r += "- rawlog: `" + sum.rawlog + "`\n- pre-filter mode: **" + toString(sum.mode) + "**\n";
-    char line[512];
-    std::snprintf(line, sizeof(line),
-                  "- scans: %zu in, %zu kept (%.1f %% dropped); points removed: %zu of %zu\n"
-                  "- time: pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s\n",
-                  sum.scans_in, sum.scans_kept, sum.dropped_pct, sum.points_removed, sum.points_in,
-                  sum.prefilter_us_per_scan, sum.icp_ms_per_scan, sum.cpu_s_total);
-    r += line;
-    if (sum.scans_corridor) {
-        std::snprintf(line, sizeof(line),
-                      "- corridor switch: %zu scans degenerate (orange in the figure)\n",
-                      sum.scans_corridor);
-        r += line;
-    }
-    if (sum.relations) {
-        std::snprintf(line, sizeof(line),
-                      "- relations error (%zu used, %zu unmatched): %.4f +- %.4f m, %.3f +- "
-                      "%.3f deg\n",
-                      sum.relations->used, sum.relations->unmatched, sum.relations->trans_mean,
-                      sum.relations->trans_std, sum.relations->rot_mean_deg,
-                      sum.relations->rot_std_deg);
-        r += line;
-    }
+    r += format(
+        "- scans: %zu in, %zu kept (%.1f %% dropped); points removed: %zu of %zu\n"
+        "- time: pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s\n",
+        sum.scans_in, sum.scans_kept, sum.dropped_pct, sum.points_removed, sum.points_in,
+        sum.prefilter_us_per_scan, sum.icp_ms_per_scan, sum.cpu_s_total);
+    if (sum.scans_corridor)
+        r += format("- corridor switch: %zu scans degenerate (orange in the figure)\n",
+                    sum.scans_corridor);
+    if (sum.relations)
+        r += format(
+            "- relations error (%zu used, %zu unmatched): %.4f +- %.4f m, %.3f +- %.3f deg\n",
+            sum.relations->used, sum.relations->unmatched, sum.relations->trans_mean,
+            sum.relations->trans_std, sum.relations->rot_mean_deg, sum.relations->rot_std_deg);
     if (sum.ate_rmse) {
         std::ostringstream ate;  // as the stream prints it (6 significant digits)
         ate << *sum.ate_rmse;
@@ -64,26 +59,80 @@ std::string reportMarkdown(const IcpSlamSummary& sum) {
     return r;
 }
 
+// The map image and figure are drawn in a local frame whose origin is the estimate's first
+// position (rounded to the metre), on a grid whose cell size keeps it within kMaxMapCells:
+// odometry and poses anywhere a double holds them (UTM coordinates, a track lost far away) give
+// a bounded image, never an allocation beyond the budget.
+constexpr double kMaxMapCells = 36.0e6;  // e.g. 6000 x 6000 cells (the RGB figure ~ 108 MB)
+constexpr double kMapResolution = 0.05;  // m per cell, the default (icp-slam's)
+
+struct MapFrame {
+    mrpt::poses::CPose3D origin;  // the local frame in map coordinates (a translation)
+    double resolution = kMapResolution;
+};
+
+MapFrame mapFrame(const IcpSlamResult& res, double insertion_reach) {
+    MapFrame f;
+    double x0 = 0.0, y0 = 0.0, xmin = 0.0, xmax = 0.0, ymin = 0.0, ymax = 0.0;
+    bool first = true;
+    for (const auto& p : res.trajectory) {
+        if (!std::isfinite(p.pose.x) || !std::isfinite(p.pose.y)) continue;
+        if (first) {
+            x0 = std::round(p.pose.x), y0 = std::round(p.pose.y);
+            first = false;
+        }
+        const double x = p.pose.x - x0, y = p.pose.y - y0;
+        xmin = std::min(xmin, x), xmax = std::max(xmax, x);
+        ymin = std::min(ymin, y), ymax = std::max(ymax, y);
+    }
+    // The grid takes the scans' points up to insertion_reach from their pose (its
+    // maxDistanceInsertion), and grows only that far around the poses.
+    const double reach = insertion_reach;
+    const double w = xmax - xmin + 2.0 * reach + 20.0, h = ymax - ymin + 2.0 * reach + 20.0;
+    f.resolution = std::max(kMapResolution, std::sqrt(w * h / kMaxMapCells));
+    f.origin = mrpt::poses::CPose3D(x0, y0, 0.0, 0.0, 0.0, 0.0);
+    return f;
+}
+
+Trajectory inFrame(const Trajectory& t, const MapFrame& f) {
+    Trajectory out = t;
+    for (auto& p : out) p.pose.x -= f.origin.x(), p.pose.y -= f.origin.y();
+    return out;
+}
+
 void writeMap(const IcpSlamResult& res, const fs::path& out) {
     const auto& sum = res.summary;
-    {  // as CMetricMapBuilder::saveCurrentMapToFile
+    // The map as built is in the map builder's frame; map_origin puts it in the log's frame.
+    const mrpt::poses::CPose3D builder(res.map_origin.x, res.map_origin.y, 0.0, 0.0, 0.0, 0.0);
+    {  // as CMetricMapBuilder::saveCurrentMapToFile, in the log's frame (like trajectory.tum)
+        mrpt::maps::CSimpleMap saved = *res.map;
+        if (res.map_origin.x != 0.0 || res.map_origin.y != 0.0)
+            saved.changeCoordinatesOrigin(builder);
         mrpt::io::CFileGZOutputStream f;
         if (!f.open((out / "final_map.simplemap").string()))
             throw SlamError("cannot write " + (out / "final_map.simplemap").string());
-        mrpt::serialization::archiveFrom(f) << *res.map;
+        mrpt::serialization::archiveFrom(f) << saved;
     }
-    mrpt::maps::COccupancyGridMap2D grid(-10, 10, -10, 10, 0.05f);
-    grid.loadFromSimpleMap(*res.map);
+    mrpt::maps::COccupancyGridMap2D grid(-10, 10, -10, 10, static_cast<float>(kMapResolution));
+    const MapFrame frame = mapFrame(res, grid.insertionOptions.maxDistanceInsertion);
+    mrpt::maps::CSimpleMap local = *res.map;  // poses copied, observations shared
+    const double dx = res.map_origin.x - frame.origin.x(), dy = res.map_origin.y - frame.origin.y();
+    if (dx != 0.0 || dy != 0.0)
+        local.changeCoordinatesOrigin(mrpt::poses::CPose3D(dx, dy, 0.0, 0.0, 0.0, 0.0));
+    grid.setSize(-10, 10, -10, 10, static_cast<float>(frame.resolution));
+    grid.loadFromSimpleMap(local);
     if (!grid.saveAsBitmapFile((out / "map.png").string()))
         throw SlamError("cannot write " + (out / "map.png").string());
     MapFigureInput fig;
     fig.grid = &grid;
-    fig.estimate = res.trajectory;
-    fig.ground_truth = res.ground_truth;
-    fig.odometry = res.odometry;
+    fig.estimate = inFrame(res.trajectory, frame);
+    fig.ground_truth = res.ground_truth;  // aligned to the estimate by the figure
+    fig.odometry = res.odometry;          // put on the estimate's start by the figure
     fig.keyframes = res.keyframes;
     fig.corridor = res.corridor;
     fig.title = fs::path(sum.rawlog).filename().string() + "  mode " + toString(sum.mode);
+    if (frame.origin.x() != 0.0 || frame.origin.y() != 0.0)
+        fig.title += format("  (origin at x %.0f, y %.0f m)", frame.origin.x(), frame.origin.y());
     if (!renderMapFigure(fig).saveToFile((out / "map_figure.png").string()))
         throw SlamError("cannot write " + (out / "map_figure.png").string());
 }

@@ -19,6 +19,7 @@
 #include "kfd/baselines/decimate_stage.h"
 #include "kfd/baselines/motion_stage.h"
 #include "kfd/core/cancel.h"
+#include "kfd/core/format.h"
 #include "kfd/eval/ate.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/open_source.h"
@@ -241,6 +242,7 @@ class Run {
     void openOutputs();
     void loop();
     void step(IcpSlamStep& step, const SourceEntry& e);
+    bool toMapFrame(mrpt::obs::CObservationOdometry& odo);
     bool prefilterScan(CObservation2DRangeScan& scan, const SourceEntry& e);
     mrpt::obs::CActionCollection* actionFor(const IcpSlamStep& step);
     void writeStep();
@@ -264,6 +266,7 @@ class Run {
     std::vector<ScanRecord> step_scans_;        // the scans of the current step, in order
     mrpt::obs::CActionCollection no_odometry_;  // laser_only: what the builder gets (empty)
     mrpt::obs::CActionCollection finite_actions_;
+    bool origin_set_ = false;  // the first absolute odometry set res_.map_origin
 };
 
 // Options that contradict each other, before anything is read.
@@ -431,10 +434,8 @@ void Run::step(IcpSlamStep& st, const SourceEntry& e) {
         bool process = true;
         if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(st.observation))
             process = prefilterScan(*scan, e);
-        else if (const auto* odo =
-                     dynamic_cast<const mrpt::obs::CObservationOdometry*>(st.observation.get()))
-            process = !opts_.laser_only &&
-                      finitePose(odo->odometry.x(), odo->odometry.y(), odo->odometry.phi());
+        else if (auto* odo = dynamic_cast<mrpt::obs::CObservationOdometry*>(st.observation.get()))
+            process = !opts_.laser_only && toMapFrame(*odo);
         if (process) timed([&] { builder_.processObservation(st.observation); });
         return;
     }
@@ -448,6 +449,21 @@ void Run::step(IcpSlamStep& st, const SourceEntry& e) {
     // odometry kept even if the frame is empty
     mrpt::obs::CActionCollection* action = actionFor(st);
     timed([&] { builder_.processActionObservation(*action, *st.frame); });
+}
+
+// An absolute odometry reading as the map builder gets it: in the local frame
+// (IcpSlamResult::map_origin), which the first finite reading sets. False when not finite.
+bool Run::toMapFrame(mrpt::obs::CObservationOdometry& odo) {
+    auto& p = odo.odometry;
+    if (!finitePose(p.x(), p.y(), p.phi())) return false;
+    if (!origin_set_) {
+        origin_set_ = true;
+        if (std::hypot(p.x(), p.y()) > kLocalFrameM)
+            res_.map_origin = Pose2D{std::round(p.x()), std::round(p.y()), 0.0};
+    }
+    p.x(p.x() - res_.map_origin.x);
+    p.y(p.y() - res_.map_origin.y);
+    return true;
 }
 
 // A scan through the door; true when it goes on to ICP. Its record waits for the step's pose.
@@ -477,11 +493,10 @@ mrpt::obs::CActionCollection* Run::actionFor(const IcpSlamStep& st) {
 // The step's pose (icp-slam's log line) and, for each of its scans, the trajectory, odometry,
 // keyframe and corridor entries and the scans.csv row.
 void Run::writeStep() {
-    const auto pose = builder_.getCurrentPoseEstimation()->getMeanVal();
-    char buf[256];
-    std::snprintf(buf, sizeof(buf), "%i %f %f %f\n", static_cast<int>(step_no_), pose.x(), pose.y(),
-                  pose.yaw());
-    f_path_ << buf;
+    const auto local = builder_.getCurrentPoseEstimation()->getMeanVal();
+    const mrpt::poses::CPose3D pose(local.x() + res_.map_origin.x, local.y() + res_.map_origin.y,
+                                    local.z(), local.yaw(), local.pitch(), local.roll());
+    f_path_ << format("%i %f %f %f\n", static_cast<int>(step_no_), pose.x(), pose.y(), pose.yaw());
     const Pose2D p{pose.x(), pose.y(), pose.yaw()};
     Trajectory& traj = res_.trajectory;
     for (const ScanRecord& s : step_scans_) {

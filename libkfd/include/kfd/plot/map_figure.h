@@ -26,7 +26,8 @@ struct MapFigureInput {
 /// Draws with MRPT's 2D canvas (no OpenGL): the grid (+y up), the odometry (grey), the ground
 /// truth (green) and the estimate (blue) with keyframes as small dots and the scans the corridor
 /// switch found degenerate in orange, a legend, the title and a
-/// 1 m scale bar. Throws PlotError without a grid.
+/// scale bar (1, 2 or 5 times a power of ten metres, at least 20 pixels). Throws PlotError
+/// without a grid.
 mrpt::img::CImage renderMapFigure(const MapFigureInput& in);
 
 /// The pixel (column, row from the top) of map point (x, y) in renderMapFigure's image.

@@ -97,12 +97,23 @@ struct IcpSlamResult {
     std::vector<std::size_t> keyframes;  // indices into `trajectory` of the kept scans
     std::vector<std::size_t> corridor;   // ... of the scans the corridor switch found degenerate
     Trajectory ground_truth;             // ground_truth_tum, sorted by time (empty without it)
-    std::optional<mrpt::maps::CSimpleMap> map;  // the built map, with write_map
+    std::optional<mrpt::maps::CSimpleMap> map;  // the built map, with write_map (map_origin's
+                                                // frame)
+    /// Where the map builder's frame sits in the log's frame (m): (0, 0) unless the log's
+    /// absolute odometry starts more than kLocalFrameM from the origin (UTM-like coordinates),
+    /// where ICP (MRPT's point maps hold floats: 0.5 m steps at 5e6 m) runs in a frame that
+    /// starts at the first odometry position, rounded to the metre. `trajectory`,
+    /// log_estimated_path.txt and scans.csv are in the log's frame.
+    Pose2D map_origin;
     /// The staged output folder holding what run() wrote; writeIcpSlamReport() adds the report
     /// and commits it (callers without a report call output->commit()). Removed uncommitted
     /// when the last copy of the result goes.
     std::shared_ptr<StagedOutputFolder> output;
 };
+
+/// Beyond this distance (m) of the first absolute odometry from the origin, kfd-icp-slam runs the
+/// map builder in a local frame (IcpSlamResult::map_origin): a float resolves 1 mm at 10 km.
+inline constexpr double kLocalFrameM = 1.0e4;
 
 /// Every file kfd-icp-slam may write into its output folder (checked against the inputs).
 inline constexpr const char* kIcpSlamOutputFiles[] = {
