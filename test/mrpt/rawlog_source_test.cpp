@@ -406,6 +406,47 @@ TEST(RawlogSource, ALengthFieldBeyondTheFileIsRefusedNotAllocated) {
     EXPECT_EQ(kfd::allocationLimit(), SIZE_MAX);
 }
 
+// A plain rawlog whose second scan's beam count reads 0x40000000 or 0xFFFFFFFF: MRPT resizes
+// the scan's three arrays (mrpt::aligned_std_vector, allocated by mrpt::aligned_malloc, not
+// operator new) to it before reading: 9.5 GB for 0x40000000 and a segfault inside MRPT's
+// allocator under a memory limit. kfd::alloc_limit's mrpt::aligned_malloc enforces the same
+// bound as its operator new: a RawlogError at once, the objects before it read.
+TEST(RawlogSource, ACorruptBeamCountIsRefusedNotAllocated) {
+    TempDir dir;
+    write(dir / "log.rawlog", observationsLog(), false);
+    const std::string data = bytes(dir / "log.rawlog");
+    const std::size_t first = data.find("LASER");
+    ASSERT_NE(first, std::string::npos);
+    const std::size_t at = kfd::test::scanBeamCountAt(data.find("LASER", first + 5), 5);
+    ASSERT_EQ(data.substr(at, 4), std::string("\x05\0\0\0", 4));  // 5 beams
+    for (const std::uint32_t count : {0x40000000u, 0xffffffffu, 0x01000000u}) {
+        SCOPED_TRACE(count);
+        std::ofstream(dir / "bad.rawlog", std::ios::binary | std::ios::trunc)
+            << kfd::test::withU32(data, at, count);
+        kfd::RawlogSource src(dir / "bad.rawlog");
+        SourceEntry e;
+        std::size_t read = 0;
+        try {
+            while (src.next(e)) ++read;
+            ADD_FAILURE() << "no error";
+        } catch (const kfd::RawlogError& err) {
+            const std::string w = err.what();
+            EXPECT_EQ(w.rfind("cannot read object #2 of " + (dir / "bad.rawlog"), 0), 0u) << w;
+            // 0x01000000 beams (64 MiB of ranges) fit in the bound: MRPT then finds the bytes
+            // missing.
+            EXPECT_NE(w.find(count == 0x01000000u ? "Cannot read requested number of bytes"
+                                                  : "(a corrupt length field)"),
+                      std::string::npos)
+                << w;
+        }
+        EXPECT_EQ(read, 2u);
+    }
+    struct rusage u {};
+    getrusage(RUSAGE_SELF, &u);
+    EXPECT_LT(u.ru_maxrss, 512L * 1024L);  // KiB
+    EXPECT_EQ(kfd::allocationLimit(), SIZE_MAX);
+}
+
 TEST(RawlogSource, MissingEmptyOrForeignFilesAreRawlogErrors) {
     TempDir dir;
     EXPECT_THROW(kfd::RawlogSource(dir / "missing.rawlog"), kfd::RawlogError);

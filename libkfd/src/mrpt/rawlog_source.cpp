@@ -57,7 +57,8 @@ struct RawlogSource::Impl {
             } catch (const std::bad_alloc&) {
                 ended = true;
                 throw error("an object claims more memory than the " + std::to_string(bytesLeft()) +
-                            " bytes left in the file (a corrupt length field)");
+                                " bytes left in the file (a corrupt length field)",
+                            true);
             } catch (const std::exception& e) {
                 ended = true;
                 if (!in.error().empty()) throw error(in.error());  // the gzip layer knows why
@@ -73,12 +74,13 @@ struct RawlogSource::Impl {
         return in.getTotalBytesCount() - std::min(in.getPosition(), in.getTotalBytesCount());
     }
 
-    RawlogError error(const std::string& what) const {
+    // `said`: `what` says itself that the file is corrupt (no hint added).
+    RawlogError error(const std::string& what, bool said = false) const {
+        const char* hint = said           ? ": "
+                           : objects == 0 ? " (is it an MRPT rawlog?): "
+                                          : " (truncated or corrupt file?): ";
         return RawlogError(
-            "cannot read object #" + std::to_string(objects) + " of " + path +
-                (objects == 0 ? " (is it an MRPT rawlog?): " : " (truncated or corrupt file?): ") +
-                what,
-            path);
+            "cannot read object #" + std::to_string(objects) + " of " + path + hint + what, path);
     }
 };
 
