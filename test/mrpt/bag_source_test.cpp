@@ -5,6 +5,7 @@
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <rosbag/view.h>
+#include <sys/resource.h>
 
 #include <cmath>
 #include <filesystem>
@@ -335,6 +336,192 @@ TEST(BagSource, NotABagOrAnOlderFormatIsRefused) {
     { BagBuilder b(d / "empty.bag"); }
     EXPECT_NE(readError(d / "empty.bag").find("no sensor_msgs/LaserScan topic"), std::string::npos)
         << readError(d / "empty.bag");
+}
+
+// --- corrupt lengths inside messages (issue 21) --------------------------------------------
+
+// Peak resident memory of this test process so far, in MiB.
+long peakMiB() {
+    struct rusage u {};
+    getrusage(RUSAGE_SELF, &u);
+    return u.ru_maxrss / 1024;
+}
+
+// A bag of `n` scans with odometry on /odom and on /tf, a /tf_static mount; message k of kind
+// `which` ("scan", "odom", "tf", "tf_static") is written as `bad` instead.
+template <class T>
+std::string bagWith(const TempDir& d, const std::string& name,
+                    rosbag::compression::CompressionType c, const std::string& which, int k,
+                    const kfd::test::Serialized<T>& bad, int n = 30) {
+    const std::string p = d / name;
+    BagBuilder b(p, c);
+    auto put = [&](const std::string& kind, int i, auto write) {
+        if (kind == which && i == k)
+            b.raw(kind == "scan"   ? "/scan"
+                  : kind == "odom" ? "/odom"
+                                   : "/" + kind,
+                  1 + 0.1 * i + (kind == "scan" ? 0.05 : 0.0), bad);
+        else
+            write();
+    };
+    put("tf_static", 0, [&] { b.tf("/tf_static", 1.0, "base_link", "laser", 0.1, 0, 0); });
+    for (int i = 0; i < n; ++i) {
+        const double t = 1 + 0.1 * i;
+        put("odom", i, [&] { b.odom("/odom", t, 0.01 * i, 0, 0); });
+        put("tf", i, [&] { b.tf("/tf", t, "odom", "base_link", 0.01 * i, 0, 0); });
+        put("scan", i,
+            [&] { b.scan("/scan", BagBuilder::scanMsg(t + 0.05, room(0.01 * i, 0, 0, 361))); });
+    }
+    return p;
+}
+
+std::string readError(const std::string& path, const kfd::SourceOptions& o) {
+    try {
+        readAll(path, o);
+    } catch (const kfd::SourceError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+// roscpp resizes a string or array to the length it reads before it finds the bytes missing: a
+// LaserScan whose ranges length read 0x40000000 took 8.4 GB. Each length is now checked
+// against the bytes of its message first (bag_message_check.cpp), in bags of every compression:
+// the error names the file, the message, the type, the field and both sizes.
+TEST(BagSource, CorruptLengthsInsideMessagesAreRefusedNotAllocated) {
+    using kfd::test::serialized;
+    using kfd::test::withU32;
+    TempDir d;
+    const auto scan = BagBuilder::scanMsg(1.55, room(0, 0, 0, 361));
+    const auto good = serialized(scan);
+    const std::size_t size = good.bytes.size();
+    const std::string fits = " does not fit in the message's " + std::to_string(size) + " bytes";
+    nav_msgs::Odometry odom;
+    odom.header.frame_id = "odom";
+    odom.child_frame_id = "base_link";
+    odom.header.stamp = ros::Time(1.5);
+    tf2_msgs::TFMessage tf;
+    tf.transforms.resize(1);
+    tf.transforms[0].header.frame_id = "odom";
+    tf.transforms[0].child_frame_id = "base_link";
+    tf.transforms[0].header.stamp = ros::Time(1.5);
+    kfd::SourceOptions via_tf;
+    via_tf.odom_topic = "tf";
+    for (auto c :
+         {rosbag::compression::Uncompressed, rosbag::compression::BZ2, rosbag::compression::LZ4}) {
+        SCOPED_TRACE(int(c));
+        const std::string z = std::to_string(int(c));
+        struct Case {
+            std::string path, message;
+            kfd::SourceOptions options;
+        };
+        const std::vector<Case> cases{
+            // A later scan: next() names the message by its number.
+            {bagWith(d, "ranges" + z + ".bag", c, "scan", 5,
+                     withU32(good, kfd::test::rangesLengthAt(scan), 0x40000000u)),
+             "(/scan at t = 1.550000 s): corrupt sensor_msgs/LaserScan: ranges: array length "
+             "1073741824 (4294967296 bytes)" +
+                 fits + " (" + std::to_string(size - kfd::test::rangesLengthAt(scan) - 4) +
+                 " left)",
+             {}},
+            // The first scan, read when the bag is opened (its frame names the mount).
+            {bagWith(d, "first" + z + ".bag", c, "scan", 0,
+                     withU32(good, kfd::test::rangesLengthAt(scan), 0xffffffffu)),
+             ": the message on /scan at t = 1.050000 s: corrupt sensor_msgs/LaserScan: ranges: "
+             "array length 4294967295 (17179869180 bytes)" +
+                 fits,
+             {}},
+            {bagWith(d, "intensities" + z + ".bag", c, "scan", 7,
+                     withU32(good, kfd::test::intensitiesLengthAt(scan), 0x40000000u)),
+             "corrupt sensor_msgs/LaserScan: intensities: array length 1073741824",
+             {}},
+            {bagWith(d, "frame" + z + ".bag", c, "scan", 3,
+                     withU32(good, kfd::test::frameIdLengthAt(), 0xfffffff0u)),
+             "corrupt sensor_msgs/LaserScan: header.frame_id: string length 4294967280" + fits,
+             {}},
+            // A message cut short: 361 ranges announced, 100 there.
+            {bagWith(d, "short" + z + ".bag", c, "scan", 4,
+                     [&] {
+                         auto s = good;
+                         s.bytes.resize(kfd::test::rangesLengthAt(scan) + 4 + 400);
+                         return s;
+                     }()),
+             "ranges: array length 361 (1444 bytes) does not fit in the message's " +
+                 std::to_string(kfd::test::rangesLengthAt(scan) + 4 + 400) + " bytes (400 left)",
+             {}},
+            {bagWith(d, "odom" + z + ".bag", c, "odom", 6,
+                     withU32(serialized(odom), 12 + 4 + 4, 0x40000000u)),
+             "(/odom at t = 1.600000 s): corrupt nav_msgs/Odometry: child_frame_id: string "
+             "length 1073741824",
+             {}},
+            {bagWith(d, "tf" + z + ".bag", c, "tf", 6, withU32(serialized(tf), 0, 0x40000000u)),
+             "(/tf at t = 1.600000 s): corrupt tf2_msgs/TFMessage: transforms: array length "
+             "1073741824 (at least 81604378624 bytes)",
+             via_tf},
+            {bagWith(d, "tfchild" + z + ".bag", c, "tf", 6,
+                     withU32(serialized(tf), 4 + 12 + 4 + 4, 0x40000000u)),
+             "corrupt tf2_msgs/TFMessage: transforms[0].child_frame_id: string length "
+             "1073741824",
+             via_tf},
+            {bagWith(d, "static" + z + ".bag", c, "tf_static", 0,
+                     withU32(serialized(tf), 0, 0xffffffffu)),
+             ": the message on /tf_static at t = 1.000000 s: corrupt tf2_msgs/TFMessage: "
+             "transforms: array length 4294967295",
+             {}},
+        };
+        for (const auto& k : cases) {
+            const std::string e = readError(k.path, k.options);
+            EXPECT_EQ(e.rfind(k.path + ": ", 0), 0u) << e;
+            EXPECT_NE(e.find(k.message), std::string::npos) << e;
+        }
+    }
+    EXPECT_LT(peakMiB(), 512);
+}
+
+// What the check allows: bytes after a message's last field (roscpp ignores them), empty
+// arrays and strings, a LaserScan without intensities.
+TEST(BagSource, TheMessageCheckRefusesNoWellFormedMessage) {
+    TempDir d;
+    auto scan = BagBuilder::scanMsg(1.55, room(0, 0, 0, 361), "");
+    auto longer = kfd::test::serialized(scan);
+    longer.bytes.insert(longer.bytes.end(), {1, 2, 3});
+    const auto p = bagWith(d, "ok.bag", rosbag::compression::LZ4, "scan", 5, longer);
+    const auto scans = scansOf(readAll(p));
+    ASSERT_EQ(scans.size(), 30u);
+    EXPECT_EQ(scans[5]->getScanSize(), 361u);
+    EXPECT_EQ(scans[5]->getScanRange(180), scan.ranges[180]);
+}
+
+// A chunk's announced size is no longer allocated before its data decompresses: an 18 kB bag
+// whose chunk claims 2 GiB took 2.1 GB. The output grows with what the data holds; a chunk
+// larger than LZ4's 4 MiB blocks (several blocks) and bz2's still read.
+TEST(BagSource, AChunkSizeFieldIsCheckedNotAllocated) {
+    TempDir d;
+    for (auto c : {rosbag::compression::BZ2, rosbag::compression::LZ4}) {
+        SCOPED_TRACE(int(c));
+        std::string bytes =
+            kfd::test::fileBytes(smallBag(d, "c" + std::to_string(int(c)) + ".bag", 30, c));
+        const auto at = bytes.find("size=");
+        ASSERT_NE(at, std::string::npos);
+        for (const std::uint32_t size : {0x7fffffffu, 1000u}) {
+            std::string bad = bytes;
+            for (int i = 0; i < 4; ++i) bad[at + 5 + i] = static_cast<char>(size >> (8 * i));
+            const std::string p = d / "bad.bag";
+            std::ofstream(p, std::ios::binary | std::ios::trunc) << bad;
+            const std::string e = readError(p);
+            EXPECT_NE(e.find("a chunk decompresses to another size than announced"),
+                      std::string::npos)
+                << e;
+        }
+        const std::string big = d / ("big" + std::to_string(int(c)) + ".bag");
+        {
+            BagBuilder b(big, c);
+            b.scan("/scan", BagBuilder::scanMsg(1.0, room(0, 0, 0, 1500000)));  // 6 MB
+            b.scan("/scan", BagBuilder::scanMsg(1.1, room(0, 0, 0, 361)));
+        }
+        EXPECT_EQ(readAll(big).size(), 2u);
+    }
+    EXPECT_LT(peakMiB(), 512);
 }
 
 // --- the filtered bag ---------------------------------------------------------------------

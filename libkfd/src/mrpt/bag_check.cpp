@@ -5,6 +5,7 @@
 #include <bzlib.h>
 #include <roslz4/lz4s.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -35,6 +36,112 @@ struct Header {
     std::map<std::string, std::string> fields;
     bool has(const char* k) const { return fields.count(k) > 0; }
 };
+
+enum class Inflated { Ok, Corrupt, OtherSize };
+
+// The output buffer of a chunk's decompression grows with what the data really holds, up to
+// the announced size and one byte more (to tell a larger content): a corrupt size field costs
+// no memory, where allocating the announced size first made an 18 kB bag take 2.1 GB.
+class GrowingOutput {
+  public:
+    GrowingOutput(std::vector<unsigned char>& out, std::uint64_t size, std::size_t compressed)
+        : out_(out), limit_(size + 1) {
+        out_.resize(static_cast<std::size_t>(
+            std::min<std::uint64_t>(limit_, std::max<std::uint64_t>(1u << 20, 8 * compressed))));
+    }
+    /// Room for at least `want` bytes after the `used` ones, when the limit allows.
+    bool grow(std::size_t used, std::size_t want) {
+        if (room(used) >= want) return true;
+        if (out_.size() < limit_)
+            out_.resize(static_cast<std::size_t>(std::min<std::uint64_t>(
+                limit_, std::max<std::uint64_t>(2 * out_.size(), used + want))));
+        return room(used) >= want;
+    }
+    unsigned char* at(std::size_t used) { return out_.data() + used; }
+    // At most 1 GiB at a time: the libraries count in int.
+    std::size_t room(std::size_t used) const {
+        return std::min<std::size_t>(out_.size() - used, 1u << 30);
+    }
+    Inflated finish(std::size_t used, std::uint64_t size) {
+        out_.resize(used);
+        return used == size ? Inflated::Ok : Inflated::OtherSize;
+    }
+
+  private:
+    std::vector<unsigned char>& out_;
+    std::uint64_t limit_;
+};
+
+Inflated inflateBz2(std::vector<unsigned char>& in, std::uint64_t size,
+                    std::vector<unsigned char>& out) {
+    GrowingOutput buf(out, size, in.size());
+    bz_stream s{};
+    if (BZ2_bzDecompressInit(&s, 0, 0) != BZ_OK) return Inflated::Corrupt;
+    s.next_in = reinterpret_cast<char*>(in.data());
+    s.avail_in = static_cast<unsigned int>(in.size());
+    std::size_t used = 0;
+    Inflated r = Inflated::Ok;
+    for (;;) {
+        if (!buf.grow(used, 1)) {
+            r = Inflated::OtherSize;  // more than announced
+            break;
+        }
+        const std::size_t room = buf.room(used);
+        s.next_out = reinterpret_cast<char*>(buf.at(used));
+        s.avail_out = static_cast<unsigned int>(room);
+        const int rc = BZ2_bzDecompress(&s);
+        used += room - s.avail_out;
+        if (rc == BZ_STREAM_END) break;
+        if (rc != BZ_OK || (s.avail_in == 0 && s.avail_out > 0)) {  // corrupt, or cut short
+            r = Inflated::Corrupt;
+            break;
+        }
+    }
+    BZ2_bzDecompressEnd(&s);
+    return r == Inflated::Ok ? buf.finish(used, size) : r;
+}
+
+Inflated inflateLz4(std::vector<unsigned char>& in, std::uint64_t size,
+                    std::vector<unsigned char>& out) {
+    // roslz4 decompresses a block whole into the output, or says the output is too small
+    // (ROSLZ4_OUTPUT_SMALL, its state kept for a retry); blocks are at most 4 MiB.
+    constexpr std::size_t kMaxBlock = 4u << 20;
+    GrowingOutput buf(out, size, in.size());
+    roslz4_stream s{};
+    s.input_next = reinterpret_cast<char*>(in.data());
+    s.input_left = static_cast<int>(in.size());
+    if (roslz4_decompressStart(&s) != ROSLZ4_OK) return Inflated::Corrupt;
+    std::size_t used = 0;
+    Inflated r = Inflated::Ok;
+    for (;;) {
+        if (s.input_left == 0) {
+            r = Inflated::Corrupt;  // cut short: no end of stream
+            break;
+        }
+        buf.grow(used, kMaxBlock);
+        const std::size_t room = buf.room(used);
+        s.output_next = reinterpret_cast<char*>(buf.at(used));
+        s.output_left = static_cast<int>(room);
+        const int rc = roslz4_decompress(&s);
+        used += room - static_cast<std::size_t>(s.output_left);
+        if (rc == ROSLZ4_STREAM_END) {
+            if (s.input_left != 0) r = Inflated::Corrupt;  // bytes after the stream
+            break;
+        }
+        if (rc == ROSLZ4_OUTPUT_SMALL && !buf.grow(used, kMaxBlock)) {
+            // At the limit: a block larger than what is left of the announced size, or
+            // corrupt data (roslz4 cannot tell them apart below a block's room).
+            r = Inflated::OtherSize;
+            break;
+        }
+        if (rc < 0 && rc != ROSLZ4_OUTPUT_SMALL) {
+            r = Inflated::Corrupt;
+            break;
+        }
+    }
+    roslz4_decompressEnd(&s);
+    return r == Inflated::Ok ? buf.finish(used, size) : r;
+}
 
 class Checker {
   public:
@@ -186,19 +293,12 @@ class Checker {
             if (data.size() != size) fail(at, "a chunk's size field does not match its data");
             plain.swap(data);
         } else if (c->second == "bz2" || c->second == "lz4") {
-            plain.resize(size);
-            unsigned int out = static_cast<unsigned int>(size);
-            const int rc =
-                c->second == "bz2"
-                    ? BZ2_bzBuffToBuffDecompress(reinterpret_cast<char*>(plain.data()), &out,
-                                                 reinterpret_cast<char*>(data.data()),
-                                                 static_cast<unsigned int>(data.size()), 0, 0)
-                    : roslz4_buffToBuffDecompress(reinterpret_cast<char*>(data.data()),
-                                                  static_cast<unsigned int>(data.size()),
-                                                  reinterpret_cast<char*>(plain.data()), &out);
-            const bool ok = c->second == "bz2" ? rc == BZ_OK : rc == ROSLZ4_OK;
-            if (!ok) fail(at, "a " + c->second + " chunk does not decompress (corrupt)");
-            if (out != size) fail(at, "a chunk decompresses to another size than announced");
+            const Inflated r =
+                c->second == "bz2" ? inflateBz2(data, size, plain) : inflateLz4(data, size, plain);
+            if (r == Inflated::Corrupt)
+                fail(at, "a " + c->second + " chunk does not decompress (corrupt)");
+            if (r == Inflated::OtherSize)
+                fail(at, "a chunk decompresses to another size than announced");
         } else {
             fail(at, "a chunk with unknown compression '" + c->second + "'");
         }

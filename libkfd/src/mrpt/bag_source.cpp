@@ -115,11 +115,25 @@ std::string pickTopic(const std::map<std::string, TopicInfo>& topics, const std:
     return {};
 }
 
+// `m` as a T, or null when it is not one; its bytes checked first (instantiateChecked), a
+// corrupt message a BagError naming its topic and time. For the choices made when a bag is
+// opened (BagSource::Impl::readOne names the message by its number).
+template <class T>
+boost::shared_ptr<T> instantiate(const rosbag::MessageInstance& m) {
+    try {
+        return instantiateChecked<T>(m);
+    } catch (const BagError& e) {
+        char buf[64];
+        std::snprintf(buf, sizeof(buf), " at t = %.6f s", m.getTime().toSec());
+        throw BagError("the message on " + m.getTopic() + buf + ": " + e.what());
+    }
+}
+
 // The first message of `topic` as a T, or null (none, or not a T).
 template <class T>
 boost::shared_ptr<T> firstMessage(rosbag::Bag& bag, const std::string& topic) {
     rosbag::View v(bag, rosbag::TopicQuery(topic));
-    for (const rosbag::MessageInstance& m : v) return m.instantiate<T>();
+    for (const rosbag::MessageInstance& m : v) return instantiate<T>(m);
     return nullptr;
 }
 
@@ -130,7 +144,7 @@ std::string baseFrameFromTf(rosbag::Bag& bag, const std::string& tf_topic,
     std::size_t n = 0;
     for (const rosbag::MessageInstance& m : v) {
         if (++n > kTfProbe) break;
-        if (const auto tf = m.instantiate<tf2_msgs::TFMessage>())
+        if (const auto tf = instantiate<tf2_msgs::TFMessage>(m))
             for (const auto& t : tf->transforms)
                 if (stripSlash(t.header.frame_id) == odom_frame)
                     return stripSlash(t.child_frame_id);
@@ -152,7 +166,7 @@ void chooseMount(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topic
         if (it == topics.end() || it->second.type != kTfMessage) continue;
         rosbag::View v(bag, rosbag::TopicQuery(topic));
         for (const rosbag::MessageInstance& m : v)
-            if (const auto tf = m.instantiate<tf2_msgs::TFMessage>())
+            if (const auto tf = instantiate<tf2_msgs::TFMessage>(m))
                 for (const auto& t : tf->transforms)
                     edges[stripSlash(t.child_frame_id)] =
                         Edge{stripSlash(t.header.frame_id),
@@ -389,7 +403,7 @@ struct BagSource::Impl {
             item.record = m->getTime().toSec();
             const std::string& topic = m->getTopic();
             if (topic == choice.scan_topic) {
-                const auto ls = m->instantiate<sensor_msgs::LaserScan>();
+                const auto ls = instantiateChecked<sensor_msgs::LaserScan>(*m);
                 if (!ls) throw BagError("not a " + std::string(kLaserScan));
                 item.scan = toScan(*ls);
                 item.stamp = ls->header.stamp.toSec();
@@ -399,12 +413,12 @@ struct BagSource::Impl {
                 }
             } else if (choice.odometry == BagChoice::Odometry::Topic &&
                        topic == choice.odom_topic) {
-                if (const auto od = m->instantiate<nav_msgs::Odometry>())
+                if (const auto od = instantiateChecked<nav_msgs::Odometry>(*m))
                     onSample(od->header.stamp.toSec(),
                              Pose2D{od->pose.pose.position.x, od->pose.pose.position.y,
                                     yawOf(od->pose.pose.orientation)});
             } else if (choice.odometry == BagChoice::Odometry::Tf && topic == choice.odom_topic) {
-                if (const auto tf = m->instantiate<tf2_msgs::TFMessage>())
+                if (const auto tf = instantiateChecked<tf2_msgs::TFMessage>(*m))
                     for (const auto& t : tf->transforms)
                         if (stripSlash(t.header.frame_id) == choice.odom_frame &&
                             stripSlash(t.child_frame_id) == choice.base_frame)

@@ -76,7 +76,7 @@ void BagWriter::copy(const NativeMessage& message) {
 std::size_t BagWriter::writeScan(const NativeMessage& original,
                                  const mrpt::obs::CObservation2DRangeScan& cleaned) {
     const auto& m = original.message;
-    auto ls = m.instantiate<sensor_msgs::LaserScan>();
+    auto ls = m.instantiate<sensor_msgs::LaserScan>();  // its bytes checked when read
     if (!ls)
         throw BagError(impl_->path + ": the message on " + m.getTopic() + " is not a LaserScan");
     const float mark = impl_->options.removed == RemovedMark::NaN

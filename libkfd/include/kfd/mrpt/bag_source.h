@@ -22,8 +22,11 @@ class BagError : public SourceError {
 /// them, the index entries and the chunk index) and throws BagError naming the file, the byte
 /// offset and what is wrong: not a bag, truncated, no index, a chunk that does not decompress,
 /// a length or an offset outside its record or chunk. rosbag_storage trusts these, so
-/// BagSource and listBag() run this check first. (Corrupt bytes inside a message's data, e.g.
-/// a range value, cannot be told from real data: bags carry no checksums.)
+/// BagSource and listBag() run this check first. A compressed chunk's output grows with what
+/// its data holds, up to its announced size: a corrupt size field allocates nothing. (The
+/// lengths inside a message are checked when it is read, see BagSource; other corrupt bytes
+/// inside a message's data, e.g. a range value, cannot be told from real data: bags carry no
+/// checksums.)
 void checkBagStructure(const std::string& path);
 
 /// What a BagSource reads from its bag (after the automatic choices).
@@ -67,6 +70,15 @@ struct BagChoice {
 /// (label "ODOMETRY", the scan's stamp and interpolated pose), the layout of kfd's rawlogs.
 /// Every message, the scans' included, also travels as `native` (scans) or as a Native entry
 /// (all other messages, odometry ones too), in the bag's order.
+///
+/// Corrupt messages: before a LaserScan, Odometry or TFMessage is deserialized, every string
+/// and array length in its bytes is checked against the bytes left of the message (roscpp
+/// resizes to the length it reads before it finds the bytes missing: 8.4 GB for a ranges
+/// length of 0x40000000). A length that does not fit is a BagError naming the file, the
+/// message (its number in next(), its topic and time), the type, the field and both sizes:
+/// "message 12 (/scan at t = 1.250000 s): corrupt sensor_msgs/LaserScan: ranges: array length
+/// 1073741824 (4294967296 bytes) does not fit in the message's 805 bytes (752 left)". Messages
+/// of other types are copied, never deserialized.
 class BagSource : public Source {
   public:
     /// Opens `path` and makes the choices; BagError naming the file and the reason.
