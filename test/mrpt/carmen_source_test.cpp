@@ -4,6 +4,7 @@
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservationOdometry.h>
+#include <sys/resource.h>
 
 #include <cmath>
 #include <filesystem>
@@ -171,15 +172,47 @@ TEST(CarmenSource, BadLinesNameTheFileTheLineAndTheField) {
     EXPECT_NE(errorOf(count).find(count + ":1: FLASER reading count ('-2') is not a count"),
               std::string::npos);
     const auto raw = d.write("raw.clf", "RAWLASER1 0 -1.5 3.0 0.01 8.0 0.01 0 3 1.0 2.0\n");
-    EXPECT_NE(errorOf(raw).find(raw + ":1: RAWLASER1 is cut short"), std::string::npos);
+    EXPECT_EQ(errorOf(raw),
+              raw + ":1: RAWLASER1 reading count 3 is more than the 2 fields after it");
+    const auto cut = d.write("cut.clf", "RAWLASER1 0 -1.5 3.0 0.01 8.0 0.01 0 2 1.0 2.0\n");
+    EXPECT_EQ(errorOf(cut), cut + ":1: RAWLASER1 is cut short");
     const auto none = d.write("none.clf", "# only comments\nPARAM x 1\n");
     EXPECT_NE(errorOf(none).find("no laser or odometry lines"), std::string::npos);
     // A gzip log cut short: the error names the file and the last line read.
     std::string bytes = kfd::test::fileBytes(d.write("full.clf.gz", kLog + "\n" + kLog, true));
-    const auto cut = d.write("cut.clf.gz", bytes.substr(0, bytes.size() - 6));
-    const std::string e = errorOf(cut);
-    EXPECT_EQ(e.rfind(cut + ": ", 0), 0u) << e;
+    const auto gz = d.write("cut.clf.gz", bytes.substr(0, bytes.size() - 6));
+    const std::string e = errorOf(gz);
+    EXPECT_EQ(e.rfind(gz + ": ", 0), 0u) << e;
     EXPECT_NE(e.find("gzip"), std::string::npos) << e;
+}
+
+// Counts are checked against the fields on their line before a scan is sized by them (issue
+// 21): a reading count of 0x40000000 is an error naming it, not a 9.5 GB scan. Lines and
+// their fields are bounded too (64 MiB, 2 000 100 fields), so no input makes the reader hold
+// more than ~100 MB.
+TEST(CarmenSource, CountsLinesAndFieldsAreBoundedBeforeAnythingIsAllocated) {
+    TempDir d;
+    const auto flaser = d.write("f.clf", "FLASER 1073741824 1 2 0 0 0 0 0 0 5.0 h 0\n");
+    EXPECT_EQ(errorOf(flaser),
+              flaser + ":1: FLASER reading count 1073741824 is more than the 11 fields after it");
+    const auto rem =
+        d.write("r.clf", "RAWLASER1 0 -1.5 3.0 0.01 8.0 0.01 0 2 1.0 2.0 4294967295 1 5.0 h 0\n");
+    EXPECT_EQ(errorOf(rem),
+              rem + ":1: RAWLASER1 remission count 4294967295 is more than the 4 fields after it");
+    std::string many = "FLASER 1000001";
+    for (int i = 0; i < 1000001 + 9; ++i) many += " 1";
+    EXPECT_EQ(errorOf(d.write("m.clf", many + "\n")),
+              d / "m.clf" + ":1: FLASER reading count 1000001 is more than 1000000");
+    std::string fields = "ODOM";
+    for (int i = 0; i < 2000100; ++i) fields += " 1";
+    EXPECT_EQ(errorOf(d.write("w.clf", fields + "\n")),
+              d / "w.clf" + ":1: more than 2000100 fields (not a CARMEN log?)");
+    const auto line =
+        d.write("l.clf", "ODOM 0 0 0 0 0 0 1.0 h 0\n" + std::string((64u << 20) + 1, 'x') + "\n");
+    EXPECT_EQ(errorOf(line), line + ":2: a line longer than 64 MiB (not a CARMEN log?)");
+    struct rusage u {};
+    getrusage(RUSAGE_SELF, &u);
+    EXPECT_LT(u.ru_maxrss, 512L * 1024L);  // KiB
 }
 
 TEST(LogFormat, TheContentDecides) {

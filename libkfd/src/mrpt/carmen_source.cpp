@@ -22,6 +22,12 @@ using mrpt::obs::CObservation2DRangeScan;
 using mrpt::obs::CObservationOdometry;
 using mrpt::poses::CPose2D;
 constexpr double kDeg = kPi / 180.0;
+// Bounds on one line, so that no input makes the reader hold more than ~100 MB: a RAWLASER
+// line of the largest counts (1e6 readings and 1e6 remissions, below) has 2 000 024 fields of
+// at most ~20 characters.
+constexpr std::size_t kMaxLine = std::size_t{64} << 20;  // bytes
+constexpr std::size_t kMaxFields = 2'000'100;
+constexpr double kMaxCount = 1e6;  // readings or remissions of one line
 
 // Reads a (plain or gzip) file line by line through detail::GzReader.
 class LineReader {
@@ -54,6 +60,11 @@ class LineReader {
             const void* nl = std::memchr(b, '\n', len_ - pos_);
             const std::size_t n =
                 nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - b) : len_ - pos_;
+            if (line.size() + n > kMaxLine)
+                throw CarmenError(path_ + ":" + std::to_string(number_ + 1) +
+                                      ": a line longer than " + std::to_string(kMaxLine >> 20) +
+                                      " MiB (not a CARMEN log?)",
+                                  path_);
             line.append(b, n);
             pos_ += n;
             if (nl) {
@@ -79,16 +90,20 @@ class LineReader {
     bool eof_ = false;
 };
 
-std::vector<std::string_view> tokenize(const std::string& line) {
-    std::vector<std::string_view> t;
+// The line's fields into `t`; false (t cut there) when it has more than kMaxFields.
+bool tokenize(const std::string& line, std::vector<std::string_view>& t) {
+    t.clear();
     std::size_t i = 0;
     while (i < line.size()) {
         while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
         const std::size_t b = i;
         while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i]))) ++i;
-        if (i > b) t.emplace_back(line.data() + b, i - b);
+        if (i > b) {
+            if (t.size() == kMaxFields) return false;
+            t.emplace_back(line.data() + b, i - b);
+        }
     }
-    return t;
+    return true;
 }
 
 // The laser of FLASER (front) or RLASER (rear) lines: its PARAMs.
@@ -140,11 +155,20 @@ struct CarmenSource::Impl {
         return v;
     }
 
+    // A count read from field i: checked against the fields after it on the line before
+    // anything is sized by it.
     std::size_t count(std::size_t i, const char* what) const {
         const double v = number(i);
-        if (!(v >= 0.0) || v > 1e6 || v != std::floor(v))
+        if (!(v >= 0.0) || v != std::floor(v))
             fail(std::string(tok[0]) + " " + what + " ('" + std::string(tok[i]) +
                  "') is not a count");
+        const std::size_t after = tok.size() - i - 1;
+        if (v > static_cast<double>(after))
+            fail(std::string(tok[0]) + " " + what + " " + std::string(tok[i]) +
+                 " is more than the " + std::to_string(after) + " fields after it");
+        if (v > kMaxCount)
+            fail(std::string(tok[0]) + " " + what + " " + std::string(tok[i]) + " is more than " +
+                 std::to_string(static_cast<long>(kMaxCount)));
         return static_cast<std::size_t>(v);
     }
 
@@ -268,7 +292,8 @@ struct CarmenSource::Impl {
     bool readMore() {
         while (ready.empty()) {
             if (!lines.next(line)) return false;
-            tok = tokenize(line);
+            if (!tokenize(line, tok))
+                fail("more than " + std::to_string(kMaxFields) + " fields (not a CARMEN log?)");
             if (tok.empty() || tok[0].front() == '#') continue;
             const std::string_view kw = tok[0];
             if (kw == "PARAM") {
@@ -322,9 +347,13 @@ SourceListing listCarmen(const std::string& path) {
     std::map<std::string, SourceListing::Stream> kinds;
     std::vector<std::string> order;
     std::string line;
+    std::vector<std::string_view> tok;
     std::size_t comments = 0;
     while (lines.next(line)) {
-        const auto tok = tokenize(line);
+        if (!tokenize(line, tok))
+            throw CarmenError(path + ":" + std::to_string(lines.number()) + ": more than " +
+                                  std::to_string(kMaxFields) + " fields (not a CARMEN log?)",
+                              path);
         if (tok.empty() || tok[0].front() == '#') {
             comments += tok.empty() ? 0 : 1;
             continue;

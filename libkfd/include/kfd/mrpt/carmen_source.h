@@ -40,7 +40,11 @@ class CarmenError : public SourceError {
 ///  - PARAM name value [host ts]: applies to the lines after it.
 ///  - comments (#), empty lines and other keywords (TRUEPOS, SYNC, ...) are skipped.
 /// A line with the wrong field count or a bad number is a CarmenError ("file:LINE: FLASER
-/// with 361 readings has 370 fields, expected 372").
+/// with 361 readings has 370 fields, expected 372"). A reading or remission count is checked
+/// against the fields after it on its line before a scan is sized by it ("FLASER reading
+/// count 1073741824 is more than the 11 fields after it"; at most 1 000 000); a line longer
+/// than 64 MiB or of more than 2 000 100 fields is refused, so no input makes the reader hold
+/// more than ~100 MB.
 class CarmenSource : public Source {
   public:
     explicit CarmenSource(const std::string& path);
