@@ -3,6 +3,7 @@
 // that every input is byte-for-byte unchanged.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -35,13 +36,31 @@ struct Result {
     std::string first() const { return err.substr(0, err.find('\n')); }
 };
 
-// Starts `exe args...` with stdout and stderr into files under `dir`; returns the pid.
-pid_t spawn(const std::string& exe, const std::vector<std::string>& args, const fs::path& dir) {
+// AddressSanitizer reserves terabytes of address space: no RLIMIT_AS under it.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAsan = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAsan = true;
+#else
+constexpr bool kAsan = false;
+#endif
+#else
+constexpr bool kAsan = false;
+#endif
+
+// Starts `exe args...` with stdout and stderr into files under `dir`; returns the pid. A
+// non-zero `address_space` limits the app's address space to that many bytes (RLIMIT_AS; not
+// under AddressSanitizer).
+pid_t spawn(const std::string& exe, const std::vector<std::string>& args, const fs::path& dir,
+            rlim_t address_space = 0) {
     const std::string out = (dir / ".stdout").string(), err = (dir / ".stderr").string();
     const pid_t pid = fork();
     if (pid == 0) {
         if (!std::freopen(out.c_str(), "w", stdout) || !std::freopen(err.c_str(), "w", stderr))
             _exit(127);
+        const struct rlimit limit { address_space, address_space };
+        if (address_space != 0 && !kAsan && setrlimit(RLIMIT_AS, &limit) != 0) _exit(126);
         std::vector<char*> argv{const_cast<char*>(exe.c_str())};
         for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
         argv.push_back(nullptr);
@@ -63,9 +82,11 @@ Result finish(pid_t pid, const fs::path& dir) {
     return r;
 }
 
-// Runs an app to its end (its stdout and stderr are kept in hidden files of `dir` meanwhile).
-Result run(const std::string& exe, const std::vector<std::string>& args, const fs::path& dir) {
-    return finish(spawn(exe, args, dir), dir);
+// Runs an app to its end (its stdout and stderr are kept in hidden files of `dir` meanwhile),
+// optionally under an address-space limit (spawn).
+Result run(const std::string& exe, const std::vector<std::string>& args, const fs::path& dir,
+           rlim_t address_space = 0) {
+    return finish(spawn(exe, args, dir, address_space), dir);
 }
 
 // Every file and folder under `dir` (relative paths), hidden ones included.
@@ -616,6 +637,130 @@ TEST(BadInputLogs, ABagOutputNeedsABagInput) {
         << r.err;
     EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
     snap.expectUnchanged();
+}
+
+// --- corrupt length fields (issue 21) ---------------------------------------------------------
+
+// The apps' normal use takes ~70 MB resident (their address space is larger: libraries, thread
+// stacks); a corrupt length field made them allocate 8-24 GB. Each row runs under this limit.
+constexpr rlim_t kOneGiB = rlim_t{1} << 30;
+
+// kfd-filter and kfd-icp-slam on an input with a corrupt length field, under a 1 GiB
+// address-space limit: exit 1 with `message` as the whole first line (after "APP: "), nothing
+// left in the folder, the input unchanged.
+void expectCorruptLengthRefused(const Dir& d, const std::string& in, const std::string& message,
+                                const std::string& out) {
+    SCOPED_TRACE(in);
+    const auto before = listing(d.path);
+    const Snapshot snap({in});
+    Result r = run(KFD_FILTER_EXE, {"-q", "-i", in, "-o", d / out, "--stats", d / "s.csv"}, d.path,
+                   kOneGiB);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(r.first(), "kfd-filter: " + message);
+    r = run(KFD_ICP_SLAM_EXE, {"-q", kSlamIni, in, "-o", d / "slam", "--no-map"}, d.path, kOneGiB);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(r.first(), "kfd-icp-slam: " + message);
+    EXPECT_EQ(listing(d.path), before);
+    snap.expectUnchanged();
+}
+
+// writeBag's bag (uncompressed, 40 scans of 181 beams, odometry) with scan k as `bad`.
+std::string writeBagWith(const Dir& d, const std::string& name, int k,
+                         const kfd::test::Serialized<sensor_msgs::LaserScan>& bad) {
+    const std::string p = d / name;
+    kfd::test::BagBuilder b(p);
+    for (int i = 0; i < 40; ++i) {
+        b.odom("/odom", 1 + 0.2 * i, 0.05 * i, 0, 0);
+        if (i == k)
+            b.raw("/scan", 1 + 0.2 * i + 0.1, bad);
+        else
+            b.scan("/scan", kfd::test::BagBuilder::scanMsg(1 + 0.2 * i + 0.1,
+                                                           std::vector<float>(181, 2.0f)));
+    }
+    return p;
+}
+
+TEST(BadInputCorruptLength, BagScanRangesLengthIsAnErrorNotGigabytes) {
+    // 0x40000000 made kfd-filter allocate 8.4 GB, 0xFFFFFFFF over 16 GiB.
+    Dir d;
+    const auto scan = kfd::test::BagBuilder::scanMsg(2.1, std::vector<float>(181, 2.0f));
+    const auto good = kfd::test::serialized(scan);
+    const std::size_t at = kfd::test::rangesLengthAt(scan);
+    const std::string sizes = " does not fit in the message's " +
+                              std::to_string(good.bytes.size()) + " bytes (" +
+                              std::to_string(good.bytes.size() - at - 4) + " left)";
+    const auto later = writeBagWith(d, "later.bag", 5, kfd::test::withU32(good, at, 0x40000000u));
+    expectCorruptLengthRefused(
+        d, later,
+        later +
+            ": message 12 (/scan at t = 2.100000 s): corrupt sensor_msgs/LaserScan: ranges: "
+            "array length 1073741824 (4294967296 bytes)" +
+            sizes,
+        "out.bag");
+    // The first scan is read when the bag is opened (its frame names the mount).
+    const auto first = writeBagWith(d, "first.bag", 0, kfd::test::withU32(good, at, 0xffffffffu));
+    expectCorruptLengthRefused(d, first,
+                               first +
+                                   ": the message on /scan at t = 1.100000 s: corrupt "
+                                   "sensor_msgs/LaserScan: ranges: array length 4294967295 "
+                                   "(17179869180 bytes)" +
+                                   sizes,
+                               "out.bag");
+}
+
+TEST(BadInputCorruptLength, BagWithFlippedMessageBytesIsAnErrorNotGigabytes) {
+    // An uncompressed bag with 64 bytes of one scan message flipped (its header's seq, stamp
+    // and frame_id length among them): the structure check cannot see it, roscpp reached 3.4 GB
+    // before its "Buffer Overrun".
+    Dir d;
+    std::string bytes = kfd::test::fileBytes(writeBag(d, "good.bag"));
+    fs::remove(d / "good.bag");
+    std::vector<float> ranges(181);  // writeBag's
+    for (std::size_t k = 0; k < ranges.size(); ++k)
+        ranges[k] = 2.0f + 0.01f * static_cast<float>(k % 7);
+    const auto msg =
+        kfd::test::serialized(kfd::test::BagBuilder::scanMsg(1 + 0.2 * 7 + 0.1, ranges));
+    const auto at = bytes.find(std::string(msg.bytes.begin(), msg.bytes.end()));
+    ASSERT_NE(at, std::string::npos);
+    for (std::size_t i = at; i < at + 64; ++i) bytes[i] = static_cast<char>(bytes[i] ^ 0x5a);
+    const auto in = d.write("flipped.bag", bytes);
+    const std::uint32_t frame_len = 5u ^ 0x5a5a5a5au;  // "laser"
+    expectCorruptLengthRefused(d, in,
+                               in +
+                                   ": message 16 (/scan at t = 2.500000 s): corrupt "
+                                   "sensor_msgs/LaserScan: header.frame_id: string length " +
+                                   std::to_string(frame_len) + " does not fit in the message's " +
+                                   std::to_string(msg.bytes.size()) + " bytes (" +
+                                   std::to_string(msg.bytes.size() - 16) + " left)",
+                               "out.bag");
+}
+
+TEST(BadInputCorruptLength, RawlogScanBeamCountIsAnErrorNotGigabytes) {
+    // The first scan's beam count: 0x40000000 made MRPT size its three arrays (9.5 GB), and
+    // under a memory limit segfault in its allocator, leaving a temporary output file.
+    const std::string data = plainOffice();
+    const std::size_t at = kfd::test::scanBeamCountAt(data.find("LASER"), 1081);
+    ASSERT_EQ(data.substr(at, 4), std::string("\x39\x04\0\0", 4));  // 1081 beams
+    for (const std::uint32_t count : {0x40000000u, 0xffffffffu}) {
+        Dir d;
+        const auto in = d.write("in.rawlog", kfd::test::withU32(data, at, count));
+        expectCorruptLengthRefused(d, in,
+                                   "cannot read object #0 of " + in +
+                                       ": an object claims more memory than the " +
+                                       std::to_string(data.size() - at - 4) +
+                                       " bytes left in the file (a corrupt length field)",
+                                   "out.rawlog");
+    }
+}
+
+TEST(BadInputCorruptLength, CarmenReadingCountIsAnErrorNotGigabytes) {
+    Dir d;
+    const auto in = d.write("in.clf",
+                            "ODOM 0 0 0 0 0 0 1.0 h 0\n"
+                            "FLASER 1073741824 1 2 0 0 0 0 0 0 5.0 h 0\n");
+    expectCorruptLengthRefused(
+        d, in, in + ":2: FLASER reading count 1073741824 is more than the 11 fields after it",
+        "out.rawlog");
 }
 
 }  // namespace
