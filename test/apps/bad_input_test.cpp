@@ -709,30 +709,33 @@ TEST(BadInputCorruptLength, BagScanRangesLengthIsAnErrorNotGigabytes) {
 }
 
 TEST(BadInputCorruptLength, BagWithFlippedMessageBytesIsAnErrorNotGigabytes) {
-    // An uncompressed bag with 64 bytes of one scan message flipped (its header's seq, stamp
-    // and frame_id length among them): the structure check cannot see it, roscpp reached 3.4 GB
-    // before its "Buffer Overrun".
+    // An uncompressed bag with 16 bytes of one scan message flipped (scan_time, range_min,
+    // range_max and the ranges length): the structure check cannot see it; roscpp resized the
+    // ranges to 1.5 G floats (6 GB) before its "Buffer Overrun".
     Dir d;
     std::string bytes = kfd::test::fileBytes(writeBag(d, "good.bag"));
     fs::remove(d / "good.bag");
-    std::vector<float> ranges(181);  // writeBag's
+    std::vector<float> ranges(181);  // writeBag's seventh scan
     for (std::size_t k = 0; k < ranges.size(); ++k)
         ranges[k] = 2.0f + 0.01f * static_cast<float>(k % 7);
-    const auto msg =
-        kfd::test::serialized(kfd::test::BagBuilder::scanMsg(1 + 0.2 * 7 + 0.1, ranges));
+    const auto scan = kfd::test::BagBuilder::scanMsg(1 + 0.2 * 7 + 0.1, ranges);
+    const auto msg = kfd::test::serialized(scan);
     const auto at = bytes.find(std::string(msg.bytes.begin(), msg.bytes.end()));
     ASSERT_NE(at, std::string::npos);
-    for (std::size_t i = at; i < at + 64; ++i) bytes[i] = static_cast<char>(bytes[i] ^ 0x5a);
+    const std::size_t ranges_at = kfd::test::rangesLengthAt(scan);
+    for (std::size_t i = at + ranges_at - 12; i < at + ranges_at + 4; ++i)
+        bytes[i] = static_cast<char>(bytes[i] ^ 0x5a);
     const auto in = d.write("flipped.bag", bytes);
-    const std::uint32_t frame_len = 5u ^ 0x5a5a5a5au;  // "laser"
-    expectCorruptLengthRefused(d, in,
-                               in +
-                                   ": message 16 (/scan at t = 2.500000 s): corrupt "
-                                   "sensor_msgs/LaserScan: header.frame_id: string length " +
-                                   std::to_string(frame_len) + " does not fit in the message's " +
-                                   std::to_string(msg.bytes.size()) + " bytes (" +
-                                   std::to_string(msg.bytes.size() - 16) + " left)",
-                               "out.bag");
+    const std::uint32_t count = 181u ^ 0x5a5a5a5au;
+    expectCorruptLengthRefused(
+        d, in,
+        in +
+            ": message 16 (/scan at t = 2.500000 s): corrupt "
+            "sensor_msgs/LaserScan: ranges: array length " +
+            std::to_string(count) + " (" + std::to_string(std::uint64_t{count} * 4) +
+            " bytes) does not fit in the message's " + std::to_string(msg.bytes.size()) +
+            " bytes (" + std::to_string(msg.bytes.size() - ranges_at - 4) + " left)",
+        "out.bag");
 }
 
 TEST(BadInputCorruptLength, RawlogScanBeamCountIsAnErrorNotGigabytes) {
