@@ -33,7 +33,7 @@ enum class MessageLayout { LaserScan, Odometry, TfMessage };
 /// every string and array length must fit in the bytes left of the message (for an array of
 /// TransformStamped, its count times the least one element takes). Throws BagError
 /// ("corrupt sensor_msgs/LaserScan: ranges: array length 1073741824 (4294967296 bytes) does
-/// not fit in the message's 845 bytes (765 left)"), without the file or the message: the
+/// not fit in the message's 781 bytes (728 left)"), without the file or the message: the
 /// caller names them. Bytes after the last field are allowed, as roscpp does.
 void checkMessageBytes(MessageLayout layout, const unsigned char* data, std::size_t size);
 /// The same on a bag message's bytes (copied out of rosbag's chunk buffer).

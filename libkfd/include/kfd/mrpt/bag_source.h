@@ -76,8 +76,8 @@ struct BagChoice {
 /// resizes to the length it reads before it finds the bytes missing: 8.4 GB for a ranges
 /// length of 0x40000000). A length that does not fit is a BagError naming the file, the
 /// message (its number in next(), its topic and time), the type, the field and both sizes:
-/// "message 12 (/scan at t = 1.250000 s): corrupt sensor_msgs/LaserScan: ranges: array length
-/// 1073741824 (4294967296 bytes) does not fit in the message's 805 bytes (752 left)". Messages
+/// "message 12 (/scan at t = 2.100000 s): corrupt sensor_msgs/LaserScan: ranges: array length
+/// 1073741824 (4294967296 bytes) does not fit in the message's 781 bytes (728 left)". Messages
 /// of other types are copied, never deserialized.
 class BagSource : public Source {
   public:
