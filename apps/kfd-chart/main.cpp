@@ -4,6 +4,7 @@
 
 #include "common/cli.h"
 #include "kfd/core/cancel.h"
+#include "kfd/mrpt/png_output.h"
 #include "kfd/plot/bar_chart.h"
 
 int main(int argc, char** argv) {
@@ -19,7 +20,7 @@ int main(int argc, char** argv) {
     cli.flag("--log", log_y, "logarithmic y axis");
     cli.option("--size", size, "image width and height in pixels (default 1000 500)", 2, 2)
         ->option_text("W H");
-    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM
+    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP
     return cli.run(argc, argv, [&] {
         kfd::app::checkOutputPaths({{"input CSV", csv}}, {{"output image", out}});
         auto c = kfd::readBarChartCsv(csv);
@@ -29,8 +30,7 @@ int main(int argc, char** argv) {
         c.width = size[0];
         c.height = size[1];
         kfd::TempOutputFile tmp(out);  // written under a temporary name, renamed when complete
-        if (!c.render().saveToFile(tmp.path().string()))
-            throw std::runtime_error("cannot write " + out);
+        kfd::writePng(c.render(), tmp.path(), out);  // every write checked (WriteError)
         kfd::throwIfCancelled();  // interrupted while drawing: nothing is moved into place
         tmp.commit();
     });

@@ -14,6 +14,7 @@
 #include "kfd/core/denoiser.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/open_source.h"
+#include "kfd/mrpt/png_output.h"
 #include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/source.h"
 #include "kfd/mrpt/stream_filter.h"
@@ -51,7 +52,7 @@ int main(int argc, char** argv) {
     cli.option("--size", size, "image width and height")->type_name("PX")->capture_default_str();
     cli.option("--extent", extent, "half the visible height in metres (default: fit the scan)")
         ->type_name("M");
-    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM
+    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP
     return cli.run(argc, argv, [&] {
         if (list) return kfd::app::printListing(in, source_opts);
         if (out.empty()) throw kfd::app::UsageError("no output image (-o)");
@@ -118,7 +119,7 @@ int main(int argc, char** argv) {
         kfd::ClusterFigure fig(o);
         auto img = fig.render(scan, *clusters);
         kfd::TempOutputFile tmp(out);  // written under a temporary name, renamed when complete
-        if (!img.saveToFile(tmp.path().string())) throw std::runtime_error("cannot write " + out);
+        kfd::writePng(img, tmp.path(), out);  // every write checked (WriteError)
         kfd::throwIfCancelled();  // interrupted while drawing: nothing is moved into place
         tmp.commit();
         std::printf("kfd-render: scan at %.6f, %zu clusters, %zu noise points -> %s\n",

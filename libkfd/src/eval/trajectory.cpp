@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "kfd/core/format.h"
+#include "kfd/core/output_paths.h"
 
 namespace kfd {
 
@@ -52,14 +53,13 @@ Trajectory readTum(const std::string& path) {
     return traj;
 }
 
-void writeTum(const std::string& path, const Trajectory& traj) {
-    std::ofstream f(path);
-    if (!f) throw EvalError("cannot write trajectory " + path);
+void writeTum(const std::string& path, const Trajectory& traj, const std::string& name) {
+    OutputFile f(path, name.empty() ? path : name);
     f << "# timestamp x y z qx qy qz qw\n";
     for (const auto& p : traj)  // any coordinates: no fixed buffer (kfd::format)
         f << format("%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", p.t, p.pose.x, p.pose.y,
                     std::sin(0.5 * p.pose.phi), std::cos(0.5 * p.pose.phi));
-    if (!f) throw EvalError("failed writing " + path);
+    f.close();
 }
 
 std::optional<std::size_t> nearest(const Trajectory& traj, double t, double max_dt) {

@@ -1,10 +1,15 @@
 #include "kfd/mrpt/bag_writer.h"
 
 #include <rosbag/bag.h>
+#include <rosbag/view.h>
 #include <sensor_msgs/LaserScan.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <limits>
+#include <memory>
+#include <vector>
 
 #include "bag_message.h"
 
@@ -18,58 +23,85 @@ RemovedMark parseRemovedMark(const std::string& text) {
     throw Error("'" + text + "' is not a removed-point mark (nan or inf)");
 }
 
+namespace {
+
+// A rosbag::Bag whose write failed cannot be destroyed: its destructor closes it, closing writes
+// the index, the write fails again and the exception leaves a destructor (std::terminate: a full
+// disk aborted kfd-filter). Such a bag is set aside here, reachable and never destroyed (its
+// temporary file is removed by its owner; the descriptor goes with the process).
+void abandon(std::unique_ptr<rosbag::Bag> bag) {
+    static auto* const abandoned = new std::vector<std::unique_ptr<rosbag::Bag>>;
+    abandoned->push_back(std::move(bag));
+}
+
+}  // namespace
+
 struct BagWriter::Impl {
-    std::string path;
-    rosbag::Bag bag;
+    std::string path, name;  // the file written, the file users know
+    std::unique_ptr<rosbag::Bag> bag = std::make_unique<rosbag::Bag>();  // null once failed
     BagWriterOptions options;
     std::size_t written = 0;
-    bool open = false;
 
+    // Runs fn on the bag; rosbag's exceptions (which say "Error writing to file", not why)
+    // become a BagError "cannot write NAME: REASON (rosbag: what: its message)", REASON the
+    // errno that rosbag's failing stdio call left, when there is one. A bag that failed is
+    // abandoned, and every later call fails at once.
     template <class Fn>
     void guarded(Fn&& fn, const char* what) {
+        if (!bag) throw BagError("cannot write " + name + ": an earlier write failed", name);
+        errno = 0;
         try {
-            fn();
+            fn(*bag);
         } catch (const std::exception& e) {
-            throw BagError(path + ": " + what + " (" + e.what() + ")", path);
+            const int err = errno;
+            abandon(std::move(bag));
+            throw BagError(
+                "cannot write " + name + ": " +
+                    (err ? std::string(std::strerror(err)) + " (rosbag: " : "(rosbag: ") + what +
+                    ": " + e.what() + ")",
+                name);
         }
     }
 };
 
-BagWriter::BagWriter(const std::string& path, const BagWriterOptions& options)
+BagWriter::BagWriter(const std::string& path, const BagWriterOptions& options,
+                     const std::string& name)
     : impl_(std::make_unique<Impl>()) {
     Impl& d = *impl_;
     d.path = path;
+    d.name = name.empty() ? path : name;
     d.options = options;
     d.guarded(
-        [&] {
-            d.bag.open(path, rosbag::bagmode::Write);
+        [&](rosbag::Bag& bag) {
+            bag.open(path, rosbag::bagmode::Write);
             switch (options.compression) {
                 case BagWriterOptions::Compression::None:
-                    d.bag.setCompression(rosbag::compression::Uncompressed);
+                    bag.setCompression(rosbag::compression::Uncompressed);
                     break;
                 case BagWriterOptions::Compression::Lz4:
-                    d.bag.setCompression(rosbag::compression::LZ4);
+                    bag.setCompression(rosbag::compression::LZ4);
                     break;
                 case BagWriterOptions::Compression::Bz2:
-                    d.bag.setCompression(rosbag::compression::BZ2);
+                    bag.setCompression(rosbag::compression::BZ2);
                     break;
             }
         },
         "cannot create the bag");
-    d.open = true;
 }
 
 BagWriter::~BagWriter() {
-    if (impl_->open) try {
-            impl_->bag.close();
-        } catch (...) {  // the file is discarded by the caller (a temporary) anyway
+    if (impl_->bag) try {  // not closed: the file is discarded by the caller (a temporary)
+            impl_->bag->close();
+        } catch (...) {
+            abandon(std::move(impl_->bag));
         }
 }
 
 void BagWriter::copy(const NativeMessage& message) {
     const auto& m = message.message;
-    impl_->guarded([&] { impl_->bag.write(m.getTopic(), m.getTime(), m, m.getConnectionHeader()); },
-                   "failed writing a message");
+    impl_->guarded(
+        [&](rosbag::Bag& bag) { bag.write(m.getTopic(), m.getTime(), m, m.getConnectionHeader()); },
+        "failed writing a message");
     ++impl_->written;
 }
 
@@ -78,7 +110,8 @@ std::size_t BagWriter::writeScan(const NativeMessage& original,
     const auto& m = original.message;
     auto ls = m.instantiate<sensor_msgs::LaserScan>();  // its bytes checked when read
     if (!ls)
-        throw BagError(impl_->path + ": the message on " + m.getTopic() + " is not a LaserScan");
+        throw BagError(impl_->name + ": the message on " + m.getTopic() + " is not a LaserScan",
+                       impl_->name);
     const float mark = impl_->options.removed == RemovedMark::NaN
                            ? std::numeric_limits<float>::quiet_NaN()
                            : std::numeric_limits<float>::infinity();
@@ -91,15 +124,31 @@ std::size_t BagWriter::writeScan(const NativeMessage& original,
         }
     }
     impl_->guarded(
-        [&] { impl_->bag.write(m.getTopic(), m.getTime(), *ls, m.getConnectionHeader()); },
+        [&](rosbag::Bag& bag) {
+            bag.write(m.getTopic(), m.getTime(), *ls, m.getConnectionHeader());
+        },
         "failed writing a scan");
     ++impl_->written;
     return marked;
 }
 
 void BagWriter::close() {
-    impl_->guarded([&] { impl_->bag.close(); }, "failed writing the bag's index");
-    impl_->open = false;
+    Impl& d = *impl_;
+    d.guarded([&](rosbag::Bag& bag) { bag.close(); }, "failed writing the bag's index");
+    // Read back: the index must open and count every message written.
+    std::size_t indexed = 0;
+    d.guarded(
+        [&](rosbag::Bag&) {
+            rosbag::Bag check(d.path, rosbag::bagmode::Read);
+            indexed = rosbag::View(check).size();
+        },
+        "the written bag does not open");
+    d.bag.reset();
+    if (indexed != d.written)
+        throw BagError("cannot write " + d.name + ": the written bag's index holds " +
+                           std::to_string(indexed) + " messages, not the " +
+                           std::to_string(d.written) + " written",
+                       d.name);
 }
 
 std::size_t BagWriter::messagesWritten() const { return impl_->written; }

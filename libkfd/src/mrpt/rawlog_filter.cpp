@@ -1,6 +1,5 @@
 #include "kfd/mrpt/rawlog_filter.h"
 
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
@@ -18,6 +17,7 @@
 #include "kfd/core/output_paths.h"
 
 #include "kfd/core/denoiser.h"
+#include "kfd/mrpt/gz_output.h"
 #include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_csv.h"
 
@@ -31,10 +31,10 @@ using mrpt::obs::CObservation2DRangeScan;
 using mrpt::obs::CSensoryFrame;
 using mrpt::poses::CPose2D;
 
-// Runs fn; the errors of the sources, of the bag writer and of the stats file (SourceError,
-// BagError, CarmenError, ScanCsvError) come out as RawlogError, the class RawlogFilter reports (a
-// RawlogError as it is). `field`: the path the error is about, when it is not the error's own (the
-// output).
+// Runs fn; the errors of the sources, of the bag writer, of the stats file and of the outputs
+// (SourceError, BagError, CarmenError, ScanCsvError, PathError, WriteError) come out as
+// RawlogError, the class RawlogFilter reports (a RawlogError as it is). `field`: the path the
+// error is about, when it is not the error's own (the output).
 template <class Fn>
 decltype(auto) asRawlogError(Fn&& fn, const std::string& field = {}) {
     try {
@@ -44,6 +44,8 @@ decltype(auto) asRawlogError(Fn&& fn, const std::string& field = {}) {
     } catch (const SourceError& e) {
         throw RawlogError(e.what(), field.empty() ? e.field() : field);
     } catch (const ScanCsvError& e) {
+        throw RawlogError(e.what(), e.field());
+    } catch (const PathError& e) {
         throw RawlogError(e.what(), e.field());
     }
 }
@@ -88,9 +90,8 @@ class Run {
     std::unique_ptr<Source> source_;
     std::optional<TempOutputFile> tmp_, tmp_csv_;  // the outputs under temporary names
     ScanCsvWriter csv_;
-    mrpt::io::CFileGZOutputStream out_;
-    std::optional<mrpt::serialization::CArchiveStreamBase<mrpt::io::CFileGZOutputStream>> arch_;
-    std::optional<BagWriter> bag_;                // a bag output (instead of out_/arch_)
+    std::optional<GzOutputStream> gz_;            // a rawlog output
+    std::optional<BagWriter> bag_;                // a bag output (instead of gz_)
     std::shared_ptr<CActionCollection> pending_;  // action waiting for its sensory frame
     CPose2D carry_;                               // odometry of dropped frames, not yet written
     bool have_carry_ = false;
@@ -103,7 +104,9 @@ class Run {
 
 void Run::write(const mrpt::serialization::CSerializable& obj) {
     try {
-        (*arch_) << obj;
+        gz_->write(obj);
+    } catch (const WriteError& e) {  // "cannot write out.rawlog: No space left on device"
+        throw RawlogError(e.what(), opts_.output);
     } catch (const std::exception& e) {
         throw RawlogError(std::string("failed writing the output: ") + e.what());
     }
@@ -251,17 +254,18 @@ void Run::prepare() {
 // Both outputs are written under temporary names beside them and renamed at the end; on any
 // failure or cancellation the destructors remove them.
 void Run::openOutputs() {
-    tmp_.emplace(opts_.output);
+    asRawlogError([&] { tmp_.emplace(opts_.output); });
     if (sum_.output_format == LogFormat::Bag) {
-        asRawlogError([&] { bag_.emplace(tmp_->path().string(), opts_.bag); }, opts_.output);
+        asRawlogError([&] { bag_.emplace(tmp_->path().string(), opts_.bag, opts_.output); },
+                      opts_.output);
     } else {
-        if (!out_.open(tmp_->path().string(), opts_.compress_level))
-            throw RawlogError("cannot write the output next to " + opts_.output, opts_.output);
-        arch_.emplace(out_);
+        asRawlogError([&] { gz_.emplace(tmp_->path(), opts_.output, opts_.compress_level); });
     }
     if (!opts_.stats_csv.empty()) {
-        tmp_csv_.emplace(opts_.stats_csv);
-        asRawlogError([&] { csv_.open(tmp_csv_->path().string(), opts_.stats_csv); });
+        asRawlogError([&] {
+            tmp_csv_.emplace(opts_.stats_csv);
+            csv_.open(tmp_csv_->path().string(), opts_.stats_csv);
+        });
     }
 }
 
@@ -337,16 +341,20 @@ void Run::finish() {
         --sum_.actions_merged;  // that motion was written, not merged away
         have_carry_ = false;
     }
-    arch_.reset();
-    if (bag_) {
-        asRawlogError([&] { bag_->close(); }, opts_.output);
-    } else {
-        out_.close();
-    }
-    asRawlogError([&] { csv_.close(); });
+    // Every output complete and checked (the gzip's trailer, the bag's index read back, sizes,
+    // fsync) before anything is renamed into place.
+    asRawlogError([&] {
+        if (bag_)
+            bag_->close();
+        else
+            gz_->close();
+        csv_.close();
+    });
     throwIfCancelled();
-    tmp_->commit();
-    if (tmp_csv_) tmp_csv_->commit();
+    asRawlogError([&] {
+        tmp_->commit();
+        if (tmp_csv_) tmp_csv_->commit();
+    });
 
     if (sum_.input_format == LogFormat::Carmen)
         sum_.layout = "FLASER/RLASER/RAWLASER/ROBOTLASER and ODOM lines";

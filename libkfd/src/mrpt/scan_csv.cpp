@@ -12,15 +12,26 @@ void appendPose(std::string& line, const std::optional<Pose2D>& p) {
     line += p ? format(",%.6f,%.6f,%.6f", p->x, p->y, p->phi) : std::string(",,,");
 }
 
+// Runs fn; a failed write comes out as a ScanCsvError with the same message.
+template <class Fn>
+void asScanCsvError(Fn&& fn) {
+    try {
+        fn();
+    } catch (const WriteError& e) {
+        throw ScanCsvError(e.what(), e.field());
+    }
+}
+
 }  // namespace
 
 void ScanCsvWriter::open(const std::string& path, const std::string& name) {
-    name_ = name;
-    out_.open(path);
-    if (!out_) throw ScanCsvError("cannot write the per-scan file " + name, name);
-    out_ << "index,timestamp,sensor,kept,reason,p_common,p_threshold,references,points_in,"
-            "removed_range,clusters,noise_clusters,removed_noise,points_out,microseconds,"
-            "view_change,changed_fraction,degeneracy,corridor,odom_x,odom_y,odom_phi,x,y,phi\n";
+    asScanCsvError([&] {
+        out_.emplace(path, name);
+        *out_
+            << "index,timestamp,sensor,kept,reason,p_common,p_threshold,references,points_in,"
+               "removed_range,clusters,noise_clusters,removed_noise,points_out,microseconds,"
+               "view_change,changed_fraction,degeneracy,corridor,odom_x,odom_y,odom_phi,x,y,phi\n";
+    });
 }
 
 void ScanCsvWriter::write(const ScanRecord& r, const std::optional<Pose2D>& pose) {
@@ -33,13 +44,11 @@ void ScanCsvWriter::write(const ScanRecord& r, const std::optional<Pose2D>& pose
     appendPose(line, r.odometry);
     appendPose(line, pose);
     line += '\n';
-    out_ << line;
+    asScanCsvError([&] { out_->write(line); });
 }
 
 void ScanCsvWriter::close() {
-    if (!out_.is_open()) return;
-    out_.close();
-    if (out_.fail()) throw ScanCsvError("failed writing the per-scan file " + name_, name_);
+    if (out_) asScanCsvError([&] { out_->close(); });
 }
 
 }  // namespace kfd

@@ -1,15 +1,12 @@
 #include "kfd/report/slam_report.h"
 
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/poses/CPose3D.h>
-#include <mrpt/serialization/CArchive.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <tuple>
@@ -18,6 +15,9 @@
 #include "kfd/baselines/motion_stage.h"
 #include "kfd/core/cancel.h"
 #include "kfd/core/format.h"
+#include "kfd/core/output_paths.h"
+#include "kfd/mrpt/gz_output.h"
+#include "kfd/mrpt/png_output.h"
 #include "kfd/plot/map_figure.h"
 
 namespace kfd {
@@ -25,11 +25,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void writeText(const fs::path& path, const std::string& text) {
-    std::ofstream f(path);
+// Every file of the folder through kfd's checked writers (OutputFile, GzOutputStream,
+// writePng): a failure is a WriteError naming the file's final name and the reason.
+void writeText(const StagedOutputFolder& out, const std::string& name, const std::string& text) {
+    OutputFile f(out.path() / name, out.finalName(name));
     f << text;
     f.close();
-    if (f.fail()) throw SlamError("cannot write " + path.string(), path.string());
 }
 
 std::string reportMarkdown(const IcpSlamSummary& sum) {
@@ -100,18 +101,18 @@ Trajectory inFrame(const Trajectory& t, const MapFrame& f) {
     return out;
 }
 
-void writeMap(const IcpSlamResult& res, const fs::path& out) {
+void writeMap(const IcpSlamResult& res, const StagedOutputFolder& out) {
     const auto& sum = res.summary;
-    // The map as built is in the map builder's frame; map_origin puts it in the log's frame.
-    const mrpt::poses::CPose3D builder(res.map_origin.x, res.map_origin.y, 0.0, 0.0, 0.0, 0.0);
-    {  // as CMetricMapBuilder::saveCurrentMapToFile, in the log's frame (like trajectory.tum)
+    {  // as CMetricMapBuilder::saveCurrentMapToFile (gzip level 1), in the log's frame (like
+       // trajectory.tum); the map as built is in the map builder's frame (map_origin)
         mrpt::maps::CSimpleMap saved = *res.map;
         if (res.map_origin.x != 0.0 || res.map_origin.y != 0.0)
-            saved.changeCoordinatesOrigin(builder);
-        mrpt::io::CFileGZOutputStream f;
-        if (!f.open((out / "final_map.simplemap").string()))
-            throw SlamError("cannot write " + (out / "final_map.simplemap").string());
-        mrpt::serialization::archiveFrom(f) << saved;
+            saved.changeCoordinatesOrigin(
+                mrpt::poses::CPose3D(res.map_origin.x, res.map_origin.y, 0.0, 0.0, 0.0, 0.0));
+        const std::string name = "final_map.simplemap";
+        GzOutputStream f(out.path() / name, out.finalName(name), 1);
+        f.write(saved);
+        f.close();
     }
     mrpt::maps::COccupancyGridMap2D grid(-10, 10, -10, 10, static_cast<float>(kMapResolution));
     const MapFrame frame = mapFrame(res, grid.insertionOptions.maxDistanceInsertion);
@@ -121,8 +122,11 @@ void writeMap(const IcpSlamResult& res, const fs::path& out) {
         local.changeCoordinatesOrigin(mrpt::poses::CPose3D(dx, dy, 0.0, 0.0, 0.0, 0.0));
     grid.setSize(-10, 10, -10, 10, static_cast<float>(frame.resolution));
     grid.loadFromSimpleMap(local);
-    if (!grid.saveAsBitmapFile((out / "map.png").string()))
-        throw SlamError("cannot write " + (out / "map.png").string());
+    {  // as COccupancyGridMap2D::saveAsBitmapFile
+        mrpt::img::CImage img;
+        grid.getAsImage(img);
+        writePng(img, out.path() / "map.png", out.finalName("map.png"));
+    }
     MapFigureInput fig;
     fig.grid = &grid;
     fig.estimate = inFrame(res.trajectory, frame);
@@ -133,8 +137,7 @@ void writeMap(const IcpSlamResult& res, const fs::path& out) {
     fig.title = fs::path(sum.rawlog).filename().string() + "  mode " + toString(sum.mode);
     if (frame.origin.x() != 0.0 || frame.origin.y() != 0.0)
         fig.title += format("  (origin at x %.0f, y %.0f m)", frame.origin.x(), frame.origin.y());
-    if (!renderMapFigure(fig).saveToFile((out / "map_figure.png").string()))
-        throw SlamError("cannot write " + (out / "map_figure.png").string());
+    writePng(renderMapFigure(fig), out.path() / "map_figure.png", out.finalName("map_figure.png"));
 }
 
 // A relations error's fields (used, unmatched, means and deviations) into `o`.
@@ -209,11 +212,11 @@ std::string toJson(const IcpSlamSummary& s) {
 void writeIcpSlamReport(const IcpSlamResult& result) {
     if (!result.output) throw SlamError("no staged output folder in the result");
     if (result.output->committed()) throw SlamError("the output was already committed");
-    const fs::path out = result.output->path();
+    const StagedOutputFolder& out = *result.output;
     if (result.map) writeMap(result, out);
     throwIfCancelled();
-    writeText(out / "summary.json", toJson(result.summary));
-    if (result.map) writeText(out / "report.md", reportMarkdown(result.summary));
+    writeText(out, "summary.json", toJson(result.summary));
+    if (result.map) writeText(out, "report.md", reportMarkdown(result.summary));
     throwIfCancelled();
     result.output->commit();
 }

@@ -1,16 +1,14 @@
 #include "kfd/sim/noisy_log.h"
 
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
-#include <mrpt/serialization/CArchive.h>
 
 #include <filesystem>
-#include <fstream>
 #include <random>
 #include <vector>
 
 #include "kfd/core/cancel.h"
 #include "kfd/core/output_paths.h"
+#include "kfd/mrpt/gz_output.h"
 #include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/source.h"
@@ -37,11 +35,9 @@ NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
     }
     const auto source = openSource(o.input);
     TempOutputFile tmp(sum.rawlog), tmp_labels(sum.labels);
-    mrpt::io::CFileGZOutputStream f;
-    if (!f.open(tmp.path().string(), 1)) throw SimulationError("cannot write " + o.output);
-    auto arch = mrpt::serialization::archiveFrom(f);
-    std::ofstream labels(tmp_labels.path());
-    if (!labels) throw SimulationError("cannot write " + sum.labels);
+    // Every byte through kfd's checked writers: a full disk is a WriteError naming the file.
+    GzOutputStream f(tmp.path(), sum.rawlog, 1);
+    OutputFile labels(tmp_labels.path(), sum.labels);
     labels << "scan,timestamp,beam,kind,model\n";
 
     std::mt19937 rng(o.seed);
@@ -64,8 +60,8 @@ NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
             if (kinds[i] == NoiseKind::Clean) continue;
             scan->setScanRange(i, core.range[i]);
             scan->setScanRangeValidity(i, true);
-            labels << k << ',' << t << ',' << i << ',' << toString(kinds[i]) << ','
-                   << toString(models[i]) << '\n';
+            labels << std::to_string(k) + ',' + t + ',' + std::to_string(i) + ',' +
+                          toString(kinds[i]) + ',' + toString(models[i]) + '\n';
             ++sum.by_kind[static_cast<std::size_t>(kinds[i])];
             ++sum.by_model[static_cast<std::size_t>(models[i])];
         }
@@ -78,17 +74,17 @@ NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
         e.forEachScan(inject);
         switch (e.kind) {
             case SourceEntry::Kind::Frame:
-                if (e.action) arch << *e.action;
-                arch << *e.frame;
+                if (e.action) f.write(*e.action);
+                f.write(*e.frame);
                 break;
             case SourceEntry::Kind::Action:
-                arch << *e.action;
+                f.write(*e.action);
                 break;
             case SourceEntry::Kind::Observation:
-                arch << *e.observation;
+                f.write(*e.observation);
                 break;
             case SourceEntry::Kind::Other:
-                arch << *e.other;
+                f.write(*e.other);
                 break;
             case SourceEntry::Kind::Native:  // another topic of a bag: not in a rawlog
                 break;
@@ -97,9 +93,8 @@ NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
             o.on_progress(static_cast<double>(source->bytesRead()) / total);
     }
     if (sum.scans == 0) throw SimulationError("no 2D scans in " + o.input);
-    f.close();
+    f.close();  // the trailer, fsync, checked
     labels.close();
-    if (!labels) throw SimulationError("failed writing " + sum.labels);
     throwIfCancelled();
     tmp.commit();
     tmp_labels.commit();

@@ -1,20 +1,18 @@
 #include "kfd/sim/simulator.h"
 
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/poses/CPose2D.h>
-#include <mrpt/serialization/CArchive.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <random>
 
 #include "kfd/core/cancel.h"
 #include "kfd/core/output_paths.h"
 #include "kfd/eval/trajectory.h"
+#include "kfd/mrpt/gz_output.h"
 #include "kfd/mrpt/scan_adapter.h"
 
 namespace kfd {
@@ -128,11 +126,9 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
     if (!out.parent_path().empty()) fs::create_directories(out.parent_path(), mk);
     TempOutputFile tmp(sum.rawlog), tmp_gt(sum.ground_truth), tmp_odo(sum.odometry),
         tmp_labels(sum.labels);
-    mrpt::io::CFileGZOutputStream f;
-    if (!f.open(tmp.path().string(), 1)) throw SimulationError("cannot write " + o.output);
-    auto arch = mrpt::serialization::archiveFrom(f);
-    std::ofstream labels(tmp_labels.path());
-    if (!labels) throw SimulationError("cannot write " + sum.labels);
+    // Every byte through kfd's checked writers: a full disk is a WriteError naming the file.
+    GzOutputStream f(tmp.path(), sum.rawlog, 1);
+    OutputFile labels(tmp_labels.path(), sum.labels);
     labels << "scan,timestamp,beam,kind\n";
 
     Trajectory gt_traj, odo_traj;
@@ -177,8 +173,8 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
             scan.setScanRange(i, core.range[i]);
             scan.setScanRangeValidity(i, core.valid[i] != 0);
             if (kinds[i] == NoiseKind::Clean) continue;
-            labels << k << ',' << std::to_string(t) << ',' << i << ',' << toString(kinds[i])
-                   << '\n';
+            labels << std::to_string(k) + ',' + std::to_string(t) + ',' + std::to_string(i) + ',' +
+                          toString(kinds[i]) + '\n';
             sum.noise_isolated += kinds[i] == NoiseKind::Isolated;
             sum.noise_clustered += kinds[i] == NoiseKind::Clustered;
             sum.noise_edge += kinds[i] == NoiseKind::Edge;
@@ -187,16 +183,16 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
         odom.sensorLabel = "ODOMETRY";
         odom.timestamp = stamp;
         odom.odometry = odo;
-        arch << scan << odom;
+        f.write(scan);
+        f.write(odom);
         gt_traj.push_back({t, gt[k]});
         odo_traj.push_back({t, Pose2D{odo.x(), odo.y(), odo.phi()}});
         if (o.on_progress && k % 200 == 0) o.on_progress(static_cast<double>(k) / gt.size());
     }
-    f.close();
+    f.close();  // the trailer, fsync, checked
     labels.close();
-    if (!labels) throw SimulationError("failed writing " + sum.labels);
-    writeTum(tmp_gt.path().string(), gt_traj);
-    writeTum(tmp_odo.path().string(), odo_traj);
+    writeTum(tmp_gt.path().string(), gt_traj, sum.ground_truth);
+    writeTum(tmp_odo.path().string(), odo_traj, sum.odometry);
     throwIfCancelled();
     tmp.commit();
     tmp_gt.commit();

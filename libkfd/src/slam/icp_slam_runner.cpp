@@ -258,8 +258,8 @@ class Run {
     StreamFilter* prefilter_ = nullptr;
     mrpt::slam::CMetricMapBuilderICP builder_;
     std::size_t rawlog_offset_ = 0;
-    std::ofstream f_path_;  // log_estimated_path.txt
-    ScanCsvWriter csv_;     // scans.csv
+    std::optional<OutputFile> f_path_;  // log_estimated_path.txt
+    ScanCsvWriter csv_;                 // scans.csv
     std::unique_ptr<Source> source_;
     double builder_s_ = 0.0;
     std::size_t step_no_ = 0;
@@ -383,14 +383,11 @@ void Run::initBuilder() {
 // result.output->commit()) moves it into place, and on failure it is removed.
 void Run::openOutputs() {
     res_.output = std::make_shared<StagedOutputFolder>(sum_.output_dir);
-    const fs::path out = res_.output->path();
-    f_path_.open(out / "log_estimated_path.txt");
-    if (!f_path_) throw SlamError("cannot write into " + sum_.output_dir);
-    try {
-        csv_.open((out / "scans.csv").string(), (fs::path(sum_.output_dir) / "scans.csv").string());
-    } catch (const ScanCsvError&) {
-        throw SlamError("cannot write into " + sum_.output_dir);
-    }
+    // Every file through kfd's checked writers: a failed write is a WriteError (ScanCsvError for
+    // scans.csv) naming the file's final name and the reason.
+    const StagedOutputFolder& out = *res_.output;
+    f_path_.emplace(out.path() / "log_estimated_path.txt", out.finalName("log_estimated_path.txt"));
+    csv_.open((out.path() / "scans.csv").string(), out.finalName("scans.csv"));
     source_ = openLog(sum_.rawlog, opts_.source);
 }
 
@@ -496,7 +493,7 @@ void Run::writeStep() {
     const auto local = builder_.getCurrentPoseEstimation()->getMeanVal();
     const mrpt::poses::CPose3D pose(local.x() + res_.map_origin.x, local.y() + res_.map_origin.y,
                                     local.z(), local.yaw(), local.pitch(), local.roll());
-    f_path_ << format("%i %f %f %f\n", static_cast<int>(step_no_), pose.x(), pose.y(), pose.yaw());
+    *f_path_ << format("%i %f %f %f\n", static_cast<int>(step_no_), pose.x(), pose.y(), pose.yaw());
     const Pose2D p{pose.x(), pose.y(), pose.yaw()};
     Trajectory& traj = res_.trajectory;
     for (const ScanRecord& s : step_scans_) {
@@ -510,15 +507,10 @@ void Run::writeStep() {
 }
 
 void Run::closeOutputs() {
-    f_path_.close();
-    bool failed = f_path_.fail();
-    try {
-        csv_.close();
-    } catch (const ScanCsvError&) {
-        failed = true;
-    }
-    if (failed) throw SlamError("cannot write into " + res_.output->path().string());
-    writeTum((res_.output->path() / "trajectory.tum").string(), res_.trajectory);
+    f_path_->close();
+    csv_.close();
+    writeTum((res_.output->path() / "trajectory.tum").string(), res_.trajectory,
+             res_.output->finalName("trajectory.tum"));
 }
 
 // The summary from the door's counters, the map, ATE and the relations error (local and long).

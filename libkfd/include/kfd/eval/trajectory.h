@@ -31,7 +31,10 @@ using Trajectory = std::vector<StampedPose>;
 /// from the quaternion (any non-zero norm). Throws EvalError naming the file and line on
 /// malformed input: missing, unparsable or non-finite numbers, a quaternion of norm 0.
 Trajectory readTum(const std::string& path);
-void writeTum(const std::string& path, const Trajectory& traj);
+/// Writes `traj` as TUM lines through kfd's checked OutputFile (kfd/core/output_paths.h):
+/// WriteError naming `name` (the file users know; `path` when empty) and the reason when any
+/// write, the fsync or the close fails.
+void writeTum(const std::string& path, const Trajectory& traj, const std::string& name = {});
 
 /// Reads the data lines of a text file (blank lines and '#' comments skipped) as `n` numbers
 /// each and calls `row(values)` for every one. `what` names the file kind in errors; a line with

@@ -25,11 +25,14 @@ struct BagWriterOptions {
     RemovedMark removed = RemovedMark::NaN;
 };
 
-/// Writes a bag (format 2.0) from messages of a BagSource's bag.
+/// Writes a bag (format 2.0) from messages of a BagSource's bag. Errors are BagErrors whose
+/// first words say what failed: "cannot write out.bag: No space left on device (rosbag: ...)".
 class BagWriter {
   public:
-    /// Opens `path` for writing; BagError when it cannot be created.
-    BagWriter(const std::string& path, const BagWriterOptions& options = {});
+    /// Opens `path` for writing; BagError when it cannot be created. `name` is the file users
+    /// know, for messages (the final name of a temporary file; `path` when empty).
+    BagWriter(const std::string& path, const BagWriterOptions& options = {},
+              const std::string& name = {});
     ~BagWriter();
     BagWriter(const BagWriter&) = delete;
     BagWriter& operator=(const BagWriter&) = delete;
@@ -42,7 +45,9 @@ class BagWriter {
     /// Returns the number of beams marked.
     std::size_t writeScan(const NativeMessage& original,
                           const mrpt::obs::CObservation2DRangeScan& cleaned);
-    /// Writes the index and closes the file; BagError on a write failure.
+    /// Writes the index and closes the file, then opens the bag again and checks that its
+    /// index holds every message written (rosbag ignores some write errors); BagError on any
+    /// failure.
     void close();
     std::size_t messagesWritten() const;
 

@@ -81,11 +81,14 @@ struct RawlogFilterSummary : ScanCounters {
 /// run goes on. Beams with a NaN, infinite, negative or huge range
 /// are marked invalid in the output (counted in beams_bad_range). The input is never modified;
 /// on any error no output file is left behind: the output and the stats CSV are written under
-/// temporary names beside them and renamed at the end. Before anything is written, an output or
-/// stats path that is (or aliases) the input or the other output is refused (a RawlogError
-/// from kfd::checkOutputPaths, kfd/core/output_paths.h). Stops with kfd::Cancelled after
-/// kfd::requestCancel() (kfd/core/cancel.h). Throws RawlogError, ConfigError, PathError (a
-/// temporary file that cannot be moved into place) or Cancelled.
+/// temporary names beside them through kfd's checked writers (GzOutputStream, BagWriter,
+/// ScanCsvWriter), both checked when complete (the gzip trailer and the bag index read back,
+/// sizes, fsync) and only then renamed. Before anything is written, an output or stats path
+/// that is (or aliases) the input or the other output, or that exists and is not a regular
+/// file, is refused (a RawlogError from kfd::checkOutputPaths, kfd/core/output_paths.h). A
+/// failed write is a RawlogError "cannot write OUT: No space left on device". Stops with
+/// kfd::Cancelled after kfd::requestCancel() (kfd/core/cancel.h). Throws RawlogError,
+/// ConfigError or Cancelled.
 class RawlogFilter {
   public:
     RawlogFilterSummary run(const RawlogFilterOptions& opts);

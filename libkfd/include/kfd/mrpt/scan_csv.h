@@ -1,16 +1,17 @@
 // The one per-scan CSV writer: kfd-filter's --stats file and kfd-icp-slam's scans.csv.
 #pragma once
 
-#include <fstream>
 #include <optional>
 #include <string>
 
 #include "kfd/core/error.h"
+#include "kfd/core/output_paths.h"
 #include "kfd/mrpt/scan_record.h"
 
 namespace kfd {
 
-/// A per-scan CSV that cannot be written (the message names the file).
+/// A per-scan CSV that cannot be written: the message names the file and the reason ("cannot
+/// write s.csv: No space left on device"), `field()` the file.
 class ScanCsvError : public Error {
   public:
     using Error::Error;
@@ -32,18 +33,19 @@ class ScanCsvError : public Error {
 /// "skipped:<why>", its points_in its beam count, its other numbers 0 and degeneracy 1.
 class ScanCsvWriter {
   public:
-    /// Opens `path` for writing and writes the header; `name` is the file users know (e.g. the
-    /// final name of a temporary file). ScanCsvError when it cannot be written.
+    /// Opens `path` for writing (kfd's checked OutputFile) and writes the header; `name` is the
+    /// file users know (e.g. the final name of a temporary file). ScanCsvError when it cannot
+    /// be written.
     void open(const std::string& path, const std::string& name);
-    bool isOpen() const { return out_.is_open(); }
-    /// One row; `pose` fills x, y, phi.
+    bool isOpen() const { return out_ && out_->isOpen(); }
+    /// One row; `pose` fills x, y, phi. ScanCsvError when the write fails.
     void write(const ScanRecord& r, const std::optional<Pose2D>& pose = std::nullopt);
-    /// Flushes and closes; ScanCsvError when anything failed to be written.
+    /// Flushes, fsyncs, checks and closes (OutputFile::close); ScanCsvError when anything
+    /// failed to be written.
     void close();
 
   private:
-    std::ofstream out_;
-    std::string name_;
+    std::optional<OutputFile> out_;
 };
 
 }  // namespace kfd

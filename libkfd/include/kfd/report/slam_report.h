@@ -18,8 +18,11 @@ std::string toJson(const IcpSlamSummary& s);
 /// map (IcpSlamOptions::write_map), final_map.simplemap, map.png (occupancy grid, 5 cm),
 /// map_figure.png (grid + estimate, keyframes, odometry and ground truth) and report.md.
 /// Writes into the result's staging folder, then moves everything into output_dir
-/// (IcpSlamResult::output->commit()). Throws SlamError when a file cannot be written, PathError
-/// when the folder cannot be moved into place, Cancelled after kfd::requestCancel().
+/// (IcpSlamResult::output->commit(), which checks every file first). Every file goes through
+/// kfd's checked writers (OutputFile, GzOutputStream, writePng): throws WriteError ("cannot write
+/// OUT/map.png: No space left on device", the file's final name) when a file cannot be written
+/// completely, PathError when the folder cannot be moved into place, Cancelled after
+/// kfd::requestCancel().
 void writeIcpSlamReport(const IcpSlamResult& result);
 
 }  // namespace kfd

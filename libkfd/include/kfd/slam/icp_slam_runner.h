@@ -151,7 +151,9 @@ class SlamOptionError : public SlamError {
 /// output folder, inside an existing one, whose other files are left alone), held by
 /// IcpSlamResult::output: trajectory.tum (one pose per input scan, TUM format),
 /// log_estimated_path.txt (icp-slam's "step x y phi", one per rawlog entry) and scans.csv (the
-/// door's per-scan records with the scan's pose, kfd/mrpt/scan_csv.h).
+/// door's per-scan records with the scan's pose, kfd/mrpt/scan_csv.h), through kfd's checked
+/// writers: a failed write is a WriteError (a ScanCsvError for scans.csv) naming the file's final
+/// name and the reason ("cannot write OUT/scans.csv: No space left on device").
 /// summary.json, final_map.simplemap, map.png, map_figure.png and report.md are written from
 /// the result by writeIcpSlamReport() (kfd/report/slam_report.h).
 class IcpSlamRunner {
