@@ -107,8 +107,9 @@ int Cli::usageError(const std::string& message) const {
 
 namespace {
 
-// SIGINT / SIGTERM: ask the running library loop to stop (it unwinds and its temporary outputs
-// are removed); SA_RESETHAND makes a second signal end the process at once.
+// SIGINT / SIGTERM / SIGHUP (the terminal closed, an ssh session dropped): ask the running
+// library loop to stop (it unwinds and its temporary outputs are removed); SA_RESETHAND makes a
+// second signal end the process at once.
 extern "C" void onSignal(int sig) { kfd::requestCancel(sig); }
 
 void installSignalHandlers() {
@@ -116,8 +117,12 @@ void installSignalHandlers() {
     sa.sa_handler = onSignal;
     sigemptyset(&sa.sa_mask);
     sa.sa_flags = SA_RESETHAND;
-    sigaction(SIGINT, &sa, nullptr);
-    sigaction(SIGTERM, &sa, nullptr);
+    for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
+        struct sigaction old {};
+        // A signal the caller ignores (nohup, `trap '' HUP`) stays ignored.
+        if (sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+        sigaction(sig, &sa, nullptr);
+    }
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
 // The command-line layer of kfd's apps, over CLI11: typed options whose errors name the flag and
 // the bad value, generated help, the exit-code contract (0 success, 1 bad input or
 // configuration, 2 bad usage, 128 + N when stopped by signal N), the shared progress printer and
-// the SIGINT/SIGTERM handling (a cancellation request the libraries' loops honour, so that no
-// temporary or partial output remains).
+// the SIGINT/SIGTERM/SIGHUP handling (a cancellation request the libraries' loops honour, so that
+// no temporary or partial output remains).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -152,10 +152,11 @@ class Cli {
     /// checked (like --version), e.g. `kfd-icp-slam --list-modes`.
     void addInfoFlag(const std::string& names, const std::string& help,
                      std::function<std::string()> text);
-    /// For apps that write files: while the body runs, SIGINT and SIGTERM call
+    /// For apps that write files: while the body runs, SIGINT, SIGTERM and SIGHUP call
     /// kfd::requestCancel() instead of killing the process, so that the library loops stop and
-    /// remove their temporary outputs (exit status 128 + N); a second signal kills at once.
-    /// Apps that write nothing keep the default (killed at once).
+    /// remove their temporary outputs (exit status 128 + N: 130, 143, 129); a second signal
+    /// kills at once. A signal ignored when the app starts (nohup) stays ignored. Apps that write
+    /// nothing keep the default (killed at once).
     void cancelOnSignal() { cancel_on_signal_ = true; }
     /// The progress printer, or null when -q was given.
     ProgressPrinter* progress();
@@ -163,8 +164,9 @@ class Cli {
     /// Parses argv, then runs `body`. Returns the exit status: 0 on success, help or version;
     /// 2 on bad usage from the parser or a UsageError ("NAME: message" and "Try 'NAME --help'."
     /// on stderr); 1 on any other exception ("NAME: what"), an output that aliases an input
-    /// included; 128 + N when signal N (SIGINT, SIGTERM) stopped the run (kfd::Cancelled).
-    /// With cancelOnSignal(), SIGINT and SIGTERM call kfd::requestCancel() while `body` runs.
+    /// included; 128 + N when signal N (SIGINT, SIGTERM, SIGHUP) stopped the run
+    /// (kfd::Cancelled). With cancelOnSignal(), those signals call kfd::requestCancel() while
+    /// `body` runs.
     int run(int argc, char** argv, const std::function<void()>& body);
 
   private:

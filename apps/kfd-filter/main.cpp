@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
                2, 3)
         ->option_text("V F [P_PAIR]");
     cli.addVersion(KFD_VERSION);
-    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM
+    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP
     return cli.run(argc, argv, [&] {
         if (list_keys) {
             for (const auto& k : kfd::configKeys())

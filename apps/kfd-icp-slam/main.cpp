@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
     bool no_map = false;
     cli.flag("--no-map", no_map, "skip final_map.simplemap and map.png");
     cli.addQuiet();
-    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM
+    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP
     return cli.run(argc, argv, [&] {
         if (!rawlog_arg.empty()) {
             if (!o.rawlog.empty()) throw kfd::app::UsageError("input log given twice");

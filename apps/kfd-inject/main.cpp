@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
         ->type_name("NAME");
     cli.option("--seed", o.seed, "random seed")->type_name("N")->capture_default_str();
     cli.addQuiet("no progress");
-    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM
+    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP
     return cli.run(argc, argv, [&] {
         if (auto* progress = cli.progress())
             o.on_progress = [progress](double f) { progress->update(f, 0, 0); };

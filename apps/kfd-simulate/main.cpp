@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     cli.option("--seed", o.seed, "random seed")->type_name("N")->capture_default_str();
     cli.addQuiet("no progress");
-    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM
+    cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP
     return cli.run(argc, argv, [&] {
         if (o.gridmap.empty() != o.route.empty())
             throw kfd::app::UsageError("--gridmap and --route go together");
