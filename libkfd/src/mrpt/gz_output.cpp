@@ -3,17 +3,25 @@
 #include <mrpt/serialization/CArchive.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <array>
-#include <optional>
+#include <cstring>
+#include <limits>
 
 namespace kfd {
 
+// zlib's gzwrite buffer size (GZBUFSIZE): the same sizes give deflate the same calls, and so the
+// same bytes as CFileGZOutputStream (gzopen/gzwrite/gzclose) at every level, stored blocks
+// included.
+constexpr unsigned kSize = 8192;
+
+// The gzip stream as zlib's gzwrite (gz_write) and gz_comp run it, writing into an OutputFile.
 struct GzOutputStream::Impl {
     OutputFile file;
     z_stream z{};
     bool deflating = false, finished = false;
-    std::string input;                         // uncompressed bytes not yet deflated
-    std::array<unsigned char, 1 << 16> out{};  // deflate's output
+    std::array<unsigned char, kSize> in{}, out{};
+    unsigned char* pending = nullptr;  // the start of the output not yet written
     std::uint64_t position = 0;
     std::exception_ptr error;  // the first write failure, rethrown by every later call
 
@@ -23,34 +31,72 @@ struct GzOutputStream::Impl {
         throw WriteError("cannot write " + file.name() + ": " + why, file.name());
     }
 
-    // Deflates `input` (all of it) with `flush` and writes what comes out.
-    void deflateInput(int flush) {
-        z.next_in = reinterpret_cast<Bytef*>(input.data());
-        z.avail_in = static_cast<uInt>(input.size());
-        int rc = Z_OK;
+    void writePending() {
+        if (z.next_out > pending)
+            file.write(pending, static_cast<std::size_t>(z.next_out - pending));
+        pending = z.next_out;
+    }
+
+    // gz_comp: deflate until it produces no more output; the buffer is written when full, or
+    // when flushing (Z_FINISH: once the stream ended).
+    void compress(int flush) {
+        int ret = Z_OK;
+        unsigned have = 0;
         do {
-            z.next_out = out.data();
-            z.avail_out = static_cast<uInt>(out.size());
-            rc = ::deflate(&z, flush);
-            if (rc == Z_STREAM_ERROR) fail("zlib error");
-            const std::size_t n = out.size() - z.avail_out;
-            if (n) file.write(out.data(), n);
-        } while (z.avail_out == 0 || (flush == Z_FINISH && rc != Z_STREAM_END));
-        input.clear();
+            if (z.avail_out == 0 ||
+                (flush != Z_NO_FLUSH && (flush != Z_FINISH || ret == Z_STREAM_END))) {
+                writePending();
+                if (z.avail_out == 0) {
+                    z.next_out = out.data();
+                    z.avail_out = kSize;
+                    pending = out.data();
+                }
+            }
+            have = z.avail_out;
+            ret = ::deflate(&z, flush);
+            if (ret == Z_STREAM_ERROR) fail("zlib error");
+            have -= z.avail_out;
+        } while (have);
+        if (flush == Z_FINISH) writePending();
+    }
+
+    // gz_write: small writes are gathered in `in` (compressed when more comes than fits), large
+    // ones compressed directly.
+    void write(const unsigned char* buf, std::size_t len) {
+        if (len < kSize) {
+            while (len) {
+                if (z.avail_in == 0) z.next_in = in.data();
+                const auto have = static_cast<std::size_t>(z.next_in + z.avail_in - in.data());
+                const std::size_t copy = std::min<std::size_t>(kSize - have, len);
+                std::memcpy(in.data() + have, buf, copy);
+                z.avail_in += static_cast<uInt>(copy);
+                buf += copy;
+                len -= copy;
+                if (len) compress(Z_NO_FLUSH);
+            }
+        } else {
+            if (z.avail_in) compress(Z_NO_FLUSH);
+            z.next_in = const_cast<unsigned char*>(buf);
+            while (len) {
+                const std::size_t n = std::min<std::size_t>(len, std::numeric_limits<uInt>::max());
+                z.avail_in = static_cast<uInt>(n);
+                compress(Z_NO_FLUSH);
+                len -= n;
+            }
+        }
     }
 };
 
-namespace {
-constexpr std::size_t kInputChunk = 1 << 16;
-}  // namespace
-
 GzOutputStream::GzOutputStream(const std::filesystem::path& path, std::string name, int level)
     : impl_(std::make_unique<Impl>(path, std::move(name))) {
+    Impl& d = *impl_;
     // As zlib's gzopen(path, "wbN"): gzip wrapping (15 + 16), memory level 8, default strategy.
-    if (deflateInit2(&impl_->z, level, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK)
-        impl_->fail("zlib cannot start (level " + std::to_string(level) + ")");
-    impl_->deflating = true;
-    impl_->input.reserve(kInputChunk);
+    if (deflateInit2(&d.z, level, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK)
+        d.fail("zlib cannot start (level " + std::to_string(level) + ")");
+    d.deflating = true;
+    d.z.next_out = d.out.data();
+    d.z.avail_out = kSize;
+    d.pending = d.out.data();
 }
 
 GzOutputStream::~GzOutputStream() {
@@ -64,8 +110,7 @@ size_t GzOutputStream::Write(const void* buffer, size_t count) {
     if (d.error) std::rethrow_exception(d.error);
     if (d.finished) d.fail("the gzip stream is already closed");
     try {
-        d.input.append(static_cast<const char*>(buffer), count);
-        if (d.input.size() >= kInputChunk) d.deflateInput(Z_NO_FLUSH);
+        d.write(static_cast<const unsigned char*>(buffer), count);
     } catch (const WriteError&) {
         d.error = std::current_exception();
         throw;
@@ -89,7 +134,7 @@ void GzOutputStream::close() {
     if (d.error) std::rethrow_exception(d.error);
     if (d.finished) return;
     try {
-        d.deflateInput(Z_FINISH);  // the rest and the trailer (CRC-32, length)
+        d.compress(Z_FINISH);  // the rest and the trailer (CRC-32, length)
         d.finished = true;
         deflateEnd(&d.z);
         d.deflating = false;
