@@ -4,13 +4,19 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/mount.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -61,6 +67,9 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, const 
             _exit(127);
         const struct rlimit limit { address_space, address_space };
         if (address_space != 0 && !kAsan && setrlimit(RLIMIT_AS, &limit) != 0) _exit(126);
+        // The apps leave a signal ignored at their start ignored (nohup): the rows that send
+        // signals need the default, whatever the test runner ignores.
+        for (const int sig : {SIGINT, SIGTERM, SIGHUP}) signal(sig, SIG_DFL);
         std::vector<char*> argv{const_cast<char*>(exe.c_str())};
         for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
         argv.push_back(nullptr);
@@ -383,6 +392,302 @@ TEST(BadInputOutputPaths, SigintDuringSimulateLeavesNoneOfItsFourOutputs) {
     EXPECT_TRUE(listing(d.path).empty());
 }
 
+// --- outputs that are not regular files, SIGHUP, a killed run's temporaries (issue 21) --------
+
+TEST(BadInputOutputPaths, DevicesFifosAndFoldersAreRefusedAsOutputs) {
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const auto csv = d.write("bars.csv", "group,series,value\na,x,1\n");
+    ASSERT_EQ(mkfifo((d / "fifo").c_str(), 0600), 0);
+    fs::create_symlink("/dev/null", d / "null.rawlog");  // never the real /dev/null itself
+    fs::create_directory(d / "sub");
+    // A fresh character device (1, 3: what /dev/null is) when this user may make one.
+    const bool chr = mknod((d / "chr").c_str(), S_IFCHR | 0600, makedev(1, 3)) == 0;
+    const auto before = listing(d.path);
+    const Snapshot snap({in, csv});
+    const std::string fifo = d / "fifo", null = d / "null.rawlog", sub = d / "sub";
+    auto refused = [&](const std::string& exe, const std::vector<std::string>& args,
+                       const std::string& first) {
+        const Result r = run(exe, args, d.path);
+        EXPECT_EQ(r.status, 1) << r.err;
+        EXPECT_EQ(r.first(), first);
+    };
+    const std::string tail = ", not a regular file: refusing to replace it";
+    refused(KFD_FILTER_EXE, {"-q", "-i", in, "-o", fifo},
+            "kfd-filter: the output " + fifo + " is a FIFO" + tail);
+    refused(KFD_FILTER_EXE, {"-q", "-i", in, "-o", null},
+            "kfd-filter: the output " + null + " is a character device" + tail);
+    refused(KFD_FILTER_EXE, {"-q", "-i", in, "-o", d / "out.rawlog", "--stats", fifo},
+            "kfd-filter: the stats file " + fifo + " is a FIFO" + tail);
+    refused(KFD_FILTER_EXE, {"-q", "-i", in, "-o", sub},
+            "kfd-filter: the output " + sub + " is a folder" + tail);
+    if (chr)
+        refused(KFD_FILTER_EXE, {"-q", "-i", in, "-o", d / "chr"},
+                "kfd-filter: the output " + (d / "chr") + " is a character device" + tail);
+    refused(KFD_SIMULATE_EXE, {"-q", "-o", fifo, "-d", "1"},
+            "kfd-simulate: the output rawlog " + fifo + " is a FIFO" + tail);
+    refused(KFD_INJECT_EXE, {"-q", "-i", in, "-o", null},
+            "kfd-inject: the output rawlog " + null + " is a character device" + tail);
+    refused(KFD_CHART_EXE, {csv, "-o", fifo},
+            "kfd-chart: the output image " + fifo + " is a FIFO" + tail);
+    refused(KFD_ICP_SLAM_EXE, {"-q", kSlamIni, in, "-o", fifo},
+            "kfd-icp-slam: the output folder " + fifo + " is not a folder");
+#ifdef KFD_RENDER_EXE
+    refused(KFD_RENDER_EXE, {"-i", in, "--index", "3", "-o", null},
+            "kfd-render: the output image " + null + " is a character device" + tail);
+#endif
+    // Nothing written, nothing replaced: the FIFO, the link and the device are what they were.
+    EXPECT_EQ(listing(d.path), before);
+    EXPECT_TRUE(fs::is_fifo(fs::symlink_status(d / "fifo")));
+    EXPECT_TRUE(fs::is_symlink(d / "null.rawlog"));
+    EXPECT_EQ(fs::read_symlink(d / "null.rawlog"), "/dev/null");
+    if (chr) {
+        EXPECT_TRUE(fs::is_character_file(fs::symlink_status(d / "chr")));
+    }
+    EXPECT_TRUE(fs::is_character_file("/dev/null"));
+    snap.expectUnchanged();
+}
+
+TEST(BadInputOutputPaths, SighupDuringSimulateLeavesNothing) {
+    Dir d;
+    const pid_t pid = spawn(KFD_SIMULATE_EXE, {"-o", d / "sim.rawlog", "-d", "600"}, d.path);
+    ASSERT_TRUE(waitForTemporary(pid, d.path)) << "the run ended before it could be interrupted";
+    kill(pid, SIGHUP);
+    const Result r = finish(pid, d.path);
+    EXPECT_EQ(r.status, 128 + SIGHUP) << r.err;
+    EXPECT_NE(r.err.find("kfd-simulate: interrupted by signal 1; no output written"),
+              std::string::npos)
+        << r.err;
+    EXPECT_TRUE(listing(d.path).empty());
+}
+
+// The temporaries (".NAME.kfd-tmp-N.EXT") in `dir`.
+std::set<std::string> temporaries(const fs::path& dir) {
+    std::set<std::string> t;
+    for (const auto& n : listing(dir))
+        if (n.find("kfd-tmp-") != std::string::npos) t.insert(n);
+    return t;
+}
+
+// Polls until `n` temporaries are in `dir` (or the process ended).
+bool waitForTemporaries(pid_t pid, const fs::path& dir, std::size_t n) {
+    for (int i = 0; i < 3000; ++i) {
+        if (temporaries(dir).size() >= n) return true;
+        int ws = 0;
+        if (waitpid(pid, &ws, WNOHANG) == pid) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return false;
+}
+
+TEST(BadInputOutputPaths, TemporariesOfAKilledRunAreRemovedByTheNextRun) {
+    Dir d;
+    const std::set<std::string> outputs{"sim.rawlog", "sim.gt.tum", "sim.odom.tum",
+                                        "sim.labels.csv"};
+    // SIGKILL cannot be caught: the four temporaries remain.
+    pid_t pid = spawn(KFD_SIMULATE_EXE, {"-q", "-o", d / "sim.rawlog", "-d", "600"}, d.path);
+    ASSERT_TRUE(waitForTemporaries(pid, d.path, 4)) << "the run ended too early";
+    kill(pid, SIGKILL);
+    Result r = finish(pid, d.path);
+    EXPECT_EQ(r.status, 128 + SIGKILL);
+    EXPECT_EQ(temporaries(d.path).size(), 4u);
+    // The next run on the same output removes them (no live process holds them).
+    r = run(KFD_SIMULATE_EXE, {"-q", "-o", d / "sim.rawlog", "-d", "1"}, d.path);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(listing(d.path), outputs);
+    // A live run's temporaries are left alone by another run on the same output.
+    pid = spawn(KFD_SIMULATE_EXE, {"-q", "-o", d / "sim.rawlog", "-d", "600"}, d.path);
+    ASSERT_TRUE(waitForTemporaries(pid, d.path, 4)) << "the run ended too early";
+    const auto live = temporaries(d.path);
+    r = run(KFD_SIMULATE_EXE, {"-q", "-o", d / "sim.rawlog", "-d", "1"}, d.path);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(temporaries(d.path), live);
+    kill(pid, SIGINT);
+    r = finish(pid, d.path);
+    EXPECT_EQ(r.status, 130) << r.err;
+    EXPECT_EQ(listing(d.path), outputs);
+}
+
+// --- a full file system (issue 21) -----------------------------------------------------------
+
+std::string writeBag(const Dir& d, const std::string& name, int scans = 40);  // below
+
+// The size of the tmpfs the full-disk rows write into: every output below is larger (each row
+// proves it with the same run into a roomy folder first).
+constexpr std::uintmax_t kTmpfsBytes = 32 * 1024;
+
+// A tmpfs of `bytes` (kTmpfsBytes) mounted on `dir` (created) while the row runs. Mounting
+// needs root (CAP_SYS_ADMIN); without it `mounted` is false and `why` says why.
+struct SmallTmpfs {
+    fs::path dir;
+    bool mounted = false;
+    std::string why;
+    explicit SmallTmpfs(fs::path at, std::uintmax_t bytes = kTmpfsBytes) : dir(std::move(at)) {
+        fs::create_directories(dir);
+        const std::string options = "size=" + std::to_string(bytes);
+        if (mount("tmpfs", dir.c_str(), "tmpfs", MS_NOSUID | MS_NODEV, options.c_str()) == 0)
+            mounted = true;
+        else
+            why = std::strerror(errno);
+    }
+    ~SmallTmpfs() {
+        if (mounted) umount2(dir.c_str(), MNT_DETACH);
+    }
+    SmallTmpfs(const SmallTmpfs&) = delete;
+    SmallTmpfs& operator=(const SmallTmpfs&) = delete;
+};
+
+#define KFD_REQUIRE_TMPFS(t)                                                       \
+    if (!(t).mounted)                                                              \
+    GTEST_SKIP() << "cannot mount a small tmpfs on " << (t).dir << " (" << (t).why \
+                 << "): the full-disk rows need root (CAP_SYS_ADMIN)"
+
+// The bytes of the regular files under `dir`.
+std::uintmax_t bytesUnder(const fs::path& dir) {
+    std::uintmax_t n = 0;
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+        if (e.is_regular_file()) n += e.file_size();
+    return n;
+}
+
+// One full-disk row: `args(folder)` writes the app's outputs into `folder`. The same run into a
+// roomy folder succeeds and writes more than the tmpfs holds; into the full tmpfs it exits 1, its
+// first line is "APP: cannot write FULL/FILE...: No space left on device" (FILE starting with
+// `file`), libpng prints nothing, and nothing is left on the tmpfs (nor, with `also_empty`,
+// there). The inputs are unchanged.
+void expectFullDiskRow(const Dir& d, const SmallTmpfs& t, const std::string& exe,
+                       const std::string& app,
+                       const std::function<std::vector<std::string>(const fs::path&)>& args,
+                       const std::string& file, const std::vector<std::string>& inputs) {
+    SCOPED_TRACE(app + " " + file);
+    const Snapshot snap(inputs);
+    const fs::path roomy = d.path / "roomy";
+    fs::create_directories(roomy);
+    Result r = run(exe, args(roomy), d.path);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_GT(bytesUnder(roomy), kTmpfsBytes) << "the outputs would fit: the row fills nothing";
+    fs::remove_all(roomy);
+    r = run(exe, args(t.dir), d.path);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(r.first().rfind(app + ": cannot write " + (t.dir / file).string(), 0), 0u) << r.err;
+    EXPECT_NE(r.first().find(": No space left on device"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("libpng"), std::string::npos) << r.err;
+    EXPECT_TRUE(listing(t.dir).empty());
+    snap.expectUnchanged();
+}
+
+TEST(BadInputFullDisk, FilterRawlogAndStatsFile) {
+    Dir d;
+    SmallTmpfs t(d.path / "full");
+    KFD_REQUIRE_TMPFS(t);
+    const auto in = d.copy(kOffice, "in.rawlog");
+    // The output, uncompressed (--compress 0): 336 kB.
+    expectFullDiskRow(d, t, KFD_FILTER_EXE, "kfd-filter",
+                      [&](const fs::path& o) {
+                          return std::vector<std::string>{
+                              "-q", "-i", in, "-o", o / "out.rawlog", "--compress", "0"};
+                      },
+                      "out.rawlog: ", {in});
+    // The stats file (80 kB) on the full tmpfs, the output elsewhere: neither is left.
+    const Snapshot snap({in});
+    const Result r =
+        run(KFD_FILTER_EXE, {"-q", "-i", in, "-o", d / "out.rawlog", "--stats", t.dir / "s.csv"},
+            d.path);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(r.first(), "kfd-filter: cannot write " + (t.dir / "s.csv").string() +
+                             ": No space left on device");
+    EXPECT_TRUE(listing(t.dir).empty());
+    EXPECT_EQ(listing(d.path), (std::set<std::string>{"in.rawlog", "full"}));
+    snap.expectUnchanged();
+}
+
+TEST(BadInputFullDisk, FilterWhoseLastBytesDoNotFit) {
+    // The issue's case: everything fits but the end of the gzip stream, written when the output
+    // is closed (CFileGZOutputStream ignored that error: exit 0, a cut-short gzip in place).
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const Snapshot snap({in});
+    fs::create_directory(d / "roomy");
+    Result r = run(KFD_FILTER_EXE, {"-q", "-i", in, "-o", d / "roomy/out.rawlog"}, d.path);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::uintmax_t size = fs::file_size(d / "roomy/out.rawlog");
+    fs::remove_all(d / "roomy");
+    ASSERT_GT(size, 2 * 65536u);  // several full buffers go out before the last one
+    SmallTmpfs t(d.path / "full", (size - 1) / 4096 * 4096);  // whole pages, one byte short
+    KFD_REQUIRE_TMPFS(t);
+    r = run(KFD_FILTER_EXE, {"-q", "-i", in, "-o", t.dir / "out.rawlog"}, d.path);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(r.first(), "kfd-filter: cannot write " + (t.dir / "out.rawlog").string() +
+                             ": No space left on device");
+    EXPECT_TRUE(listing(t.dir).empty());
+    snap.expectUnchanged();
+}
+
+TEST(BadInputFullDisk, FilterBagOutput) {
+    Dir d;
+    SmallTmpfs t(d.path / "full");
+    KFD_REQUIRE_TMPFS(t);
+    const auto in = writeBag(d, "in.bag", 400);
+    expectFullDiskRow(d, t, KFD_FILTER_EXE, "kfd-filter",
+                      [&](const fs::path& o) {
+                          return std::vector<std::string>{
+                              "-q", "-i", in, "-o", o / "out.bag", "--bag-compression", "none"};
+                      },
+                      "out.bag: ", {in});
+}
+
+TEST(BadInputFullDisk, IcpSlamOutputFolder) {
+    Dir d;
+    SmallTmpfs t(d.path / "full");
+    KFD_REQUIRE_TMPFS(t);
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const auto cfg = d.copy(kSlamIni, "slam.ini");
+    expectFullDiskRow(d, t, KFD_ICP_SLAM_EXE, "kfd-icp-slam",
+                      [&](const fs::path& o) {
+                          return std::vector<std::string>{"-q", cfg, in, "-o", o / "slam"};
+                      },
+                      "slam/", {in, cfg});
+}
+
+TEST(BadInputFullDisk, SimulateAndInject) {
+    Dir d;
+    SmallTmpfs t(d.path / "full");
+    KFD_REQUIRE_TMPFS(t);
+    expectFullDiskRow(d, t, KFD_SIMULATE_EXE, "kfd-simulate",
+                      [&](const fs::path& o) {
+                          return std::vector<std::string>{"-q", "-o", o / "sim.rawlog", "-d", "5"};
+                      },
+                      "sim.", {});
+    const auto in = d.copy(kOffice, "in.rawlog");
+    expectFullDiskRow(d, t, KFD_INJECT_EXE, "kfd-inject",
+                      [&](const fs::path& o) {
+                          return std::vector<std::string>{"-q", "-i", in, "-o", o / "noisy.rawlog"};
+                      },
+                      "noisy.", {in});
+}
+
+TEST(BadInputFullDisk, ChartAndRenderImages) {
+    Dir d;
+    SmallTmpfs t(d.path / "full");
+    KFD_REQUIRE_TMPFS(t);
+    const auto csv = d.write("bars.csv", "group,series,value\na,x,1\na,y,2\nb,x,3\n");
+    expectFullDiskRow(d, t, KFD_CHART_EXE, "kfd-chart",
+                      [&](const fs::path& o) {
+                          return std::vector<std::string>{csv,      "-o",   o / "bars.png",
+                                                          "--size", "3000", "2000"};
+                      },
+                      "bars.png: ", {csv});
+#ifdef KFD_RENDER_EXE
+    const auto in = d.copy(kOffice, "in.rawlog");
+    expectFullDiskRow(d, t, KFD_RENDER_EXE, "kfd-render",
+                      [&](const fs::path& o) {
+                          return std::vector<std::string>{"-i",  in,   "--index",
+                                                          "300", "-o", o / "scan.png"};
+                      },
+                      "scan.png: ", {in});
+#endif
+}
+
 // --- truncated input -------------------------------------------------------------------------
 
 // kfd-filter on a damaged copy of a gzip rawlog: exit 1, the reason, nothing written.
@@ -549,11 +854,11 @@ TEST(BadInputConfiguration, DuplicateKeysEmptyPipelinesAndHangingYamlAreErrors) 
 
 // --- ROS bags and CARMEN logs (issue 13) ----------------------------------------------------
 
-// A small bag: 40 scans of a 6 m x 4 m room with odometry, uncompressed.
-std::string writeBag(const Dir& d, const std::string& name) {
+// A small bag: `scans` scans (40) of a 6 m x 4 m room with odometry, uncompressed.
+std::string writeBag(const Dir& d, const std::string& name, int scans) {
     const std::string p = d / name;
     kfd::test::BagBuilder b(p);
-    for (int i = 0; i < 40; ++i) {
+    for (int i = 0; i < scans; ++i) {
         b.odom("/odom", 1 + 0.2 * i, 0.05 * i, 0, 0);
         std::vector<float> r(181);
         for (std::size_t k = 0; k < r.size(); ++k) r[k] = 2.0f + 0.01f * static_cast<float>(k % 7);
