@@ -139,7 +139,7 @@ void Run::noteSensor(const CObservation2DRangeScan& scan, const StreamResult& r)
 bool Run::handleScan(CObservation2DRangeScan& scan) {
     const StreamResult r = filter_.process(scan, odometry_);
     if (r.skipped == ScanSkipReason::None) noteSensor(scan, r);
-    if (csv_.isOpen()) csv_.write(r.record);
+    if (csv_.isOpen()) asRawlogError([&] { csv_.write(r.record); });
     return r.keep;
 }
 

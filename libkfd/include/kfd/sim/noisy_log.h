@@ -29,8 +29,10 @@ struct NoisyLogSummary {
 /// Copies every object of `input` in order, adding labelled outliers to each 2D scan, and
 /// writes the labels ("scan,timestamp,beam,kind,model": the scan's index among the log's 2D
 /// scans, as kfd-denoise-eval counts them). Scans that fail kfd::checkScan are copied
-/// unchanged. Outputs are checked against the input first and written under temporary names
-/// (renamed when complete). SimulationError (or a SourceError) on bad input.
+/// unchanged. Outputs are checked against the input first (PathError) and written under
+/// temporary names through kfd's checked writers, renamed when both are complete and checked.
+/// SimulationError (or a SourceError) on bad input; WriteError ("cannot write noisy.rawlog: No
+/// space left on device") when an output cannot be written.
 NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o);
 
 }  // namespace kfd

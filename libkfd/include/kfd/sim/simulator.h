@@ -52,7 +52,9 @@ struct SimulationSummary {
 /// odometry. Writes an observations-only rawlog (one CObservation2DRangeScan "LASER" and one
 /// CObservationOdometry per scan), the ground truth and the odometry as TUM, and a label CSV
 /// ("scan,timestamp,beam,kind" for every outlier beam; all other beams are clean). The same
-/// options and seed give byte-identical files.
+/// options and seed give byte-identical files. The four outputs are written under temporary
+/// names through kfd's checked writers and renamed when all four are complete and checked: a
+/// WriteError ("cannot write sim.rawlog: No space left on device") leaves none of them.
 class Simulator {
   public:
     SimulationSummary run(const SimulationOptions& opts);
