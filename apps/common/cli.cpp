@@ -164,7 +164,8 @@ int Cli::run(int argc, char** argv, const std::function<void()>& body) {
         return usageError(e.what());
     } catch (const std::exception& e) {  // kfd::Error and anything else the libraries throw
         if (progress_) progress_->abort();
-        std::fprintf(stderr, "%s: %s\n", name_.c_str(), e.what());
+        // An MRPT exception that got this far: its message, not its banner and call stack.
+        std::fprintf(stderr, "%s: %s\n", name_.c_str(), kfd::plainMessage(e.what()).c_str());
         return 1;
     }
 }

@@ -163,7 +163,8 @@ class Cli {
 
     /// Parses argv, then runs `body`. Returns the exit status: 0 on success, help or version;
     /// 2 on bad usage from the parser or a UsageError ("NAME: message" and "Try 'NAME --help'."
-    /// on stderr); 1 on any other exception ("NAME: what"), an output that aliases an input
+    /// on stderr); 1 on any other exception ("NAME: what", an MRPT exception's banner and call
+    /// stack reduced to its message by kfd::plainMessage), an output that aliases an input
     /// included; 128 + N when signal N (SIGINT, SIGTERM, SIGHUP) stopped the run
     /// (kfd::Cancelled). With cancelOnSignal(), those signals call kfd::requestCancel() while
     /// `body` runs.

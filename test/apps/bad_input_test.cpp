@@ -1071,4 +1071,26 @@ TEST(BadInputCorruptLength, CarmenReadingCountIsAnErrorNotGigabytes) {
         "out.rawlog");
 }
 
+
+// --- an MRPT exception (issue 21, item 4) ---------------------------------------------------
+
+TEST(BadInputIssue21, AnMrptExceptionSaysWhatIsWrongOnItsFirstLine) {
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    std::string ini = fileBytes(kSlamIni);
+    const auto at = ini.find("ICP_algorithm = icpClassic");
+    ASSERT_NE(at, std::string::npos);
+    ini.replace(at, 26, "ICP_algorithm = icpFancy");
+    const auto cfg = d.write("slam.ini", ini);
+    const Snapshot snap({in, cfg});
+    const Result r = run(KFD_ICP_SLAM_EXE, {"-q", cfg, in, "-o", d / "out"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-icp-slam: the configuration " + cfg +
+                             " ([MappingApplication], [ICP]): Invalid value 'icpFancy' for enum "
+                             "type while reading key='ICP_algorithm'.");
+    EXPECT_EQ(r.err.find("MRPT exception"), std::string::npos) << r.err;  // no banner, no stack
+    EXPECT_EQ(listing(d.path), (std::set<std::string>{"in.rawlog", "slam.ini"}));
+    snap.expectUnchanged();
+}
+
 }  // namespace

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -125,6 +126,23 @@ TEST(Cli, ExitCodesFollowTheContract) {
                       cli, {"app"}, [] { throw kfd::Error("cannot open x", "x"); }, &err),
                   1);
         EXPECT_EQ(err, "app: cannot open x\n");  // bad input: no usage hint
+    }
+    {
+        // An MRPT exception's banner and call stack (nested, as MRPT_END rethrows): the first
+        // line says what is wrong, the banner and the stack are left out.
+        kfd::app::Cli cli("app", "[-n N]", "about");
+        make(cli);
+        const std::string banner =
+            "==== MRPT exception ====\nMessage:  outer\nLocation: a.cpp:1: [f\nCall stack "
+            "backtrace:\n[0 ] x\n==== MRPT exception ====\nMessage:  ASSERT_EQUAL_(a,b) "
+            "failed with\na=1\nb=2\n\nLocation: b.cpp:2: [g\nCall stack backtrace:\n[0 ] y\n";
+        EXPECT_EQ(runCli(
+                      cli, {"app"}, [&] { throw std::logic_error(banner); }, &err),
+                  1);
+        EXPECT_EQ(err, "app: ASSERT_EQUAL_(a,b) failed with; a=1; b=2\n");
+        EXPECT_EQ(kfd::plainMessage("cannot read [KFD]: " + banner),
+                  "cannot read [KFD]: ASSERT_EQUAL_(a,b) failed with; a=1; b=2");
+        EXPECT_EQ(kfd::plainMessage("two\nlines"), "two\nlines");  // not MRPT's: as it is
     }
     {
         kfd::app::Cli cli("app", "[-n N]", "about");

@@ -77,12 +77,10 @@ std::optional<std::string> iniTextOf(const mrpt::config::CConfigFileBase& cfg) {
     return std::nullopt;
 }
 
-// MRPT nests exception texts ("==== MRPT exception ==== ... Message: ..."): the innermost
-// message line says what failed.
+// MRPT's exception banner as its message (kfd::plainMessage), on one line.
 std::string mrptMessage(const std::string& what) {
-    const auto pos = what.rfind("Message:");
-    if (pos == std::string::npos) return what.substr(0, what.find('\n'));
-    return trim(what.substr(pos + 8, what.find('\n', pos) - pos - 8));
+    const std::string m = plainMessage(what);
+    return m.substr(0, m.find('\n'));
 }
 
 }  // namespace

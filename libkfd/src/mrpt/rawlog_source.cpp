@@ -16,14 +16,10 @@ namespace {
 namespace fs = std::filesystem;
 using detail::GzReader;
 
-// MRPT nests exception texts ("==== MRPT exception ==== Message: ..."); keep the innermost
-// message line, which says what actually failed.
+// MRPT's exception banner as its message (kfd::plainMessage), on one line.
 std::string lastMessage(const std::string& what) {
-    const auto pos = what.rfind("Message:");
-    if (pos == std::string::npos) return what.substr(0, what.find('\n'));
-    std::string line = what.substr(pos + 8, what.find('\n', pos) - pos - 8);
-    const auto b = line.find_first_not_of(' ');
-    return b == std::string::npos ? line : line.substr(b);
+    const std::string m = plainMessage(what);
+    return m.substr(0, m.find('\n'));
 }
 
 }  // namespace

@@ -92,6 +92,21 @@ bool nextEntry(Source& source, SourceEntry& e) {
     }
 }
 
+// Runs fn, a call into MRPT; what MRPT throws becomes a SlamError that says what kfd was doing
+// (doing(), called only then), then MRPT's message (kfd::plainMessage: no banner, no stack).
+template <class Fn, class Doing>
+void callMrpt(Fn&& fn, Doing&& doing, const std::string& field) {
+    try {
+        fn();
+    } catch (const Error&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw SlamError(doing() + ": " + plainMessage(e.what()), field);
+    }
+}
+
 void checkReadable(const std::string& role, const std::string& path) {
     if (path.empty()) return;
     std::error_code ec;
@@ -369,12 +384,17 @@ void Run::readGroundTruth() {
 
 // The map builder, configured exactly as icp-slam does.
 void Run::initBuilder() {
-    builder_.setVerbosityLevel(mrpt::system::LVL_ERROR);
-    builder_.ICP_options.loadFromConfigFile(*cfg_, kSect);
-    builder_.ICP_params.loadFromConfigFile(*cfg_, "ICP");
-    builder_.initialize();
-    builder_.options.alwaysInsertByClass.fromString(
-        cfg_->read_string(kSect, "alwaysInsertByClass", ""));
+    callMrpt(
+        [&] {
+            builder_.setVerbosityLevel(mrpt::system::LVL_ERROR);
+            builder_.ICP_options.loadFromConfigFile(*cfg_, kSect);
+            builder_.ICP_params.loadFromConfigFile(*cfg_, "ICP");
+            builder_.initialize();
+            builder_.options.alwaysInsertByClass.fromString(
+                cfg_->read_string(kSect, "alwaysInsertByClass", ""));
+        },
+        [&] { return "the configuration " + opts_.config_file + " ([" + kSect + "], [ICP])"; },
+        opts_.config_file);
     rawlog_offset_ =
         static_cast<std::size_t>(std::max(0, cfg_->read_int(kSect, "rawlog_offset", 0)));
 }
@@ -422,9 +442,24 @@ void Run::loop() {
 // odometry to the map builder.
 void Run::step(IcpSlamStep& st, const SourceEntry& e) {
     step_scans_.clear();
+    // The map builder's time; what it throws names the step, its last scan's stamp and the log.
     auto timed = [&](auto&& process) {
         const auto t0 = std::chrono::steady_clock::now();
-        process();
+        callMrpt(
+            process,
+            [&] {
+                char where[96];
+                std::snprintf(where, sizeof(where), "MRPT's ICP map builder failed at step %zu",
+                              step_no_);
+                std::string doing = where;
+                if (!step_scans_.empty()) {
+                    std::snprintf(where, sizeof(where), " (scan at t = %.6f s)",
+                                  step_scans_.back().stamp);
+                    doing += where;
+                }
+                return doing + " of " + sum_.rawlog;
+            },
+            sum_.rawlog);
         builder_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     };
     if (st.observation) {

@@ -33,6 +33,13 @@ class ParameterError : public Error {
         : Error(field + ": " + message, field, message) {}
 };
 
+/// An exception's message as one line of words. MRPT's exceptions carry a banner
+/// ("==== MRPT exception ====", "Message: ...", "Location: file:line", a call stack; nested ones
+/// repeat it): the text before the banner is kept and the banner becomes its innermost message,
+/// its lines joined with "; " ("cannot read [KFD]: ==== MRPT exception ====\nMessage:  X\n..."
+/// -> "cannot read [KFD]: X"). Any other text is returned as it is.
+std::string plainMessage(const std::string& what);
+
 /// A scan the library cannot process as given (no beams, buffers of different sizes).
 class ScanError : public Error {
   public:
