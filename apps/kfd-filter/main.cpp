@@ -70,6 +70,26 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
             s.beams_bad_range, s.odometry_bad, s.stamps_backwards);
     if (s.geometry_resets)
         std::printf("  resets   %zu (scan geometry changed)\n", s.geometry_resets);
+    const kfd::SourceCounters& src = s.source;  // what the bag or CARMEN source repaired
+    if (src.lines_unparsable)
+        std::printf(
+            "  unparsed %zu lines that are not CARMEN text skipped (%llu bytes, the first "
+            "at line %zu)\n",
+            src.lines_unparsable, static_cast<unsigned long long>(src.bytes_unparsable),
+            src.first_unparsable_line);
+    if (src.scans_bad_angles)
+        std::printf(
+            "  angles   %zu LaserScans whose angle fields do not match their beam count "
+            "(skipped: bad_aperture)\n",
+            src.scans_bad_angles);
+    if (src.stamps_zero)
+        std::printf("  stamps   %zu messages stamped 0 (unset): their bag time used\n",
+                    src.stamps_zero);
+    if (src.scans_without_odometry)
+        std::printf(
+            "  odometry %zu scans more than 1 s outside the odometry's time span: no "
+            "odometry for them\n",
+            src.scans_without_odometry);
     std::printf("  time     wall %.2f s, filter %.3f s (%.1f us per scan)\n", s.wall_seconds,
                 s.filter_seconds, s.scans_in ? 1e6 * s.filter_seconds / s.scans_in : 0.0);
 }

@@ -12,6 +12,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -25,6 +26,7 @@
 
 #include <mrpt/io/CFileGZInputStream.h>
 
+#include "bad_logs.h"
 #include "test_bags.h"
 #include "test_files.h"
 
@@ -981,6 +983,47 @@ std::string writeBagWith(const Dir& d, const std::string& name, int k,
         else
             b.scan("/scan", kfd::test::BagBuilder::scanMsg(1 + 0.2 * i + 0.1,
                                                            std::vector<float>(181, 2.0f)));
+
+// --- every bad input a clear error or a counted repair (issue 21, item 4) ---------------------
+
+// kfd-filter and kfd-icp-slam on a log they repair: exit 0, the repair counted in kfd-filter's
+// summary (`line`) and in summary.json (`json`), the input unchanged. Returns kfd-filter's stdout.
+std::string expectLogRepaired(const Dir& d, const std::string& in, const std::string& line,
+                              const std::string& json, const std::string& out = "out.bag") {
+    SCOPED_TRACE(in + " " + line);
+    const Snapshot snap({in});
+    const Result r = run(KFD_FILTER_EXE, {"-q", "-i", in, "-o", d / out}, d.path);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    if (!line.empty()) {
+        EXPECT_NE(r.out.find("\n" + line + "\n"), std::string::npos) << r.out;
+    }
+    EXPECT_TRUE(fs::exists(d / out));
+    const Result s =
+        run(KFD_ICP_SLAM_EXE, {kSlamIni, in, "-o", d / "slam", "-q", "--no-map"}, d.path);
+    EXPECT_EQ(s.status, 0) << s.err;
+    const std::string summary = fileBytes(d / "slam/summary.json");
+    EXPECT_NE(summary.find(json), std::string::npos) << summary;
+    fs::remove(d / out);
+    fs::remove_all(d / "slam");
+    snap.expectUnchanged();
+    return r.out;
+}
+
+// 40 scans of writeBag's room; `tweak(k, scan)` changes scan k, `bag_time(k)` its record time
+// (its stamp when negative); odometry at `odom_t0 + 0.2 k`.
+std::string writeBagWith(const Dir& d, const std::string& name,
+                         const std::function<void(int, sensor_msgs::LaserScan&)>& tweak,
+                         double odom_t0 = 1.0) {
+    const std::string p = d / name;
+    kfd::test::BagBuilder b(p);
+    for (int i = 0; i < 40; ++i) {
+        b.odom("/odom", odom_t0 + 0.2 * i, 0.05 * i, 0, 0);
+        std::vector<float> r(181);
+        for (std::size_t k = 0; k < r.size(); ++k) r[k] = 2.0f + 0.01f * static_cast<float>(k % 7);
+        auto m = kfd::test::BagBuilder::scanMsg(1 + 0.2 * i + 0.1, r);
+        tweak(i, m);
+        b.scan("/scan", m, 1 + 0.2 * i + 0.1);
     }
     return p;
 }
@@ -1073,6 +1116,150 @@ TEST(BadInputCorruptLength, CarmenReadingCountIsAnErrorNotGigabytes) {
 
 
 // --- an MRPT exception (issue 21, item 4) ---------------------------------------------------
+
+TEST(BadInputIssue21, ANonFiniteLaserMountIsAnErrorNamingTheFrame) {
+    Dir d;
+    const std::string bag = d / "mount.bag";
+    {
+        kfd::test::BagBuilder b(bag);
+        b.tf("/tf_static", 1, "base_link", "laser", std::nan(""), 0, 0);
+        for (int i = 0; i < 10; ++i) {
+            b.odom("/odom", 1 + 0.2 * i, 0.05 * i, 0, 0);
+            b.scan("/scan",
+                   kfd::test::BagBuilder::scanMsg(1.1 + 0.2 * i, std::vector<float>(181, 2)));
+        }
+    }
+    expectLogRefused(d, bag, {},
+                     bag +
+                         ": the laser mount of frame 'laser' (base_link -> laser in /tf_static) "
+                         "is not usable: the transform base_link -> laser: its translation "
+                         "(nan, 0, 0) is not finite");
+    // A rawlog scan's sensor pose, a CARMEN laser pose: the same rule, the object or line named.
+    const std::string rawlog = d / "mount.rawlog";
+    kfd::test::writeRoomLog(rawlog, 10, [](int k, mrpt::obs::CObservation2DRangeScan& s) {
+        if (k == 3) s.sensorPose = mrpt::poses::CPose3D(0, 0, 0, std::nan(""), 0, 0);
+    });
+    expectLogRefused(d, rawlog, {},
+                     rawlog +
+                         ": object #7: the laser mount (sensor pose) of scan 'LASER' is not "
+                         "finite",
+                     "out.rawlog");
+    const auto clf = d.write("mount.clf",
+                             "FLASER 3 1 2 3 0 0 0 0 0 0 5.0 h 0\n"
+                             "FLASER 3 1 2 3 0 inf 0 0 0 0 5.2 h 0\n");
+    expectLogRefused(d, clf, {},
+                     clf +
+                         ":2: FLASER laser pose (x y theta) or odometry (odom_x odom_y "
+                         "odom_theta) is not finite: the laser mount is unknown",
+                     "out.rawlog");
+}
+
+// A CARMEN log of `n` FLASER lines (bad_logs.h's room walk, 361 beams) after a comment line.
+std::string carmenRoom(int n) {
+    std::string s = "# kfd test log\n";
+    char buf[128];
+    for (int k = 0; k < n; ++k) {
+        mrpt::obs::CObservation2DRangeScan scan;
+        kfd::test::roomScanInto(scan, 0.05 * k, 0.0);
+        s += "FLASER 361";
+        for (std::size_t i = 0; i < scan.getScanSize(); ++i) {
+            std::snprintf(buf, sizeof(buf), " %.3f", scan.getScanRange(i));
+            s += buf;
+        }
+        const double x = 0.05 * k, t = 1000.0 + 0.2 * k;
+        std::snprintf(buf, sizeof(buf), " %.3f 0 0 %.3f 0 0 %.3f host %.3f\n", x, x, t, t);
+        s += buf;
+    }
+    return s;
+}
+
+// `n` bytes of binary data (every byte value, line ends included, no empty line) from a fixed
+// seed, starting with a byte that is no line end and ending with one.
+std::string garbage(std::size_t n) {
+    std::string g(n, '\0');
+    unsigned seed = 21;
+    for (std::size_t i = 0; i < n; ++i) {
+        seed = seed * 1103515245u + 12345u;
+        g[i] = static_cast<char>((seed >> 16) & 0xff);
+        if (i > 0 && g[i] == '\n' && g[i - 1] == '\n') g[i] = '\x01';
+    }
+    g.front() = '\x01';
+    g.back() = '\n';
+    return g;
+}
+
+TEST(BadInputIssue21, CarmenBinaryGarbageIsCountedAndRefusedWhereItDominates) {
+    Dir d;
+    const std::string head = carmenRoom(50), tail = carmenRoom(100).substr(head.size());
+    const auto clean = d.write("clean.clf", head + tail);
+    const auto dirty = d.write("dirty.clf", head + garbage(60000) + tail);
+    ASSERT_LT(60000u, (head + tail).size());
+    // Counted, reported, and the output is the clean log's.
+    const std::string out = expectLogRepaired(d, dirty, "", "\"lines_unparsable\": ", "x.rawlog");
+    const std::string prefix = "\n  unparsed ";
+    const auto at = out.find(prefix);
+    ASSERT_NE(at, std::string::npos) << out;
+    const std::string line = out.substr(at + 1, out.find('\n', at + 1) - at - 1);
+    EXPECT_NE(line.find(" lines that are not CARMEN text skipped (60000 bytes, the first at line "
+                        "52)"),
+              std::string::npos)
+        << line;
+    Result r = run(KFD_FILTER_EXE, {"-q", "-i", clean, "-o", d / "clean.rawlog"}, d.path);
+    ASSERT_EQ(r.status, 0) << r.err;
+    r = run(KFD_FILTER_EXE, {"-q", "-i", dirty, "-o", d / "dirty.rawlog"}, d.path);
+    ASSERT_EQ(r.status, 0) << r.err;
+    auto decoded = [](const std::string& p) {
+        mrpt::io::CFileGZInputStream in(p);
+        std::string bytes, buf(1 << 16, '\0');
+        while (const std::size_t n = in.Read(buf.data(), buf.size())) bytes.append(buf.data(), n);
+        return bytes;
+    };
+    EXPECT_TRUE(decoded(d / "clean.rawlog") == decoded(d / "dirty.rawlog"));
+    EXPECT_EQ(run(KFD_FILTER_EXE, {"-q", "-i", clean, "-o", d / "c2.rawlog"}, d.path)
+                  .out.find("unparsed"),
+              std::string::npos);  // a clean log: no such line
+    fs::remove(d / "clean.rawlog");
+    fs::remove(d / "dirty.rawlog");
+    fs::remove(d / "c2.rawlog");
+    // Where the garbage outweighs the CARMEN lines: an error, nothing written.
+    const auto mostly = d.write("mostly.clf", carmenRoom(5) + garbage(60000));
+    expectLogRefused(
+        d, mostly, {},
+        mostly + ": most of the log is not CARMEN text (binary data or another format?): ",
+        "out.rawlog");
+}
+
+TEST(BadInputIssue21, LaserScanAnglesStampsAndOdometryAreCountedRepairs) {
+    Dir d;
+    // Angle fields that do not match the beam count: a counted skip (the scan was mirrored).
+    const auto angles = writeBagWith(d, "angles.bag", [](int k, sensor_msgs::LaserScan& m) {
+        if (k % 10 == 3) m.angle_increment = k == 3 ? std::nanf("") : -m.angle_increment;
+    });
+    const std::string out = expectLogRepaired(
+        d, angles,
+        "  angles   4 LaserScans whose angle fields do not match their beam count (skipped: "
+        "bad_aperture)",
+        "\"scans_bad_angles\": 4");
+    EXPECT_NE(out.find("\n  skipped  4 (bad geometry, dropped from the output): bad_aperture 4\n"),
+              std::string::npos)
+        << out;
+    // Header stamps of 0: the bag time, counted; the odometry still found for every scan.
+    const auto zero = writeBagWith(
+        d, "zero.bag", [](int, sensor_msgs::LaserScan& m) { m.header.stamp = ros::Time(); });
+    const std::string z =
+        expectLogRepaired(d, zero, "  stamps   40 messages stamped 0 (unset): their bag time used",
+                          "\"stamps_zero\": 40");
+    EXPECT_NE(z.find(", odometry\n"), std::string::npos) << z;
+    // Odometry that never brackets the scans: no odometry for them, counted (not the first
+    // sample for every scan).
+    const auto late = writeBagWith(
+        d, "late.bag", [](int, sensor_msgs::LaserScan&) {}, 100.0);
+    const std::string l = expectLogRepaired(
+        d, late,
+        "  odometry 40 scans more than 1 s outside the odometry's time span: no odometry for them",
+        "\"scans_without_odometry\": 40");
+    EXPECT_NE(l.find("no odometry (laser only)"), std::string::npos) << l;
+}
 
 TEST(BadInputIssue21, AnMrptExceptionSaysWhatIsWrongOnItsFirstLine) {
     Dir d;

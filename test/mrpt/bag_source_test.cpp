@@ -179,6 +179,134 @@ TEST(BagSource, ALaserOnlyBagGivesScansWithoutOdometry) {
     }
 }
 
+TEST(BagSource, ANonFiniteStaticMountIsAnErrorNamingTheFrames) {
+    TempDir d;
+    const double nan = std::nan("");
+    auto errorOf = [&](const std::string& name, double x, double yaw, bool on_chain) {
+        {
+            BagBuilder b(d / name);
+            b.tf("/tf_static", 0.5, "base_link", "mount", x, 0.0, yaw);
+            b.tf("/tf_static", 0.5, on_chain ? "mount" : "base_link", on_chain ? "laser" : "other",
+                 0.05, 0.0, 0.0);
+            b.tf("/tf_static", 0.5, "base_link", "camera", nan, 0.0, 0.0);  // not the laser's
+            b.odom("/odom", 0.9, 0.0, 0.0, 0.0);
+            b.scan("/scan", BagBuilder::scanMsg(1.0, room(0, 0, 0, 20)));
+        }
+        try {
+            kfd::BagSource src(d / name);
+            return std::string("no error, mount found: ") +
+                   (src.choice().mount_found ? "yes" : "no");
+        } catch (const kfd::BagError& e) {
+            return std::string(e.what());
+        }
+    };
+    EXPECT_EQ(errorOf("x.bag", nan, 0.0, true),
+              (d / "x.bag") +
+                  ": the laser mount of frame 'laser' (base_link -> laser in /tf_static) is not "
+                  "usable: the transform base_link -> mount: its translation (nan, 0, 0) is not "
+                  "finite");
+    EXPECT_NE(errorOf("yaw.bag", 0.1, nan, true)
+                  .find("the transform base_link -> mount: its "
+                        "rotation (quaternion 0, 0, nan, nan) is "
+                        "not finite"),
+              std::string::npos);
+    // A NaN transform off the laser's chain (the camera's) changes nothing.
+    EXPECT_EQ(errorOf("off.bag", 0.1, 0.0, false), "no error, mount found: no");
+    // The listing says why it cannot be used instead of throwing.
+    const auto l = kfd::listSource(d / "x.bag");
+    ASSERT_FALSE(l.choices.empty());
+    EXPECT_NE(l.choices.back().find("cannot use as it is: the laser mount of frame 'laser'"),
+              std::string::npos)
+        << l.choices.back();
+}
+
+TEST(BagSource, AnglesThatDoNotMatchTheBeamCountAreSkippedAndCounted) {
+    TempDir d;
+    {
+        BagBuilder b(d / "a.bag");
+        auto msg = [&](double t) { return BagBuilder::scanMsg(t, room(0, 0, 0, 20)); };
+        b.scan("/scan", msg(1.0));  // good: 19 increments over the span
+        auto m = msg(2.0);
+        m.angle_increment = kNaN;
+        b.scan("/scan", m);
+        m = msg(3.0);
+        m.angle_increment = -m.angle_increment;  // mirrored the scan before
+        b.scan("/scan", m);
+        m = msg(4.0);
+        m.angle_increment /= 2;  // the span holds 39 increments, not 19
+        b.scan("/scan", m);
+        m = msg(5.0);
+        m.angle_max = kInf;
+        b.scan("/scan", m);
+        m = msg(6.0);
+        m.angle_increment = (m.angle_max - m.angle_min) / 20;  // n increments: within one beam
+        b.scan("/scan", m);
+    }
+    kfd::BagSource src(d / "a.bag");
+    std::vector<SourceEntry> v;
+    SourceEntry e;
+    while (src.next(e)) v.push_back(e);
+    const auto scans = scansOf(v);
+    ASSERT_EQ(scans.size(), 6u);
+    kfd::StreamFilter door;
+    std::vector<kfd::ScanSkipReason> skipped;
+    for (const auto& s : scans) {
+        EXPECT_TRUE(std::isfinite(s->sensorPose.yaw()));
+        skipped.push_back(door.process(*s).skipped);
+    }
+    using R = kfd::ScanSkipReason;
+    EXPECT_EQ(skipped, (std::vector<R>{R::None, R::BadAperture, R::BadAperture, R::BadAperture,
+                                       R::BadAperture, R::None}));
+    EXPECT_EQ(src.counters().scans_bad_angles, 4u);
+    EXPECT_TRUE(scans[0]->rightToLeft);
+    EXPECT_FLOAT_EQ(scans[5]->aperture, 3.0f);
+}
+
+TEST(BagSource, ZeroStampsTakeTheBagTimeAndOdometryIsHeldOneSecondAtMost) {
+    TempDir d;
+    {
+        BagBuilder b(d / "s.bag");
+        b.scan("/scan", BagBuilder::scanMsg(3.0, room(0, 0, 0, 20)));  // 2 s before the odometry
+        b.scan("/scan", BagBuilder::scanMsg(4.5, room(0, 0, 0, 20)));  // 0.5 s before: held
+        b.odom("/odom", 5.0, 1.0, 0.0, 0.0);
+        b.scan("/scan", BagBuilder::scanMsg(0.0, room(0, 0, 0, 20)), 5.5);  // stamp 0: bag time
+        b.odom("/odom", 6.0, 2.0, 0.0, 0.0);
+        b.scan("/scan", BagBuilder::scanMsg(6.8, room(0, 0, 0, 20)));   // 0.8 s after the last
+        b.scan("/scan", BagBuilder::scanMsg(40.0, room(0, 0, 0, 20)));  // 34 s after
+    }
+    kfd::BagSource src(d / "s.bag");
+    std::vector<SourceEntry> v;
+    SourceEntry e;
+    while (src.next(e)) v.push_back(e);
+    std::vector<std::optional<kfd::Pose2D>> odo;
+    std::vector<double> stamps;
+    for (const auto& x : v)
+        if (auto s = std::dynamic_pointer_cast<Scan2D>(x.observation)) {
+            odo.push_back(x.odometry);
+            stamps.push_back(kfd::stampOf(*s));
+        }
+    ASSERT_EQ(odo.size(), 5u);
+    EXPECT_FALSE(odo[0].has_value());  // unknown, not the first sample 2 s later
+    ASSERT_TRUE(odo[1].has_value());
+    EXPECT_NEAR(odo[1]->x, 1.0, 1e-9);
+    EXPECT_NEAR(stamps[2], 5.5, 1e-6);  // the bag time
+    ASSERT_TRUE(odo[2].has_value());
+    EXPECT_NEAR(odo[2]->x, 1.5, 1e-9);  // interpolated at it
+    ASSERT_TRUE(odo[3].has_value());
+    EXPECT_NEAR(odo[3]->x, 2.0, 1e-9);
+    EXPECT_FALSE(odo[4].has_value());
+    const kfd::SourceCounters c = src.counters();
+    EXPECT_EQ(c.stamps_zero, 1u);
+    EXPECT_EQ(c.scans_without_odometry, 2u);
+    EXPECT_EQ(c.scans_bad_angles, 0u);
+    // No odometry observation precedes a scan without odometry.
+    std::size_t odometry_observations = 0;
+    for (const auto& x : v)
+        odometry_observations +=
+            dynamic_cast<const mrpt::obs::CObservationOdometry*>(x.observation.get()) ? 1 : 0;
+    EXPECT_EQ(odometry_observations, 3u);
+}
+
 TEST(BagSource, TopicChoicesAndTheirErrorsNameTheTopics) {
     TempDir d;
     {

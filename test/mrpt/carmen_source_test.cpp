@@ -14,6 +14,7 @@
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/rawlog_source.h"
+#include "kfd/mrpt/source_listing.h"
 #include "kfd/mrpt/stream_filter.h"
 #include "test_files.h"
 
@@ -213,6 +214,67 @@ TEST(CarmenSource, CountsLinesAndFieldsAreBoundedBeforeAnythingIsAllocated) {
     struct rusage u {};
     getrusage(RUSAGE_SELF, &u);
     EXPECT_LT(u.ru_maxrss, 512L * 1024L);  // KiB
+}
+
+// Bytes that are not text: every value but '\n', from a fixed seed.
+std::string binary(std::size_t n, unsigned seed) {
+    std::string b(n, '\0');
+    for (auto& c : b) {
+        seed = seed * 1103515245u + 12345u;
+        c = static_cast<char>((seed >> 16) & 0xff);
+        if (c == '\n' || c == '\r') c = '\0';
+    }
+    return b;
+}
+
+TEST(CarmenSource, LinesThatAreNotCarmenTextAreSkippedCountedAndMustNotDominate) {
+    TempDir d;
+    const std::string odom = "ODOM 1.0 2.0 0.1 0.0 0.0 0.0 100.25 host 0.0\n";
+    const std::string bad1 = binary(300, 1) + "\n", bad2 = "hello 1 2 3\n",
+                      bad3 = "# a comment with a control character \x01\n";
+    const std::string text =
+        "# caf\xc3\xa9: UTF-8 in a comment is fine\n" + odom + bad1 + odom + bad2 + bad3 + kLog;
+    const auto mixed = d.write("mixed.clf", text);
+    kfd::CarmenSource src(mixed);
+    std::vector<SourceEntry> v;
+    SourceEntry e;
+    while (src.next(e)) v.push_back(e);
+    const kfd::SourceCounters c = src.counters();
+    EXPECT_EQ(c.lines_unparsable, 3u);
+    EXPECT_EQ(c.first_unparsable_line, 3u);
+    EXPECT_EQ(c.bytes_unparsable, bad1.size() + bad2.size() + bad3.size());
+    // The other lines read as without them.
+    const auto clean = readAll(d.write("clean.clf", odom + odom + kLog));
+    ASSERT_EQ(v.size(), clean.size());
+    for (std::size_t i = 0; i < v.size(); ++i)
+        EXPECT_EQ(v[i].observation->GetRuntimeClass(), clean[i].observation->GetRuntimeClass());
+    EXPECT_EQ(kfd::CarmenSource(d.write("c2.clf", kLog)).counters().lines_unparsable, 0u);
+    // The listing counts them too.
+    EXPECT_NE(kfd::listSource(mixed).detail.find(", 3 not CARMEN text)"), std::string::npos)
+        << kfd::listSource(mixed).detail;
+    // Where they outweigh the CARMEN lines, the log is refused (at its end).
+    const auto mostly = d.write("mostly.clf", odom + binary(5000, 2) + "\n" + odom);
+    EXPECT_EQ(errorOf(mostly), mostly +
+                                   ": most of the log is not CARMEN text (binary data or another "
+                                   "format?): 5001 of its " +
+                                   std::to_string(5001 + 2 * odom.size()) +
+                                   " bytes, in 1 line, the first at line 2");
+}
+
+TEST(CarmenSource, ALaserMountThatIsNotFiniteIsAnError) {
+    TempDir d;
+    const auto flaser = d.write("f.clf", "FLASER 2 1 2 nan 0 0 0 0 0 5.0 h 0\n");
+    EXPECT_EQ(errorOf(flaser), flaser +
+                                   ":1: FLASER laser pose (x y theta) or odometry (odom_x odom_y "
+                                   "odom_theta) is not finite: the laser mount is unknown");
+    const auto param = d.write("p.clf", "PARAM robot_frontlaser_offset inf\n");
+    EXPECT_EQ(errorOf(param), param + ":1: PARAM robot_frontlaser_offset ('inf') is not finite");
+    const auto raw =
+        d.write("r.clf", "RAWLASER1 0 nan 3.0 0.01 8.0 0.01 0 3 1.0 2.0 9.0 0 1 h 0\n");
+    EXPECT_EQ(errorOf(raw),
+              raw +
+                  ":1: RAWLASER1 start angle or field of view is not finite: the laser mount is "
+                  "unknown");
 }
 
 TEST(LogFormat, TheContentDecides) {

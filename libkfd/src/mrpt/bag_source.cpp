@@ -32,6 +32,9 @@ constexpr double kLookaheadSeconds = 10.0;  // bag time searched for the odometr
 constexpr std::size_t kLookaheadMessages = 100000;
 constexpr std::size_t kHistory = 4096;  // odometry samples kept for late scans
 constexpr std::size_t kTfProbe = 500;   // /tf messages searched for the odom frame
+// A scan up to this long before the first odometry sample or after the last one takes that
+// sample; further away its odometry is unknown.
+constexpr double kOdometryHoldSeconds = 1.0;
 
 std::string stripSlash(const std::string& s) {
     const auto b = s.find_first_not_of('/');
@@ -40,6 +43,17 @@ std::string stripSlash(const std::string& s) {
 
 double yawOf(const geometry_msgs::Quaternion& q) {
     return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
+}
+
+// True when a LaserScan's angle fields describe its beam count: finite, an increment that is
+// not 0, and (angle_max - angle_min) / angle_increment within one beam of n - 1 (its sign
+// then matches the span's). Fewer than 2 beams: left to the door (no_beams).
+bool anglesMatch(const sensor_msgs::LaserScan& m) {
+    const std::size_t n = m.ranges.size();
+    if (n < 2) return true;
+    const double lo = m.angle_min, hi = m.angle_max, inc = m.angle_increment;
+    if (!std::isfinite(lo) || !std::isfinite(hi) || !std::isfinite(inc) || inc == 0.0) return false;
+    return std::fabs((hi - lo) / inc - static_cast<double>(n - 1)) <= 1.0;
 }
 
 struct TopicInfo {
@@ -154,8 +168,29 @@ std::string baseFrameFromTf(rosbag::Bag& bag, const std::string& tf_topic,
 
 struct Edge {
     std::string parent;
-    Pose2D pose;  // child in the parent's frame
+    Pose2D pose;      // child in the parent's frame
+    std::string bad;  // why the transform cannot be used ("" when it can)
 };
+
+// Why a /tf_static transform cannot be a mount: not finite, or a rotation of norm 0.
+std::string badTransform(const geometry_msgs::Transform& t) {
+    const auto& p = t.translation;
+    const auto& q = t.rotation;
+    char buf[200];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        std::snprintf(buf, sizeof(buf), "its translation (%g, %g, %g) is not finite", p.x, p.y,
+                      p.z);
+        return buf;
+    }
+    if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z) || !std::isfinite(q.w)) {
+        std::snprintf(buf, sizeof(buf), "its rotation (quaternion %g, %g, %g, %g) is not finite",
+                      q.x, q.y, q.z, q.w);
+        return buf;
+    }
+    if (q.x == 0.0 && q.y == 0.0 && q.z == 0.0 && q.w == 0.0)
+        return "its rotation is a quaternion of norm 0";
+    return {};
+}
 
 void chooseMount(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topics, BagChoice& c) {
     if (const auto s = firstMessage<sensor_msgs::LaserScan>(bag, c.scan_topic))
@@ -171,17 +206,25 @@ void chooseMount(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topic
                     edges[stripSlash(t.child_frame_id)] =
                         Edge{stripSlash(t.header.frame_id),
                              Pose2D{t.transform.translation.x, t.transform.translation.y,
-                                    yawOf(t.transform.rotation)}};
+                                    yawOf(t.transform.rotation)},
+                             badTransform(t.transform)};
     }
     Pose2D mount{0.0, 0.0, 0.0};
-    std::string f = c.laser_frame;
+    std::string f = c.laser_frame, bad;  // bad: the first unusable transform of the chain
     for (std::size_t hops = 0; hops < 64 && f != c.base_frame; ++hops) {
         const auto it = edges.find(f);
         if (it == edges.end()) break;
+        if (bad.empty() && !it->second.bad.empty())
+            bad = "the transform " + it->second.parent + " -> " + f + ": " + it->second.bad;
         mount = compose(it->second.pose, mount);
         f = it->second.parent;
     }
     c.mount_found = !c.laser_frame.empty() && f == c.base_frame && c.laser_frame != c.base_frame;
+    if (c.mount_found && bad.empty() && !finitePose(mount.x, mount.y, mount.phi))
+        bad = "the composed pose is not finite";
+    if (c.mount_found && !bad.empty())  // an unknown mount would put every point nowhere
+        throw BagError("the laser mount of frame '" + c.laser_frame + "' (" + c.base_frame +
+                       " -> " + c.laser_frame + " in /tf_static) is not usable: " + bad);
     if (c.mount_found || c.laser_frame == c.base_frame) {
         c.mount_x = mount.x;
         c.mount_y = mount.y;
@@ -297,6 +340,7 @@ struct BagSource::Impl {
     std::deque<Sample> history;
     double last_record = 0.0;
     OdometryTracker tracker;
+    SourceCounters counts;
 
     Impl(const std::string& p, const SourceOptions& o) : path(p) {
         openBag(bag, path);
@@ -334,14 +378,22 @@ struct BagSource::Impl {
                       wrapAngle(a.p.phi + w * wrapAngle(b.p.phi - a.p.phi))};
     }
 
-    // The odometry at `t` from the samples seen so far, or nullopt while the sample after `t`
-    // has not come.
-    std::optional<Pose2D> odometryAt(double t) const {
-        if (history.empty() || history.back().t < t) return std::nullopt;
+    // Resolves a scan's odometry from the samples seen so far: interpolated between the samples
+    // around its stamp; the first sample when the stamp is up to kOdometryHoldSeconds before
+    // it, unknown further before it (or before the oldest sample kept). Left unresolved while no
+    // sample at or after the stamp has come.
+    void resolve(Item& q) const {
+        const double t = q.stamp;
+        if (history.empty() || history.back().t < t) return;
         std::size_t k = history.size() - 1;  // the first sample at or after t, from the back
         while (k > 0 && history[k - 1].t >= t) --k;
-        if (history[k].t == t || k == 0) return history[k].p;
-        return interpolate(history[k - 1], history[k], t);
+        q.resolved = true;
+        if (history[k].t == t)
+            q.odom = history[k].p;
+        else if (k > 0)
+            q.odom = interpolate(history[k - 1], history[k], t);
+        else if (history[0].t - t <= kOdometryHoldSeconds)
+            q.odom = history[0].p;
     }
 
     void onSample(double t, const Pose2D& p) {
@@ -349,27 +401,39 @@ struct BagSource::Impl {
         history.push_back(Sample{t, p});
         if (history.size() > kHistory) history.pop_front();
         for (Item& q : queue)
-            if (!q.resolved) {
-                q.odom = odometryAt(q.stamp);
-                q.resolved = q.odom.has_value();
-            }
+            if (!q.resolved) resolve(q);
     }
 
-    // Holds the last odometry for scans whose next odometry message never comes.
+    // A scan whose next odometry sample never comes (the bag ends, or the lookahead runs out):
+    // the last sample when it is at most kOdometryHoldSeconds older, else unknown.
     void hold(Item& q) {
-        if (!history.empty()) q.odom = history.back().p;
+        if (!history.empty() && q.stamp - history.back().t <= kOdometryHoldSeconds)
+            q.odom = history.back().p;
         q.resolved = true;
     }
 
-    CObservation2DRangeScan::Ptr toScan(const sensor_msgs::LaserScan& m) const {
+    // A message's stamp: its header's, or its bag time when the header's is 0 (unset; counted).
+    double stampOf(const std_msgs::Header& h, double record) {
+        if (!h.stamp.isZero()) return h.stamp.toSec();
+        ++counts.stamps_zero;
+        return record;
+    }
+
+    // The MRPT scan of a LaserScan stamped `stamp`. Angle fields that do not match the beam
+    // count give an aperture of NaN (the door skips the scan: bad_aperture; counted).
+    CObservation2DRangeScan::Ptr toScan(const sensor_msgs::LaserScan& m, double stamp) {
         auto obs = std::make_shared<CObservation2DRangeScan>();
         obs->sensorLabel = label;
-        obs->timestamp = mrpt::Clock::fromDouble(m.header.stamp.toSec());
+        obs->timestamp = mrpt::Clock::fromDouble(stamp);
         const std::size_t n = m.ranges.size();
-        obs->aperture = static_cast<float>(std::fabs(double(m.angle_max) - double(m.angle_min)));
-        obs->rightToLeft = m.angle_increment >= 0.0f;
+        const bool angles_ok = anglesMatch(m);
+        counts.scans_bad_angles += angles_ok ? 0 : 1;
+        obs->aperture =
+            angles_ok ? static_cast<float>(std::fabs(double(m.angle_max) - double(m.angle_min)))
+                      : std::numeric_limits<float>::quiet_NaN();
+        obs->rightToLeft = !angles_ok || m.angle_increment >= 0.0f;
         obs->maxRange = m.range_max;
-        const double mid = 0.5 * (double(m.angle_min) + double(m.angle_max));
+        const double mid = angles_ok ? 0.5 * (double(m.angle_min) + double(m.angle_max)) : 0.0;
         obs->sensorPose = mrpt::poses::CPose3D(choice.mount_x, choice.mount_y, 0.0,
                                                choice.mount_yaw + mid, 0.0, 0.0);
         obs->resizeScan(n);
@@ -405,16 +469,16 @@ struct BagSource::Impl {
             if (topic == choice.scan_topic) {
                 const auto ls = instantiateChecked<sensor_msgs::LaserScan>(*m);
                 if (!ls) throw BagError("not a " + std::string(kLaserScan));
-                item.scan = toScan(*ls);
-                item.stamp = ls->header.stamp.toSec();
+                item.stamp = stampOf(ls->header, item.record);
+                item.scan = toScan(*ls, item.stamp);
                 if (choice.odometry != BagChoice::Odometry::None) {
-                    item.odom = odometryAt(item.stamp);
-                    item.resolved = item.odom.has_value();
+                    item.resolved = false;
+                    resolve(item);
                 }
             } else if (choice.odometry == BagChoice::Odometry::Topic &&
                        topic == choice.odom_topic) {
                 if (const auto od = instantiateChecked<nav_msgs::Odometry>(*m))
-                    onSample(od->header.stamp.toSec(),
+                    onSample(stampOf(od->header, item.record),
                              Pose2D{od->pose.pose.position.x, od->pose.pose.position.y,
                                     yawOf(od->pose.pose.orientation)});
             } else if (choice.odometry == BagChoice::Odometry::Tf && topic == choice.odom_topic) {
@@ -422,7 +486,7 @@ struct BagSource::Impl {
                     for (const auto& t : tf->transforms)
                         if (stripSlash(t.header.frame_id) == choice.odom_frame &&
                             stripSlash(t.child_frame_id) == choice.base_frame)
-                            onSample(t.header.stamp.toSec(),
+                            onSample(stampOf(t.header, item.record),
                                      Pose2D{t.transform.translation.x, t.transform.translation.y,
                                             yawOf(t.transform.rotation)});
             }
@@ -481,6 +545,8 @@ bool BagSource::next(SourceEntry& e) {
         e.kind = SourceEntry::Kind::Observation;
         e.observation = q.scan;
         e.odometry = q.odom;
+        if (d.choice.odometry != BagChoice::Odometry::None && !q.odom)
+            ++d.counts.scans_without_odometry;
     } else {
         e.kind = SourceEntry::Kind::Native;
         e.odometry = d.tracker.current();
@@ -500,6 +566,7 @@ std::uint64_t BagSource::bytesRead() const {
 }
 std::uint64_t BagSource::bytesTotal() const { return impl_->size; }
 const BagChoice& BagSource::choice() const { return impl_->choice; }
+SourceCounters BagSource::counters() const { return impl_->counts; }
 
 SourceListing listBag(const std::string& path, const SourceOptions& options) {
     rosbag::Bag bag;

@@ -42,6 +42,7 @@ class LineReader {
     // when the stream is broken (a cut or corrupt gzip).
     bool next(std::string& line) {
         line.clear();
+        bytes_ = 0;
         for (;;) {
             if (pos_ == len_) {
                 if (eof_) break;
@@ -67,8 +68,10 @@ class LineReader {
                                   path_);
             line.append(b, n);
             pos_ += n;
+            bytes_ += n;
             if (nl) {
                 ++pos_;
+                ++bytes_;
                 ++number_;
                 if (!line.empty() && line.back() == '\r') line.pop_back();
                 return true;
@@ -79,6 +82,8 @@ class LineReader {
         return true;
     }
     std::size_t number() const { return number_; }
+    /// The bytes of the last line in the file, its line end included.
+    std::size_t bytes() const { return bytes_; }
     std::uint64_t position() const { return in_.getPosition(); }
     std::uint64_t total() const { return in_.getTotalBytesCount(); }
 
@@ -86,7 +91,7 @@ class LineReader {
     detail::GzReader in_;
     std::string path_;
     std::array<char, 1 << 16> buf_{};
-    std::size_t pos_ = 0, len_ = 0, number_ = 0;
+    std::size_t pos_ = 0, len_ = 0, number_ = 0, bytes_ = 0;
     bool eof_ = false;
 };
 
@@ -125,6 +130,27 @@ double defaultResolution(std::size_t n) {
     return r;
 }
 
+// A CARMEN keyword: an upper-case letter, then upper-case letters, digits or '_' (FLASER,
+// ROBOTLASER1, NMEAGGA, ...).
+bool isKeyword(std::string_view w) {
+    if (w.empty() || w[0] < 'A' || w[0] > 'Z') return false;
+    for (const char c : w)
+        if (!((c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_')) return false;
+    return true;
+}
+
+// True for a line that is not CARMEN text (SourceCounters::lines_unparsable): a control
+// character other than a tab anywhere, a byte above 127 outside a comment, or a first field
+// that is not a keyword. `tok`: the line's fields (none for an empty line).
+bool unparsable(const std::string& line, const std::vector<std::string_view>& tok) {
+    const bool comment = !tok.empty() && tok[0].front() == '#';
+    for (const char ch : line) {
+        const auto c = static_cast<unsigned char>(ch);
+        if ((c < 0x20 && c != '\t') || c == 0x7f || (c > 0x7f && !comment)) return true;
+    }
+    return !tok.empty() && !comment && !isKeyword(tok[0]);
+}
+
 }  // namespace
 
 struct CarmenSource::Impl {
@@ -136,6 +162,8 @@ struct CarmenSource::Impl {
     std::size_t entries = 0;
     std::string line;
     std::vector<std::string_view> tok;
+    SourceCounters counts;
+    std::uint64_t bytes_parsed = 0;  // the bytes of every other line (line ends included)
 
     explicit Impl(const std::string& p) : path(p), lines(p) {}
 
@@ -178,10 +206,21 @@ struct CarmenSource::Impl {
                  " fields, expected " + std::to_string(expected));
     }
 
+    // A laser's mount (its pose on the robot) must be finite: every point depends on it.
+    void checkMount(const mrpt::poses::CPose3D& mount, const std::string& from) const {
+        if (!finitePose(mount.x(), mount.y(), mount.yaw()))
+            fail(std::string(tok[0]) + " " + from + " is not finite: the laser mount is unknown");
+    }
+
     void param() {
         if (tok.size() < 3) fail("PARAM needs a name and a value");
         const std::string name(tok[1]);
-        auto value = [&] { return number(2); };
+        auto value = [&] {  // the PARAMs kfd uses: finite numbers
+            const double v = number(2);
+            if (!std::isfinite(v))
+                fail("PARAM " + name + " ('" + std::string(tok[2]) + "') is not finite");
+            return v;
+        };
         if (name == "robot_front_laser_max")
             front.max_range = value();
         else if (name == "robot_rear_laser_max")
@@ -259,6 +298,7 @@ struct CarmenSource::Impl {
                 mrpt::poses::CPose3D(p.offset_x, p.offset_side, 0.0, p.offset_angle, 0.0, 0.0);
         else
             s->sensorPose = mrpt::poses::CPose3D(CPose2D(lx, ly, lth) - CPose2D(ox, oy, oth));
+        checkMount(s->sensorPose, "laser pose (x y theta) or odometry (odom_x odom_y odom_theta)");
         pushOdometry(ox, oy, oth, stamp);
         pushScan(std::move(s));
     }
@@ -285,6 +325,8 @@ struct CarmenSource::Impl {
             pushOdometry(base.x(), base.y(), base.phi(), stamp);
         }
         s->sensorPose = mrpt::poses::CPose3D(mount + CPose2D(0.0, 0.0, start + 0.5 * fov));
+        checkMount(s->sensorPose, robot ? "start angle, field of view, laser pose or robot pose"
+                                        : "start angle or field of view");
         pushScan(std::move(s));
     }
 
@@ -294,6 +336,12 @@ struct CarmenSource::Impl {
             if (!lines.next(line)) return false;
             if (!tokenize(line, tok))
                 fail("more than " + std::to_string(kMaxFields) + " fields (not a CARMEN log?)");
+            if (unparsable(line, tok)) {  // skipped, counted
+                if (counts.lines_unparsable++ == 0) counts.first_unparsable_line = lines.number();
+                counts.bytes_unparsable += lines.bytes();
+                continue;
+            }
+            bytes_parsed += lines.bytes();
             if (tok.empty() || tok[0].front() == '#') continue;
             const std::string_view kw = tok[0];
             if (kw == "PARAM") {
@@ -323,6 +371,17 @@ CarmenSource::~CarmenSource() = default;
 bool CarmenSource::next(SourceEntry& e) {
     Impl& d = *impl_;
     if (d.ready.empty() && !d.readMore()) {
+        const SourceCounters& c = d.counts;
+        if (c.bytes_unparsable > d.bytes_parsed)
+            throw CarmenError(d.path +
+                                  ": most of the log is not CARMEN text (binary data or another "
+                                  "format?): " +
+                                  std::to_string(c.bytes_unparsable) + " of its " +
+                                  std::to_string(c.bytes_unparsable + d.bytes_parsed) +
+                                  " bytes, in " + std::to_string(c.lines_unparsable) +
+                                  (c.lines_unparsable == 1 ? " line" : " lines") +
+                                  ", the first at line " + std::to_string(c.first_unparsable_line),
+                              d.path);
         if (d.entries == 0)
             throw CarmenError(d.path + ": no laser or odometry lines (not a CARMEN log?)", d.path);
         return false;
@@ -338,6 +397,7 @@ const std::string& CarmenSource::path() const { return impl_->path; }
 std::uint64_t CarmenSource::bytesRead() const { return impl_->lines.position(); }
 std::uint64_t CarmenSource::bytesTotal() const { return impl_->lines.total(); }
 std::size_t CarmenSource::line() const { return impl_->lines.number(); }
+SourceCounters CarmenSource::counters() const { return impl_->counts; }
 
 SourceListing listCarmen(const std::string& path) {
     LineReader lines(path);
@@ -348,12 +408,16 @@ SourceListing listCarmen(const std::string& path) {
     std::vector<std::string> order;
     std::string line;
     std::vector<std::string_view> tok;
-    std::size_t comments = 0;
+    std::size_t comments = 0, unparsed = 0;
     while (lines.next(line)) {
         if (!tokenize(line, tok))
             throw CarmenError(path + ":" + std::to_string(lines.number()) + ": more than " +
                                   std::to_string(kMaxFields) + " fields (not a CARMEN log?)",
                               path);
+        if (unparsable(line, tok)) {
+            ++unparsed;
+            continue;
+        }
         if (tok.empty() || tok[0].front() == '#') {
             comments += tok.empty() ? 0 : 1;
             continue;
@@ -387,7 +451,8 @@ SourceListing listCarmen(const std::string& path) {
     }
     for (const auto& k : order) l.streams.push_back(kinds[k]);
     l.detail = "CARMEN log, " + std::to_string(lines.number()) + " lines (" +
-               std::to_string(comments) + " comments)";
+               std::to_string(comments) + " comments" +
+               (unparsed ? ", " + std::to_string(unparsed) + " not CARMEN text" : "") + ")";
     return l;
 }
 

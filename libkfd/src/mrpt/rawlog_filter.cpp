@@ -363,6 +363,7 @@ void Run::finish() {
                       : saw_frames_                    ? "actions+sensory-frames"
                                                        : "observations";
     static_cast<ScanCounters&>(sum_) = filter_.counters();
+    sum_.source = source_->counters();
     sum_.sensors = filter_.sensorCount();
 }
 

@@ -4,6 +4,8 @@
 #include <mrpt/serialization/CArchive.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <vector>
 
@@ -149,6 +151,20 @@ bool RawlogSource::next(SourceEntry& e) {
     e.odometry = m.odometry.current();
     e.index = m.entries++;
     e.objects_read = m.objects - (m.lookahead ? 1 : 0);
+    // A laser mount (sensor pose) that is not finite would put every point of the scan nowhere.
+    e.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
+        const auto& p = s->sensorPose;
+        if (std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()) &&
+            std::isfinite(p.yaw()) && std::isfinite(p.pitch()) && std::isfinite(p.roll()))
+            return;
+        char buf[160];
+        std::snprintf(buf, sizeof(buf), "(x %g, y %g, z %g m, yaw %g, pitch %g, roll %g rad)",
+                      p.x(), p.y(), p.z(), p.yaw(), p.pitch(), p.roll());
+        throw RawlogError(m.path + ": object #" + std::to_string(e.objects_read - 1) +
+                              ": the laser mount (sensor pose) of scan '" + s->sensorLabel +
+                              "' is not finite " + buf,
+                          m.path);
+    });
     return true;
 }
 

@@ -188,6 +188,16 @@ std::string toJson(const IcpSlamSummary& s) {
     if (s.target_drop_pct) j["target_drop_pct"] = *s.target_drop_pct;
     j["cpu_s_match"] = s.cpu_s_match;
     j["scans_skipped_start"] = s.scans_skipped_start;
+    if (s.source.any()) {  // what a bag or CARMEN source repaired (absent when nothing)
+        nlohmann::ordered_json src;
+        src["lines_unparsable"] = s.source.lines_unparsable;
+        src["bytes_unparsable"] = s.source.bytes_unparsable;
+        src["first_unparsable_line"] = s.source.first_unparsable_line;
+        src["scans_bad_angles"] = s.source.scans_bad_angles;
+        src["stamps_zero"] = s.source.stamps_zero;
+        src["scans_without_odometry"] = s.source.scans_without_odometry;
+        j["source"] = std::move(src);
+    }
     j["laser_only"] = s.laser_only;
     if (s.ate_rmse) j["ate_rmse_m"] = *s.ate_rmse;
     if (s.relations) {

@@ -436,6 +436,7 @@ void Run::loop() {
     if (sum_.entries == 0) throw SlamError("no entries in " + sum_.rawlog + ": not a rawlog?");
     if (opts_.on_progress) progress(1.0);
     sum_.scans_skipped_start = skipper.skipped();
+    sum_.source = source_->counters();
 }
 
 // One step: its scans through the door (every mode, `none` included), the kept ones and the

@@ -12,7 +12,8 @@
 namespace kfd {
 
 /// A bag that cannot be read or used: not a bag, truncated, unindexed or corrupt; a topic that
-/// is missing or of the wrong type; a bag without a usable LaserScan topic.
+/// is missing or of the wrong type; a bag without a usable LaserScan topic; a laser mount in
+/// /tf_static that is not finite.
 class BagError : public SourceError {
   public:
     using SourceError::SourceError;
@@ -53,17 +54,27 @@ struct BagChoice {
 ///    Odometry topic (/odom among several), else /tf when it holds transforms from the odom
 ///    frame, else none (laser only). A scan's odometry is the odometry interpolated at its
 ///    header stamp (linearly, the heading along the shorter arc) between the last message at
-///    or before it and the first after it; before the first message it is the first, after the
-///    last the last (the rule of the datasets' bag2clf.py, so a bag and the rawlog made from
-///    it give the same poses). The source looks ahead at most 10 s of bag time (or 100 000
-///    messages) for the message after a scan, then holds the last one.
+///    or before it and the first after it; up to 1 s before the first message it is the first,
+///    up to 1 s after the last the last (the rule of the datasets' bag2clf.py, so a bag and the
+///    rawlog made from it give the same poses). Further outside the odometry's time span (a
+///    header stamp of another clock, odometry that starts late or stops early) the scan's
+///    odometry is unknown (no odometry observation before it), counted
+///    (SourceCounters::scans_without_odometry). The source looks ahead at most 10 s of bag time
+///    (or 100 000 messages) for the message after a scan, then holds the last one (within 1 s).
+///  - stamps: a header stamp of 0 (unset) is replaced by the message's bag record time, for
+///    scans and odometry alike (counted: SourceCounters::stamps_zero).
 ///  - mount: the chain of /tf_static transforms from the base frame to the scan's frame_id
-///    (leading '/' ignored), composed in 2D; identity when there is none.
+///    (leading '/' ignored), composed in 2D; identity when there is none. A transform of that
+///    chain that is not finite (or a rotation of norm 0) is a BagError naming the frames.
 ///
 /// Entries: each scan is an Observation entry with a CObservation2DRangeScan (label = topic
 /// without its leading '/', stamp = header.stamp, aperture = angle_max - angle_min, direction
 /// from the sign of angle_increment, sensor pose = mount + the yaw of the beams' middle,
-/// maxRange = range_max, intensities when there is one per beam). A beam is valid when its
+/// maxRange = range_max, intensities when there is one per beam). Angle fields that do not
+/// match the beam count (not finite, an increment of 0, (angle_max - angle_min) /
+/// angle_increment more than one beam away from n - 1, which includes an increment of the wrong
+/// sign) give the scan an aperture of NaN: the door skips it (bad_aperture), and the source
+/// counts it (SourceCounters::scans_bad_angles). A beam is valid when its
 /// range is finite and range_min <= r < range_max (r = range_max is taken as "no return", as
 /// MRPT's CARMEN and rawlog conventions do); invalid non-finite ranges are stored as 0.
 /// With odometry, each scan is preceded by an Observation entry with a CObservationOdometry
@@ -94,6 +105,8 @@ class BagSource : public Source {
     std::uint64_t bytesTotal() const override;
 
     const BagChoice& choice() const;
+    /// Angle fields that do not match the beam count, stamps of 0, scans without odometry.
+    SourceCounters counters() const override;
 
   private:
     struct Impl;

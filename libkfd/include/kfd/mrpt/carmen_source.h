@@ -39,12 +39,20 @@ class CarmenError : public SourceError {
 ///  - ODOM x y theta tv rv accel ipc_ts host logger_ts: a CObservationOdometry.
 ///  - PARAM name value [host ts]: applies to the lines after it.
 ///  - comments (#), empty lines and other keywords (TRUEPOS, SYNC, ...) are skipped.
+///  - a line that is not CARMEN text (a control character other than a tab, a byte above 127
+///    outside a comment, a first field that is not an upper-case keyword: binary data, another
+///    format) is skipped and counted (SourceCounters::lines_unparsable, bytes_unparsable,
+///    first_unparsable_line). When such lines hold more bytes than all the other lines, the
+///    log is refused at its end ("most of the log is not CARMEN text").
 /// A line with the wrong field count or a bad number is a CarmenError ("file:LINE: FLASER
-/// with 361 readings has 370 fields, expected 372"). A reading or remission count is checked
-/// against the fields after it on its line before a scan is sized by it ("FLASER reading
-/// count 1073741824 is more than the 11 fields after it"; at most 1 000 000); a line longer
-/// than 64 MiB or of more than 2 000 100 fields is refused, so no input makes the reader hold
-/// more than ~100 MB.
+/// with 361 readings has 370 fields, expected 372"), and so is a laser mount that is not finite
+/// (a FLASER's laser pose or odometry, a RAWLASER's start angle or field of view, a
+/// ROBOTLASER's laser or robot pose: "file:LINE: FLASER laser pose ... is not finite") or a
+/// PARAM kfd uses (laser offsets, range, resolution) that is not finite. A reading or remission
+/// count is checked against the fields after it on its line before a scan is sized by it
+/// ("FLASER reading count 1073741824 is more than the 11 fields after it"; at most 1 000 000); a
+/// line longer than 64 MiB or of more than 2 000 100 fields is refused, so no input makes the
+/// reader hold more than ~100 MB.
 class CarmenSource : public Source {
   public:
     explicit CarmenSource(const std::string& path);
@@ -58,6 +66,8 @@ class CarmenSource : public Source {
     std::uint64_t bytesTotal() const override;
     /// Lines read so far (the number of the last line read).
     std::size_t line() const;
+    /// The lines that are not CARMEN text, skipped so far.
+    SourceCounters counters() const override;
 
   private:
     struct Impl;

@@ -63,6 +63,7 @@ struct RawlogFilterSummary : ScanCounters {
     std::size_t actions_merged = 0;   // odometry actions composed into a later kept action
     std::size_t sensors = 0;
     SensorSummary sensor;       // the first sensor, as measured from its scans
+    SourceCounters source;      // what the bag or CARMEN source repaired or left out
     double wall_seconds = 0.0;  // whole run, I/O included
 };
 

@@ -8,8 +8,8 @@
 
 namespace kfd {
 
-/// Bad rawlog input or output: missing or unreadable file, not a rawlog, truncated rawlog,
-/// write failure.
+/// Bad rawlog input or output: missing or unreadable file, not a rawlog, truncated rawlog, a
+/// scan whose laser mount is not finite, write failure.
 class RawlogError : public SourceError {
   public:
     using SourceError::SourceError;
@@ -32,6 +32,8 @@ void checkGzipIntegrity(const std::string& path);
 /// ends next() normally, unless zlib reports that the gzip stream itself was cut short (its
 /// decoded data happened to end at a boundary); the second is a truncated or corrupt file:
 /// RawlogError. A plain file cut exactly at an object boundary is a valid, shorter rawlog.
+/// A 2D scan whose sensor pose (the laser mount) is not finite is a RawlogError naming the
+/// file, the object and the scan's sensor label, as a bag's or a CARMEN log's mount is.
 class RawlogSource : public Source {
   public:
     /// Opens `path`; RawlogError when it is missing, unreadable or empty.

@@ -126,6 +126,34 @@ struct SourceEntry {
     }
 };
 
+/// What a source repaired or left out while reading a log, counted: the summaries (kfd-filter's,
+/// kfd-icp-slam's summary.json) report what is not 0. An MRPT rawlog has none of these.
+struct SourceCounters {
+    /// CARMEN: lines that are not CARMEN lines (a control character or a byte above 127 outside
+    /// a comment, or a first field that is not an upper-case keyword such as FLASER: binary data,
+    /// another format), skipped. A log where they outweigh the other lines in bytes is refused
+    /// (CarmenError, at its end).
+    std::size_t lines_unparsable = 0;
+    std::uint64_t bytes_unparsable = 0;     // their bytes, line ends included
+    std::size_t first_unparsable_line = 0;  // the first one's number (1-based); 0: none
+    /// Bags: LaserScan messages whose angle fields do not match their beam count (not finite,
+    /// an increment of 0 or of the wrong sign, (angle_max - angle_min) / angle_increment more
+    /// than one beam away from n - 1): their aperture is made NaN, so the door skips them as
+    /// bad_aperture.
+    std::size_t scans_bad_angles = 0;
+    /// Bags: LaserScan, Odometry and /tf odometry messages whose header stamp is 0 (unset): their
+    /// bag record time is used instead.
+    std::size_t stamps_zero = 0;
+    /// Bags with odometry: scans stamped more than BagSource's hold time (1 s) before the first
+    /// odometry sample or after the last one (or than the source can look ahead): their odometry
+    /// is unknown, not the nearest sample.
+    std::size_t scans_without_odometry = 0;
+
+    bool any() const {
+        return lines_unparsable || scans_bad_angles || stamps_zero || scans_without_odometry;
+    }
+};
+
 /// A log read entry by entry, never loaded whole. Implementations: RawlogSource (MRPT
 /// rawlogs, kfd/mrpt/rawlog_source.h), BagSource (ROS 1 bags, kfd/mrpt/bag_source.h),
 /// CarmenSource (CARMEN logs, kfd/mrpt/carmen_source.h); openSource
@@ -143,6 +171,8 @@ class Source {
     /// compressed file the decoded size).
     virtual std::uint64_t bytesRead() const = 0;
     virtual std::uint64_t bytesTotal() const = 0;
+    /// What the source repaired or left out so far (final once next() returned false).
+    virtual SourceCounters counters() const { return {}; }
 };
 
 /// The formats kfd reads.

@@ -75,6 +75,7 @@ struct IcpSlamSummary : ScanCounters {
     double cpu_s_total = 0.0;             // process CPU time of the run (I/O included)
     double cpu_s_match = 0.0;             // of which the match_drop_of pre-pass
     std::size_t scans_skipped_start = 0;  // the first skip_scans scans, not in scans_in
+    SourceCounters source;                // what the bag or CARMEN source repaired or left out
     bool laser_only = false;
     std::optional<double> target_drop_pct;  // what the odometry or decimate mode matched
     double wall_s_total = 0.0;
