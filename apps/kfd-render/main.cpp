@@ -67,6 +67,7 @@ int main(int argc, char** argv) {
         struct Seen {
             mrpt::obs::CObservation2DRangeScan::Ptr scan;
             std::optional<kfd::Pose2D> odometry;
+            long number = 0;  // 0-based among the log's 2D scans
         };
         std::deque<Seen> recent, chosen;
         double best = 1e300;
@@ -75,9 +76,10 @@ int main(int argc, char** argv) {
         while (!(index >= 0 && !chosen.empty()) && source->next(entry)) {
             kfd::throwIfCancelled();
             entry.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
-                recent.push_back({s, entry.odometry});
+                recent.push_back({s, entry.odometry, n});
                 if (recent.size() > static_cast<std::size_t>(history) + 1) recent.pop_front();
-                if (index >= 0 && n++ == index) chosen = recent;
+                if (index >= 0 && n == index) chosen = recent;
+                ++n;
                 if (index < 0) {
                     const double d = std::abs(kfd::stampOf(*s) - stamp);
                     if (d < best) {
@@ -87,19 +89,26 @@ int main(int argc, char** argv) {
                 }
             });
         }
-        if (chosen.empty()) throw std::runtime_error("no such scan in " + in);
+        if (n == 0) throw std::runtime_error("no laser scan in " + in);
+        if (chosen.empty())
+            throw std::runtime_error("no scan " + std::to_string(index) + " in " + in +
+                                     ": it holds " + std::to_string(n) +
+                                     " 2D scans (--index counts from 0)");
         // Through the one door, as every tool: the distance filter and the denoiser, every scan
-        // kept (no keyframe stage), so the history scans are the denoiser's previous ones.
+        // kept (no keyframe stage), so the history scans are the denoiser's previous ones. A
+        // history scan the door skips is no previous keyframe; the chosen one must be usable.
         kfd::Pipeline::Params drawn = p;
         drawn.stages = {"distance", "denoise"};
         kfd::StreamFilter door(drawn);
         kfd::StreamResult r;
-        for (const Seen& seen : chosen) {
-            r = door.process(*seen.scan, seen.odometry);
-            if (r.skipped != kfd::ScanSkipReason::None)
-                throw std::runtime_error(std::string("scan at ") +
-                                         std::to_string(kfd::stampOf(*seen.scan)) +
-                                         " cannot be used: " + kfd::toString(r.skipped));
+        for (const Seen& seen : chosen) r = door.process(*seen.scan, seen.odometry);
+        if (r.skipped != kfd::ScanSkipReason::None) {
+            char t[64];
+            std::snprintf(t, sizeof(t), "%.6f", kfd::stampOf(*chosen.back().scan));
+            throw std::runtime_error("scan " + std::to_string(chosen.back().number) + " of " + in +
+                                     " (t = " + t + " s) cannot be drawn: it has " +
+                                     kfd::describe(r.skipped) + " (" + kfd::toString(r.skipped) +
+                                     ")");
         }
         // Drawn: every clustered point of the scan (the denoiser's input; noise in red).
         const auto& last = *chosen.back().scan;

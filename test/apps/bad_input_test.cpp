@@ -1229,6 +1229,54 @@ TEST(BadInputIssue21, CarmenBinaryGarbageIsCountedAndRefusedWhereItDominates) {
         "out.rawlog");
 }
 
+TEST(BadInputIssue21, ARunWithNoUsableScanFailsAndWritesNothing) {
+    Dir d;
+    const std::string odometry = d / "odometry.rawlog";
+    {
+        mrpt::io::CFileGZOutputStream f(odometry);
+        auto arch = mrpt::serialization::archiveFrom(f);
+        for (int k = 0; k < 10; ++k) {
+            mrpt::obs::CObservationOdometry o;
+            o.timestamp = mrpt::Clock::fromDouble(1000.0 + 0.2 * k);
+            o.odometry = mrpt::poses::CPose2D(0.05 * k, 0, 0);
+            arch << o;
+        }
+    }
+    expectLogRefused(d, odometry, {}, "no laser scan in " + odometry, "out.rawlog");
+    const std::string skipped = d / "skipped.rawlog";
+    kfd::test::writeRoomLog(skipped, 5,
+                            [](int, mrpt::obs::CObservation2DRangeScan& s) { s.aperture = 0; });
+    expectLogRefused(d, skipped, {},
+                     "no usable scan in " + skipped +
+                         ": all 5 scans skipped (bad_aperture 5: an aperture that is not finite, "
+                         "<= 0 or above 2 pi)",
+                     "out.rawlog");
+    const auto clf =
+        d.write("odometry.clf", "ODOM 1 2 0 0 0 0 5.0 h 0\nODOM 1 2 0 0 0 0 5.2 h 0\n");
+    expectLogRefused(d, clf, {}, "no laser scan in " + clf, "out.rawlog");
+    const auto bag = writeBagWith(d, "angles.bag", [](int, sensor_msgs::LaserScan& m) {
+        m.angle_increment = -m.angle_increment;
+    });
+    expectLogRefused(d, bag, {},
+                     "no usable scan in " + bag +
+                         ": all 40 scans skipped (bad_aperture 40: an aperture that is not "
+                         "finite, <= 0 or above 2 pi; of them 40 LaserScans whose angle fields do "
+                         "not match their beam count)");
+    // kfd-icp-slam skipping every scan at the start.
+    const std::string room = d / "room.rawlog";
+    kfd::test::writeRoomLog(room, 10);
+    const auto before = listing(d.path);
+    const Snapshot snap({room});
+    const Result r =
+        run(KFD_ICP_SLAM_EXE,
+            {kSlamIni, room, "-o", d / "slam", "-q", "--no-map", "--skip-scans", "100"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-icp-slam: no laser scan in " + room +
+                             " after the 10 skipped at its start (skip_scans = 100)");
+    EXPECT_EQ(listing(d.path), before);
+    snap.expectUnchanged();
+}
+
 TEST(BadInputIssue21, LaserScanAnglesStampsAndOdometryAreCountedRepairs) {
     Dir d;
     // Angle fields that do not match the beam count: a counted skip (the scan was mirrored).
@@ -1260,6 +1308,38 @@ TEST(BadInputIssue21, LaserScanAnglesStampsAndOdometryAreCountedRepairs) {
         "\"scans_without_odometry\": 40");
     EXPECT_NE(l.find("no odometry (laser only)"), std::string::npos) << l;
 }
+
+#ifdef KFD_RENDER_EXE
+TEST(BadInputIssue21, RenderChecksTheScanThroughTheDoor) {
+    Dir d;
+    const std::string in = d / "bad.rawlog";
+    kfd::test::writeRoomLog(in, 30, [](int k, mrpt::obs::CObservation2DRangeScan& s) {
+        if (k == 6) s.resizeScan(0);
+        if (k == 8) s.aperture = std::nanf("");
+    });
+    const Snapshot snap({in});
+    Result r = run(KFD_RENDER_EXE, {"-i", in, "--index", "6", "-o", d / "x.png"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-render: scan 6 of " + in +
+                             " (t = 1001.200000 s) cannot be drawn: it has fewer than 2 beams "
+                             "(no_beams)");
+    r = run(KFD_RENDER_EXE, {"-i", in, "--time", "1001.6", "-o", d / "x.png"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-render: scan 8 of " + in +
+                             " (t = 1001.600000 s) cannot be drawn: it has an aperture that is not "
+                             "finite, <= 0 or above 2 pi (bad_aperture)");
+    r = run(KFD_RENDER_EXE, {"-i", in, "--index", "30", "-o", d / "x.png"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(),
+              "kfd-render: no scan 30 in " + in + ": it holds 30 2D scans (--index counts from 0)");
+    EXPECT_EQ(listing(d.path), std::set<std::string>{"bad.rawlog"});
+    // A bad scan among the history scans is no previous keyframe: the chosen one is drawn.
+    r = run(KFD_RENDER_EXE, {"-i", in, "--index", "7", "-o", d / "x.png"}, d.path);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(listing(d.path), (std::set<std::string>{"bad.rawlog", "x.png"}));
+    snap.expectUnchanged();
+}
+#endif
 
 TEST(BadInputIssue21, AnMrptExceptionSaysWhatIsWrongOnItsFirstLine) {
     Dir d;

@@ -281,6 +281,9 @@ void Run::loop() {
         if (before / every != sum_.objects_in / every) reportProgress(source_->bytesRead());
     }
     if (sum_.objects_in == 0) throw RawlogError("no objects in " + opts_.input + ": not a rawlog?");
+    // Nothing to filter: an error, not an empty output (nothing is committed).
+    const std::string none = noUsableScan(filter_.counters(), source_->counters(), opts_.input);
+    if (!none.empty()) throw RawlogError(none, opts_.input);
 }
 
 void Run::handleEntry(const SourceEntry& e) {

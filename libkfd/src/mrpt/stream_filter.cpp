@@ -143,6 +143,24 @@ void StreamFilter::record(StreamResult& res) {
     }
 }
 
+std::string noUsableScan(const ScanCounters& c, const SourceCounters& source,
+                         const std::string& log) {
+    if (c.scans_in == 0) return "no laser scan in " + log;
+    if (c.scans_skipped < c.scans_in) return {};
+    std::string why;
+    for (std::size_t r = 1; r < kScanSkipReasons; ++r)
+        if (c.skipped_by_reason[r])
+            why += (why.empty() ? "" : "; ") +
+                   std::string(toString(static_cast<ScanSkipReason>(r))) + " " +
+                   std::to_string(c.skipped_by_reason[r]) + ": " +
+                   describe(static_cast<ScanSkipReason>(r));
+    if (source.scans_bad_angles)
+        why += "; of them " + std::to_string(source.scans_bad_angles) +
+               " LaserScans whose angle fields do not match their beam count";
+    return "no usable scan in " + log + ": all " + std::to_string(c.scans_in) + " scans skipped (" +
+           why + ")";
+}
+
 const Clusters* StreamFilter::lastClusters(const std::string& sensor_label) const {
     const auto it = sensors_.find(sensor_label);
     return it == sensors_.end() ? nullptr : it->second.pipeline->lastClusters();

@@ -433,10 +433,17 @@ void Run::loop() {
         if (opts_.on_progress && step_no_ % 500 == 0)
             progress(static_cast<double>(source_->bytesRead()) / total_bytes);
     }
-    if (sum_.entries == 0) throw SlamError("no entries in " + sum_.rawlog + ": not a rawlog?");
-    if (opts_.on_progress) progress(1.0);
+    if (sum_.entries == 0 && skipper.skipped() == 0)
+        throw SlamError("no entries in " + sum_.rawlog + ": not a rawlog?", sum_.rawlog);
     sum_.scans_skipped_start = skipper.skipped();
     sum_.source = source_->counters();
+    // No scan reached the pre-filter's stages: an error, not a run without a map.
+    std::string none = noUsableScan(prefilter_->counters(), sum_.source, sum_.rawlog);
+    if (!none.empty() && prefilter_->counters().scans_in == 0 && sum_.scans_skipped_start)
+        none += " after the " + std::to_string(sum_.scans_skipped_start) +
+                " skipped at its start (skip_scans = " + std::to_string(opts_.skip_scans) + ")";
+    if (!none.empty()) throw SlamError(none, sum_.rawlog);
+    if (opts_.on_progress) progress(1.0);
 }
 
 // One step: its scans through the door (every mode, `none` included), the kept ones and the

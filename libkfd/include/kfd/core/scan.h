@@ -105,6 +105,22 @@ inline const char* toString(ScanSkipReason r) {
     return "unknown";
 }
 
+/// The reason in words, for messages: "fewer than 2 beams", "more than 65536 beams", "an
+/// aperture that is not finite, <= 0 or above 2 pi" ("" for None).
+inline const char* describe(ScanSkipReason r) {
+    switch (r) {
+        case ScanSkipReason::None:
+            return "";
+        case ScanSkipReason::NoBeams:
+            return "fewer than 2 beams";
+        case ScanSkipReason::TooManyBeams:
+            return "more than 65536 beams";
+        case ScanSkipReason::BadAperture:
+            return "an aperture that is not finite, <= 0 or above 2 pi";
+    }
+    return "";
+}
+
 /// Checks beam count and aperture against the limits above.
 inline ScanSkipReason checkGeometry(const ScanGeometry& g) {
     if (g.beams < kMinScanBeams) return ScanSkipReason::NoBeams;

@@ -80,7 +80,9 @@ struct RawlogFilterSummary : ScanCounters {
 /// finite, <= 0 or > 2*pi) is removed from the output exactly like a non-keyframe, counted in
 /// scans_skipped and skipped_by_reason, and its stats row has reason "skipped:<reason>"; the
 /// run goes on. Beams with a NaN, infinite, negative or huge range
-/// are marked invalid in the output (counted in beams_bad_range). The input is never modified;
+/// are marked invalid in the output (counted in beams_bad_range). A log with no scan the door
+/// could use (none at all, or every one skipped) is a RawlogError naming the log and the skip
+/// reasons (kfd::noUsableScan), and no output is left. The input is never modified;
 /// on any error no output file is left behind: the output and the stats CSV are written under
 /// temporary names beside them through kfd's checked writers (GzOutputStream, BagWriter,
 /// ScanCsvWriter), both checked when complete (the gzip trailer and the bag index read back,

@@ -14,6 +14,7 @@
 
 #include "kfd/core/pipeline.h"
 #include "kfd/mrpt/scan_record.h"
+#include "kfd/mrpt/source.h"
 
 namespace kfd {
 
@@ -85,5 +86,14 @@ class StreamFilter {
     Scan spare_scan_;  // the next scan's buffer (swapped with its sensor's)
     ScanCounters counters_;
 };
+
+/// Empty when a run through the door had a usable scan (one that reached the pipeline); else
+/// what the run's error says, naming the log: "no laser scan in LOG" when the door saw none,
+/// "no usable scan in LOG: all N scans skipped (bad_aperture N: an aperture that is not finite,
+/// <= 0 or above 2 pi)" when it skipped every one (with the source's count of LaserScans
+/// whose angle fields do not match their beam count, when there are some). RawlogFilter and
+/// IcpSlamRunner throw it: a run with no usable scan writes nothing and fails.
+std::string noUsableScan(const ScanCounters& counters, const SourceCounters& source,
+                         const std::string& log);
 
 }  // namespace kfd

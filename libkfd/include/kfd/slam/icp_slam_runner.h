@@ -142,11 +142,13 @@ class SlamOptionError : public SlamError {
 /// propagated with odometry for dropped scans). Every scan enters through the one door
 /// (StreamFilter::process), in every mode (`none` included): a bad geometry skips it (counted,
 /// never reaches ICP), bad ranges are marked invalid, and a non-finite odometry reading is left
-/// out of the map builder's input. An exception of MRPT's map builder becomes a SlamError
-/// naming the step, its scan's stamp and the log, with MRPT's message (kfd::plainMessage); one
-/// while configuring it names the configuration file. Relations given but none matched, or a
-/// negative relations_max_dt, are errors (SlamError); contradicting options are a
-/// SlamOptionError.
+/// out of the map builder's input. A log with no scan the door could use (none at all, none
+/// after skip_scans, or every one skipped) is a SlamError naming the log and the skip reasons
+/// (kfd::noUsableScan), and nothing is written. An exception of MRPT's map builder becomes a
+/// SlamError naming the step, its scan's stamp and the log, with MRPT's message
+/// (kfd::plainMessage); one while configuring it names the configuration file. Relations given
+/// but none matched, or a negative relations_max_dt, are errors (SlamError); contradicting
+/// options are a SlamOptionError.
 ///
 /// Checks first that the configuration, the rawlog, the relations and the ground truth are
 /// readable (the ground truth and relations are parsed before the run) and that no output file
