@@ -983,47 +983,6 @@ std::string writeBagWith(const Dir& d, const std::string& name, int k,
         else
             b.scan("/scan", kfd::test::BagBuilder::scanMsg(1 + 0.2 * i + 0.1,
                                                            std::vector<float>(181, 2.0f)));
-
-// --- every bad input a clear error or a counted repair (issue 21, item 4) ---------------------
-
-// kfd-filter and kfd-icp-slam on a log they repair: exit 0, the repair counted in kfd-filter's
-// summary (`line`) and in summary.json (`json`), the input unchanged. Returns kfd-filter's stdout.
-std::string expectLogRepaired(const Dir& d, const std::string& in, const std::string& line,
-                              const std::string& json, const std::string& out = "out.bag") {
-    SCOPED_TRACE(in + " " + line);
-    const Snapshot snap({in});
-    const Result r = run(KFD_FILTER_EXE, {"-q", "-i", in, "-o", d / out}, d.path);
-    EXPECT_EQ(r.status, 0) << r.err;
-    EXPECT_EQ(r.err, "");
-    if (!line.empty()) {
-        EXPECT_NE(r.out.find("\n" + line + "\n"), std::string::npos) << r.out;
-    }
-    EXPECT_TRUE(fs::exists(d / out));
-    const Result s =
-        run(KFD_ICP_SLAM_EXE, {kSlamIni, in, "-o", d / "slam", "-q", "--no-map"}, d.path);
-    EXPECT_EQ(s.status, 0) << s.err;
-    const std::string summary = fileBytes(d / "slam/summary.json");
-    EXPECT_NE(summary.find(json), std::string::npos) << summary;
-    fs::remove(d / out);
-    fs::remove_all(d / "slam");
-    snap.expectUnchanged();
-    return r.out;
-}
-
-// 40 scans of writeBag's room; `tweak(k, scan)` changes scan k, `bag_time(k)` its record time
-// (its stamp when negative); odometry at `odom_t0 + 0.2 k`.
-std::string writeBagWith(const Dir& d, const std::string& name,
-                         const std::function<void(int, sensor_msgs::LaserScan&)>& tweak,
-                         double odom_t0 = 1.0) {
-    const std::string p = d / name;
-    kfd::test::BagBuilder b(p);
-    for (int i = 0; i < 40; ++i) {
-        b.odom("/odom", odom_t0 + 0.2 * i, 0.05 * i, 0, 0);
-        std::vector<float> r(181);
-        for (std::size_t k = 0; k < r.size(); ++k) r[k] = 2.0f + 0.01f * static_cast<float>(k % 7);
-        auto m = kfd::test::BagBuilder::scanMsg(1 + 0.2 * i + 0.1, r);
-        tweak(i, m);
-        b.scan("/scan", m, 1 + 0.2 * i + 0.1);
     }
     return p;
 }
@@ -1114,8 +1073,49 @@ TEST(BadInputCorruptLength, CarmenReadingCountIsAnErrorNotGigabytes) {
         "out.rawlog");
 }
 
+// --- every bad input a clear error or a counted repair (issue 21, item 4) ---------------------
 
-// --- an MRPT exception (issue 21, item 4) ---------------------------------------------------
+// kfd-filter and kfd-icp-slam on a log they repair: exit 0, the repair counted in kfd-filter's
+// summary (`line`) and in summary.json (`json`), the input unchanged. Returns kfd-filter's stdout.
+std::string expectLogRepaired(const Dir& d, const std::string& in, const std::string& line,
+                              const std::string& json, const std::string& out = "out.bag") {
+    SCOPED_TRACE(in + " " + line);
+    const Snapshot snap({in});
+    const Result r = run(KFD_FILTER_EXE, {"-q", "-i", in, "-o", d / out}, d.path);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    if (!line.empty()) {
+        EXPECT_NE(r.out.find("\n" + line + "\n"), std::string::npos) << r.out;
+    }
+    EXPECT_TRUE(fs::exists(d / out));
+    const Result s =
+        run(KFD_ICP_SLAM_EXE, {kSlamIni, in, "-o", d / "slam", "-q", "--no-map"}, d.path);
+    EXPECT_EQ(s.status, 0) << s.err;
+    const std::string summary = fileBytes(d / "slam/summary.json");
+    EXPECT_NE(summary.find(json), std::string::npos) << summary;
+    fs::remove(d / out);
+    fs::remove_all(d / "slam");
+    snap.expectUnchanged();
+    return r.out;
+}
+
+// 40 scans of writeBag's room; `tweak(k, scan)` changes scan k, `bag_time(k)` its record time
+// (its stamp when negative); odometry at `odom_t0 + 0.2 k`.
+std::string writeBagWith(const Dir& d, const std::string& name,
+                         const std::function<void(int, sensor_msgs::LaserScan&)>& tweak,
+                         double odom_t0 = 1.0) {
+    const std::string p = d / name;
+    kfd::test::BagBuilder b(p);
+    for (int i = 0; i < 40; ++i) {
+        b.odom("/odom", odom_t0 + 0.2 * i, 0.05 * i, 0, 0);
+        std::vector<float> r(181);
+        for (std::size_t k = 0; k < r.size(); ++k) r[k] = 2.0f + 0.01f * static_cast<float>(k % 7);
+        auto m = kfd::test::BagBuilder::scanMsg(1 + 0.2 * i + 0.1, r);
+        tweak(i, m);
+        b.scan("/scan", m, 1 + 0.2 * i + 0.1);
+    }
+    return p;
+}
 
 TEST(BadInputIssue21, ANonFiniteLaserMountIsAnErrorNamingTheFrame) {
     Dir d;
