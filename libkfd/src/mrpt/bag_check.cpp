@@ -188,6 +188,7 @@ class Checker {
                     break;
                 case kConnection:
                     (void)u32field(h, "conn", at);
+                    connectionHeader(data.data(), data.size(), at);
                     break;
                 case kChunkInfo:
                     chunkInfo(h, at);
@@ -258,11 +259,19 @@ class Checker {
         }
         if (dlen > size_ - dpos)
             fail(pos, "a record's data runs past the end of the file (truncated?)");
-        if (op == kChunk || op == kIndexData) {  // the only data this check reads
+        if (op == kChunk || op == kIndexData || op == kConnection) {  // the data this check reads
             data.resize(dlen);
             if (dlen && !readAt(dpos, data.data(), dlen)) fail(pos, "read error");
         }
         return dpos + dlen;
+    }
+
+    // A connection record's data is itself a header (topic, type, md5sum, definition) that
+    // rosbag_storage parses with ros::Header::parse, which copies a field before checking that
+    // it fits (a fuzzed length read past the buffer: test/fuzz/corpus/bag/finding-*).
+    void connectionHeader(const unsigned char* bytes, std::uint64_t len, std::uint64_t at) const {
+        if (len > kMaxHeader) fail(at, "a connection header of more than 1 MiB");
+        (void)parseHeader(bytes, len, at);
     }
 
     std::uint8_t opOf(const Header& h, std::uint64_t at) const {
@@ -318,6 +327,7 @@ class Checker {
             if (op != kMessageData && op != kConnection)
                 fail(at, "a chunk holds a record of op " + std::to_string(op));
             (void)u32field(rh, "conn", at);
+            if (op == kConnection) connectionHeader(plain.data() + p + 8 + hlen, dlen, at);
             if (op == kMessageData) starts.insert(static_cast<std::uint32_t>(p));
             p += 8 + hlen + dlen;
         }

@@ -54,13 +54,17 @@ struct RawlogSource::Impl {
                 if (const std::string f = in.failure(); !f.empty()) throw error(f);
             } catch (const std::bad_alloc&) {
                 ended = true;
-                throw error("an object claims more memory than the " + std::to_string(bytesLeft()) +
-                                " bytes left in the file (a corrupt length field)",
-                            true);
+                throw corruptLength();
             } catch (const std::exception& e) {
                 ended = true;
                 if (!in.error().empty()) throw error(in.error());  // the gzip layer knows why
-                throw error(lastMessage(e.what()));
+                // OpenCV's images allocate with malloc, outside the limit: an impossible size
+                // comes back as OpenCV's out-of-memory error (fuzz_rawlog's finding).
+                const std::string what = e.what();
+                if (what.find("Insufficient memory") != std::string::npos ||
+                    what.find("Failed to allocate") != std::string::npos)
+                    throw corruptLength();
+                throw error(lastMessage(what));
             }
         }
         if (obj) ++objects;
@@ -70,6 +74,12 @@ struct RawlogSource::Impl {
     // Decoded bytes not read yet.
     std::uint64_t bytesLeft() const {
         return in.getTotalBytesCount() - std::min(in.getPosition(), in.getTotalBytesCount());
+    }
+
+    RawlogError corruptLength() const {
+        return error("an object claims more memory than the " + std::to_string(bytesLeft()) +
+                         " bytes left in the file (a corrupt length field)",
+                     true);
     }
 
     // `said`: `what` says itself that the file is corrupt (no hint added).

@@ -15,7 +15,10 @@
 // length field. A program that does not link kfd::alloc_limit reads rawlogs as MRPT does,
 // without the bound. Not covered: C allocation calls (malloc, posix_memalign), which
 // libmrpt-obs does not make but Eigen's dynamic matrices (libmrpt-math, libmrpt-poses) and
-// OpenCV's images (an image observation in a rawlog) do.
+// OpenCV's images (an image observation in a rawlog) do. Those do not zero what they allocate
+// (a corrupt image size costs address space, not memory, until the read fails), and a size no
+// malloc can give (fuzz_rawlog found 1.2e18 bytes: test/fuzz/corpus/rawlog/finding-*) returns
+// null, which OpenCV turns into an exception: a clear error like the others.
 #pragma once
 
 #include <cstddef>
