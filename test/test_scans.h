@@ -134,10 +134,11 @@ inline Scan wallWithOutliers() {
 }
 
 /// A wall 4 m ahead over -60..60 deg (181 beams over 180 deg) with isolated outliers at 1 m on
-/// beams 50, 100 and 130, an out-of-range beam (60, 45 m) and a NaN beam (61), stamped 100 s
-/// and without odometry.
+/// beams 50, 100 and 130, an out-of-range beam (60, 45 m, beyond the sensor's 30 m maximum)
+/// and a NaN beam (61), stamped 100 s and without odometry.
 inline Scan noisyWall() {
     Scan scan = emptyScan(181, kPi);
+    scan.max_range = 30.0f;
     setWall(scan, 30, 150, 4.0);
     insertOutliers(scan, {50, 100, 130}, 1.0);
     scan.range[60] = 45.0f;

@@ -11,7 +11,12 @@
 
 namespace kfd::app {
 
-inline void addSourceOptions(Cli& cli, kfd::SourceOptions& o, bool& list) {
+/// `laser_only`: --laser-only, "ignore the log's odometry" (`laser_only_help` says what else).
+inline void addSourceOptions(Cli& cli, kfd::SourceOptions& o, bool& list, bool& laser_only,
+                             const char* laser_only_help) {
+    cli.flag("--laser-only", laser_only,
+             std::string("ignore the log's odometry: kfd decides from the scans\nalone") +
+                 laser_only_help);
     cli.option("--scan-topic", o.scan_topic,
                "bag: the sensor_msgs/LaserScan topic\n"
                "(default: the only one, else /scan)")

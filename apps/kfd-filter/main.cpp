@@ -47,6 +47,20 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
     std::printf("  points   in %zu; in kept scans removed: %zu out of range, %zu noise (%.2f %%)\n",
                 s.points_in, s.points_removed_range, s.points_removed_noise,
                 s.points_in ? 100.0 * removed / static_cast<double>(s.points_in) : 0.0);
+    if (s.scans_odometry_frozen || s.scans_odometry_jump)
+        std::printf(
+            "  odometry withheld from %zu scans (%zu frozen while the scans changed, %zu jumps "
+            "the scans do not show): decided laser only\n",
+            s.scans_odometry_frozen + s.scans_odometry_jump, s.scans_odometry_frozen,
+            s.scans_odometry_jump);
+    if (s.points_removed_noise)
+        std::printf("  denoise  at most %.2f %% of a kept scan's returns removed",
+                    100.0 * s.max_removed_noise_share);
+    if (s.scans_denoise_stale || s.scans_denoise_capped)
+        std::printf("; the bound on removal acted on %zu scans (%zu stale references, %zu capped)",
+                    s.scans_denoise_stale + s.scans_denoise_capped, s.scans_denoise_stale,
+                    s.scans_denoise_capped);
+    if (s.points_removed_noise) std::printf("\n");
     if (s.output_format == kfd::LogFormat::Bag)
         std::printf(
             "  messages in %zu, out %zu, scans dropped %zu; %zu removed points written as %s\n",
@@ -137,7 +151,8 @@ int main(int argc, char** argv) {
                "output: a rawlog, or for a bag input a bag (X.bag);\n"
                "written to a temporary file, then renamed")
         ->type_name("FILE");
-    kfd::app::addSourceOptions(cli, opts.source, list);
+    kfd::app::addSourceOptions(cli, opts.source, list, opts.laser_only,
+                               " (the output keeps it)");
     cli.option("--removed-as", removed_as, "bag output: removed points as nan or inf (REP 117)")
         ->type_name("MARK")
         ->check(CLI::IsMember({"nan", "inf"}))

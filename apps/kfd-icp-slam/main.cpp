@@ -32,7 +32,9 @@ int main(int argc, char** argv) {
         ->type_name("FILE");
     cli.option("-i,--rawlog", o.rawlog, "input log (default: [MappingApplication] rawlog_file)")
         ->type_name("FILE");
-    kfd::app::addSourceOptions(cli, o.source, list);
+    kfd::app::addSourceOptions(cli, o.source, list, o.laser_only,
+                               "; nor does ICP-SLAM get any (what a robot\nwithout wheel "
+                               "odometry sees)");
     cli.option("-o,--out", o.output_dir,
                "output folder (default: [MappingApplication] "
                "logOutput_dir)")
@@ -63,9 +65,6 @@ int main(int argc, char** argv) {
     cli.option("--skip-scans", o.skip_scans,
                "skip the first K scans of the log (repeats that start later)")
         ->type_name("K");
-    cli.flag("--laser-only", o.laser_only,
-             "ignore odometry: neither the pre-filter nor ICP-SLAM gets any\n"
-             "(what a robot without wheel odometry sees)");
     cli.option("--split-seconds", o.split_seconds,
                "relations over at most S s are local, the others long")
         ->type_name("S")
@@ -116,6 +115,15 @@ int main(int argc, char** argv) {
             "  time       pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s, "
             "wall %.2f s\n",
             s.prefilter_us_per_scan, s.icp_ms_per_scan, s.cpu_s_total, s.wall_s_total);
+        if (s.icp_runs)
+            std::printf("  ICP        %zu corrections, %zu rejected, median goodness %.2f\n",
+                        s.icp_runs, s.icp_rejected, s.icp_goodness_median);
+        if (!s.lost_track_stamps.empty())
+            std::printf(
+                "  WARNING    %zu suspected lost track%s (%zu ICP corrections rejected in a row), "
+                "first at t = %.3f s: see report.md and scans.csv's icp_goodness\n",
+                s.lost_track_stamps.size(), s.lost_track_stamps.size() == 1 ? "" : "s",
+                kfd::kLostTrackRejections, s.lost_track_stamps.front());
         if (s.ate_rmse) std::printf("  ATE        RMSE %.4f m\n", *s.ate_rmse);
         if (s.relations) {
             const auto& r = *s.relations;

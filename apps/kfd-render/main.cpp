@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
     double stamp = std::nan(""), extent = 0.0;
     int size = 800;
     kfd::SourceOptions source_opts;
+    bool laser_only = false;
     bool list = false;
     cli.option("-i", in, "input log (rawlog, ROS 1 bag or CARMEN log)")
         ->type_name("FILE")
@@ -48,7 +49,9 @@ int main(int argc, char** argv) {
     cli.option("-c", cfg, "configuration (.ini [KFD] or .yaml); default: kfd's defaults")
         ->type_name("FILE");
     cli.option("-o", out, "output PNG")->type_name("FILE");
-    kfd::app::addSourceOptions(cli, source_opts, list);
+    kfd::app::addSourceOptions(cli, source_opts, list, laser_only,
+                               " (the denoiser's temporal evidence then\naligns the scans "
+                               "without it)");
     cli.option("--size", size, "image width and height")->type_name("PX")->capture_default_str();
     cli.option("--extent", extent, "half the visible height in metres (default: fit the scan)")
         ->type_name("M");
@@ -100,6 +103,7 @@ int main(int argc, char** argv) {
         kfd::Pipeline::Params drawn = p;
         drawn.stages = {"distance", "denoise"};
         kfd::StreamFilter door(drawn);
+        door.setLaserOnly(laser_only);
         kfd::StreamResult r;
         for (const Seen& seen : chosen) r = door.process(*seen.scan, seen.odometry);
         if (r.skipped != kfd::ScanSkipReason::None) {

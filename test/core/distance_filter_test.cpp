@@ -170,10 +170,37 @@ TEST(DistanceFilter, MatchesThePlainDoubleReferenceOnRandomScans) {
     }
 }
 
-TEST(DistanceFilter, DefaultsAreThePapersSensorLimits) {
+TEST(DistanceFilter, DefaultsAreTheScansOwnLimits) {
     const DistanceFilter f;
-    EXPECT_DOUBLE_EQ(f.params().min_range, 0.1);
-    EXPECT_DOUBLE_EQ(f.params().max_range, 30.0);
+    EXPECT_DOUBLE_EQ(f.params().min_range, 0.0);
+    EXPECT_TRUE(std::isinf(f.params().max_range));
+    // A 45 m return of a sensor that measures to 80 m is kept (issue 22: 30 m cut aces' returns).
+    Scan scan = makeScan({0.05f, 12.0f, 45.0f, 80.0f, 81.0f});
+    scan.max_range = 80.0f;
+    const auto res = f.filter(scan);
+    EXPECT_EQ(scan.valid, (std::vector<std::uint8_t>{1, 1, 1, 1, 0}));
+    EXPECT_EQ(res.removed_out_of_range, 1u);
+    EXPECT_DOUBLE_EQ(res.max_range_used, 80.0);
+}
+
+TEST(DistanceFilter, ScanWithoutAMaximumKeepsEveryFiniteReturn) {
+    Scan scan = makeScan({0.5f, 200.0f, kInf});
+    const auto res = DistanceFilter().filter(scan);
+    EXPECT_EQ(scan.valid, (std::vector<std::uint8_t>{1, 1, 0}));
+    EXPECT_EQ(res.removed_non_finite, 1u);
+    EXPECT_TRUE(std::isinf(res.max_range_used));
+}
+
+TEST(DistanceFilter, ParameterNarrowsTheScansMaximumButNeverWidensIt) {
+    Scan narrowed = makeScan({10.0f, 29.0f, 31.0f, 50.0f});
+    narrowed.max_range = 40.0f;
+    EXPECT_EQ(makeFilter(0.0, 30.0).filter(narrowed).removed_out_of_range, 2u);
+    EXPECT_EQ(narrowed.valid, (std::vector<std::uint8_t>{1, 1, 0, 0}));
+    Scan wider = makeScan({10.0f, 29.0f, 31.0f, 50.0f});
+    wider.max_range = 20.0f;
+    const auto res = makeFilter(0.0, 30.0).filter(wider);
+    EXPECT_EQ(wider.valid, (std::vector<std::uint8_t>{1, 0, 0, 0}));
+    EXPECT_DOUBLE_EQ(res.max_range_used, 20.0);
 }
 
 TEST(DistanceFilter, RejectsInconsistentParams) {
@@ -184,7 +211,7 @@ TEST(DistanceFilter, RejectsInconsistentParams) {
     EXPECT_THROW(f.initialize({nan, 30.0}), kfd::ParameterError);
     EXPECT_THROW(f.initialize({1.0, 1.0}), kfd::ParameterError);
     EXPECT_THROW(f.initialize({2.0, 1.0}), kfd::ParameterError);
-    EXPECT_THROW(f.initialize({0.1, inf}), kfd::ParameterError);
+    EXPECT_NO_THROW(f.initialize({0.1, inf}));  // +inf: the scan's own maximum
     EXPECT_THROW(f.initialize({0.1, nan}), kfd::ParameterError);
     EXPECT_NO_THROW(f.initialize({0.0, 1.0}));
     EXPECT_DOUBLE_EQ(f.params().min_range, 0.0);

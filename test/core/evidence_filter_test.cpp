@@ -75,6 +75,55 @@ TEST(EvidenceFilter, APersistentThinObjectIsKept) {
     EXPECT_EQ(r.points_removed, 0u);
 }
 
+TEST(EvidenceFilter, ReferencesThatContradictTooMuchOfAScanAreStale) {
+    // The keyframe saw a wall at 4 m; odometry says the robot did not move, but the scan shows
+    // a wall at 2 m across the whole view (odometry that lied, a turn): every return lies in
+    // space the keyframe saw through. That is stale references, not noise (issue 22).
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    Scan second = test::flatWall(361, deg2rad(150.0), 2.0);
+    second.odometry = Pose2D{};
+    const auto r = f.filter(second, c);
+    EXPECT_TRUE(r.stale_references);
+    EXPECT_FALSE(r.capped);
+    EXPECT_GT(r.removal_wanted, 300u);
+    EXPECT_EQ(r.points_removed, 0u);  // spatially one wall: nothing small
+    EXPECT_EQ(second.countValid(), 361u);
+}
+
+TEST(EvidenceFilter, RemovalIsCappedSmallestSegmentsFirst) {
+    // 30 lone returns and one pair, all small and unsupported (no keyframe yet): 32 returns,
+    // above 5 % of 361 (18). The 18 lone returns of the farthest ranges go, nothing else.
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan s = room(std::nullopt);
+    for (std::size_t k = 0; k < 30; ++k) test::insertSpike(s, 15 + 10 * k, 1.5 + 0.01 * k);
+    test::setRange(s, 330, 331, 1.0);
+    const auto r = f.filter(s, c);
+    EXPECT_FALSE(r.stale_references);
+    EXPECT_TRUE(r.capped);
+    EXPECT_EQ(r.removal_wanted, 32u);
+    EXPECT_EQ(r.points_removed, 18u);
+    EXPECT_EQ(s.valid[330], 1);
+    EXPECT_EQ(s.valid[331], 1);
+    for (std::size_t k = 0; k < 30; ++k)
+        EXPECT_EQ(s.valid[15 + 10 * k], k >= 12 ? 0 : 1) << k;  // the farthest 18
+}
+
+TEST(EvidenceFilter, NoBoundRemovesEverySmallSegment) {
+    EvidenceFilter::Params p = exact();
+    p.max_removed_fraction = 1.0;
+    EvidenceFilter f(p);
+    Clusters c;
+    Scan s = room(std::nullopt);
+    for (std::size_t k = 0; k < 30; ++k) test::insertSpike(s, 15 + 10 * k, 1.5 + 0.01 * k);
+    const auto r = f.filter(s, c);
+    EXPECT_FALSE(r.capped);
+    EXPECT_EQ(r.points_removed, 30u);
+}
+
 TEST(EvidenceFilter, WithoutAPreviousKeyframeOnlyLoneReturnsAreRemoved) {
     EvidenceFilter f(exact());
     Clusters c;
@@ -208,6 +257,8 @@ TEST(EvidenceFilter, BadParametersAreRejected) {
     bad([](auto& p) { p.moving_object_m = std::numeric_limits<double>::infinity(); });
     bad([](auto& p) { p.max_step_m = 0.0; });
     bad([](auto& p) { p.refine_samples = 0; });
+    bad([](auto& p) { p.max_removed_fraction = 0.0; });
+    bad([](auto& p) { p.max_removed_fraction = 1.5; });
 }
 
 TEST(EvidenceFilter, DegenerateScansAreHandled) {

@@ -24,8 +24,8 @@ using test::noisyWall;
 
 TEST(StageRegistry, CoreRegistryHoldsThePapersStagesInOrder) {
     const auto& r = coreStageRegistry();
-    EXPECT_EQ(r.names(), "distance, keyframe, denoise");
-    ASSERT_EQ(r.stages().size(), 3u);
+    EXPECT_EQ(r.names(), "distance, keyframe, denoise, odometry_check");
+    ASSERT_EQ(r.stages().size(), 4u);
     for (const auto& s : r.stages()) {
         EXPECT_FALSE(s.help.empty()) << s.name;
         EXPECT_FALSE(s.keys.empty()) << s.name;
@@ -50,7 +50,10 @@ TEST(StageRegistry, EachStageOwnsItsKeys) {
             "variant", "rings", "ring_r_max", "angle_gap_factor", "merge_distance_m", "m_threshold",
             "jump_lambda_deg", "jump_sigma_m", "min_object_size_m", "min_points_floor",
             "incidence_deg", "sigma_m", "max_gap_beams", "max_small_points", "temporal",
-            "pose_trans_error_m", "pose_rot_error_deg", "motion_error_fraction"}));
+            "pose_trans_error_m", "pose_rot_error_deg", "motion_error_fraction",
+            "max_removed_fraction"}));
+    EXPECT_EQ(keyNames(*r.find("odometry_check")),
+              (std::vector<std::string>{"frozen_changed_fraction", "jump_margin"}));
 }
 
 TEST(StageRegistry, KeysParseRangeCheckAndPrintBack) {
@@ -80,6 +83,24 @@ TEST(StageRegistry, KeysParseRangeCheckAndPrintBack) {
     EXPECT_THROW(p_pair->set(sp.data(), "inf"), ParameterError);
 }
 
+TEST(StageRegistry, MaxRangeKeyTakesScanOrANumber) {
+    const StageInfo& d = *coreStageRegistry().find("distance");
+    PipelineParams p;
+    StageParams& sp = p.at(d);
+    const StageKey* max = d.keyForField("max_range");
+    ASSERT_NE(max, nullptr);
+    EXPECT_EQ(max->get(sp.data()), "scan");  // the default: the scan's own maximum
+    max->set(sp.data(), "25");
+    EXPECT_DOUBLE_EQ(p.get<DistanceStage>().max_range, 25.0);
+    EXPECT_EQ(max->get(sp.data()), "25");
+    max->set(sp.data(), "scan");
+    EXPECT_TRUE(std::isinf(p.get<DistanceStage>().max_range));
+    EXPECT_THROW(max->set(sp.data(), "inf"), ParameterError);
+    EXPECT_THROW(max->set(sp.data(), "0"), ParameterError);
+    EXPECT_THROW(max->set(sp.data(), "Scan"), ParameterError);
+    EXPECT_NE(max->range.find("scan"), std::string::npos) << max->range;
+}
+
 TEST(StageRegistry, AngleGapKeySetsBothVariants) {
     const StageInfo& dn = *coreStageRegistry().find("denoise");
     PipelineParams p;
@@ -94,7 +115,7 @@ TEST(StageRegistry, RejectsRepeatedAndEmptyNames) {
     EXPECT_THROW(r.add<KeyframeStage>(), Error);
     StageInfo nameless;
     EXPECT_THROW(r.add(nameless), Error);
-    EXPECT_EQ(r.stages().size(), 3u);
+    EXPECT_EQ(r.stages().size(), 4u);
 }
 
 TEST(PipelineParams, TypedAccessCopiesAndDefaults) {

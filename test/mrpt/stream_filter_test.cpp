@@ -90,8 +90,9 @@ TEST(StreamFilter, ResetsWhenGeometryChanges) {
 TEST(StreamFilter, CleansInPlaceKeepingBeamsAndRanges) {
     kfd::StreamFilter f(paperParams());
     auto s = roomScan(361, M_PI, 3.0);
+    s.maxRange = 30.0f;                // the sensor's maximum: Algorithm 1's default limit
     s.setScanRange(100, 1.0f);         // an isolated spike
-    s.setScanRange(200, 50.0f);        // beyond max_range
+    s.setScanRange(200, 50.0f);        // beyond it
     s.setScanRangeValidity(7, false);  // invalid on input: never made valid again
     const auto before = s;
     const auto r = f.process(s);

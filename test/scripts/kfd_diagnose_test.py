@@ -23,9 +23,10 @@ def write_run(folder, kept, x_of):
         # kfd-icp-slam's scans.csv (the per-scan columns of kfd/mrpt/scan_csv.h)
         f.write("index,timestamp,sensor,kept,reason,p_common,p_threshold,references,points_in,"
                 "removed_range,clusters,noise_clusters,removed_noise,points_out,microseconds,"
-                "view_change,changed_fraction,degeneracy,corridor,odom_x,odom_y,odom_phi,x,y,phi\n")
+                "view_change,changed_fraction,degeneracy,corridor,denoise_bound,odometry_check,icp_goodness,odom_x,odom_y,"
+                "odom_phi,x,y,phi\n")
         for i in range(N):
-            f.write("%d,%.6f,LASER,%d,r,0,0,0,10,0,0,0,0,10,1,0,0,1,0,,,,%f,0,0\n"
+            f.write("%d,%.6f,LASER,%d,r,0,0,0,10,0,0,0,0,10,1,0,0,1,0,none,none,,,,,%f,0,0\n"
                     % (i, 100 + 0.2 * i, kept(i), x_of(i)))
     with open(os.path.join(folder, "trajectory.tum"), "w") as f:
         f.write("# timestamp x y z qx qy qz qw\n")

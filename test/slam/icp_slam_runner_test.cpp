@@ -144,20 +144,36 @@ TEST(IcpSlamRunner, ScansCsvIsTheDoorsRecordWithThePose) {
     ASSERT_FALSE(slam.empty());
     ASSERT_FALSE(filter.empty());
     EXPECT_EQ(slam[0], filter[0]);  // one column set
-    ASSERT_EQ(slam[0].size(), 25u);
+    ASSERT_EQ(slam[0].size(), 28u);
     EXPECT_EQ(slam[0][3], "kept");
-    EXPECT_EQ(slam[0][22], "x");
-    std::size_t kept = 0;
+    EXPECT_EQ(slam[0][21], "icp_goodness");
+    EXPECT_EQ(slam[0][25], "x");
+    std::size_t kept = 0, corrected = 0, rejected = 0;
     for (std::size_t i = 1; i < slam.size(); ++i) {
-        ASSERT_EQ(slam[i].size(), 25u) << i;
+        ASSERT_EQ(slam[i].size(), 28u) << i;
         kept += slam[i][3] == "1";
-        EXPECT_FALSE(slam[i][22].empty()) << i;  // the SLAM pose
+        EXPECT_FALSE(slam[i][25].empty()) << i;  // the SLAM pose
+        const std::string& g = slam[i][21];
+        if (g.empty()) continue;
+        EXPECT_EQ(slam[i][3], "1") << i;  // only kept scans reach ICP
+        ++corrected;
+        rejected += g.back() == 'r';
+        const double v = std::stod(g);
+        EXPECT_GE(v, 0.0) << i;
+        EXPECT_LE(v, 1.0) << i;
     }
     EXPECT_EQ(kept, s.scans_kept);
     EXPECT_EQ(slam.size(), s.scans_in + 1);
+    // ICP's goodness of every correction, from the map builder's log.
+    EXPECT_GT(corrected, 10u);
+    EXPECT_EQ(corrected, s.icp_runs);
+    EXPECT_EQ(rejected, s.icp_rejected);
+    EXPECT_GT(s.icp_goodness_median, 0.4);
+    EXPECT_LE(s.icp_goodness_median, 1.0);
     for (std::size_t i = 1; i < filter.size(); ++i) {
-        ASSERT_EQ(filter[i].size(), 25u) << i;
-        EXPECT_TRUE(filter[i][22].empty()) << i;  // kfd-filter has no SLAM pose
+        ASSERT_EQ(filter[i].size(), 28u) << i;
+        EXPECT_TRUE(filter[i][25].empty()) << i;  // kfd-filter has no SLAM pose
+        EXPECT_TRUE(filter[i][21].empty()) << i;  // nor ICP
     }
     EXPECT_EQ(filter.size(), f.scans_in + 1);
     // The same counters: the scans both drivers gave the door add up alike.

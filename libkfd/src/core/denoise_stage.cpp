@@ -86,7 +86,10 @@ std::vector<StageKey> DenoiseStage::keys() {
                       [](P& p) -> double& { return p.evidence.pose_rot_error_deg; }),
         keys::real<P>("motion_error_fraction", "motion_error_fraction",
                       "evidence: odometry error per metre and per radian of the step", 0, 10, false,
-                      [](P& p) -> double& { return p.evidence.motion_error_fraction; })};
+                      [](P& p) -> double& { return p.evidence.motion_error_fraction; }),
+        keys::real<P>("max_removed_fraction", "max_removed_fraction",
+                      "evidence: largest share of a scan's valid returns removed (step 5)", 0, 1,
+                      true, [](P& p) -> double& { return p.evidence.max_removed_fraction; })};
 }
 
 }  // namespace kfd

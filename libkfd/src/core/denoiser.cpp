@@ -59,6 +59,8 @@ Denoiser::Result Denoiser::filter(Scan& scan) {
         res.temporal = r.temporal;
         res.sigma = r.sigma;
         res.free_points = r.free_points;
+        res.stale_references = r.stale_references;
+        res.capped = r.capped;
     } else if (params_.variant == DenoiseVariant::Reference) {
         const auto r = reference_.cluster(scan, clusters_);
         res.blocks = r.blocks;

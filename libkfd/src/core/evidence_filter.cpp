@@ -72,6 +72,8 @@ void EvidenceFilter::initialize(const Params& p) {
     if (p.refine_iterations > 20 || p.refine_samples < 1 || !(p.refine_gate_m > 0.0) ||
         !std::isfinite(p.refine_gate_m))
         throw ParameterError("refine", "refine_iterations <= 20, refine_samples >= 1, gate > 0");
+    if (!(p.max_removed_fraction > 0.0 && p.max_removed_fraction <= 1.0))
+        throw ParameterError("max_removed_fraction", "max_removed_fraction must be in (0, 1]");
     params_ = p;
     lambda_ = p.incidence_deg * kDeg;
     reset();
@@ -442,20 +444,24 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     res.temporal = temporalEvidence(scan, out, sigma, res);
 
     // 4. Segments: small and unsupported, or mostly in free space.
-    for (std::size_t c = 0; c < out.count(); ++c) {
-        const double r = std::max(0.05, static_cast<double>(out.mean_range[c]));
-        const double need = res_ > 0.0f ? std::ceil(params_.min_object_size_m / (r * res_)) : 1.0;
-        const auto bar = static_cast<std::size_t>(
-            std::min(static_cast<double>(params_.max_small_points) + 1.0, std::max(2.0, need)));
-        const bool small = out.size[c] < bar;
-        const bool supported = res.temporal && supported_in_[c] > 0;
-        const bool free =
-            res.temporal && classified_in_[c] > 0 && 2 * free_in_[c] >= classified_in_[c];
-        if ((small && !supported) || free) {
-            out.noise[c] = 1;
-            res.small_segments += small;
+    const std::size_t valid_in = scan.countValid();
+    const auto cap = static_cast<std::size_t>(
+        std::floor(params_.max_removed_fraction * static_cast<double>(valid_in)));
+    res.removal_wanted = markNoise(out, res.temporal, evidence_);
+    // 5. Bounded removal: more than the bound disagrees with the references: they are stale.
+    bool temporal = res.temporal;
+    if (res.removal_wanted > cap && temporal) {
+        res.stale_references = true;
+        temporal = false;
+        if (markNoise(out, false, evidence_) > cap) {
+            capNoise(out, cap);
+            res.capped = true;
         }
+    } else if (res.removal_wanted > cap) {
+        capNoise(out, cap);
+        res.capped = true;
     }
+    for (std::size_t c = 0; c < out.count(); ++c) res.small_segments += out.noise[c] & small_[c];
     // The previous keyframe for the next scan keeps every return (removed ones too: a thin
     // object removed once as unsupported must still support the next view).
     keepAsReference(scan);  // swaps evidence_, x_, y_, link_ away: use the reference's below
@@ -466,12 +472,54 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     for (std::size_t i = 0; i < n; ++i) {
         if (out.label[i] < 0) continue;
         if (out.noise[static_cast<std::size_t>(out.label[i])] ||
-            (kept_ev[i] == kFree && !line_[i])) {
+            (temporal && kept_ev[i] == kFree && !line_[i])) {
             scan.valid[i] = 0;
             ++res.points_removed;
         }
     }
     return res;
+}
+
+std::size_t EvidenceFilter::markNoise(Clusters& out, bool temporal,
+                                      const std::vector<std::uint8_t>& ev) {
+    small_.resize(out.count());
+    for (std::size_t c = 0; c < out.count(); ++c) {
+        const double r = std::max(0.05, static_cast<double>(out.mean_range[c]));
+        const double need = res_ > 0.0f ? std::ceil(params_.min_object_size_m / (r * res_)) : 1.0;
+        const auto bar = static_cast<std::size_t>(
+            std::min(static_cast<double>(params_.max_small_points) + 1.0, std::max(2.0, need)));
+        const bool small = out.size[c] < bar;
+        const bool supported = temporal && supported_in_[c] > 0;
+        const bool free =
+            temporal && classified_in_[c] > 0 && 2 * free_in_[c] >= classified_in_[c];
+        out.noise[c] = (small && !supported) || free ? 1 : 0;
+        small_[c] = small ? 1 : 0;
+    }
+    std::size_t removed = 0;
+    for (std::size_t i = 0; i < out.label.size(); ++i) {
+        if (out.label[i] < 0) continue;
+        removed += out.noise[static_cast<std::size_t>(out.label[i])] ||
+                   (temporal && ev[i] == kFree && !line_[i]);
+    }
+    return removed;
+}
+
+void EvidenceFilter::capNoise(Clusters& out, std::size_t cap) {
+    order_.clear();
+    for (std::size_t c = 0; c < out.count(); ++c)
+        if (out.noise[c]) order_.push_back(static_cast<std::uint32_t>(c));
+    // Smallest first; among equals the farthest (fewest returns expected of an object there).
+    std::sort(order_.begin(), order_.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return out.size[a] != out.size[b] ? out.size[a] < out.size[b]
+                                           : out.mean_range[a] > out.mean_range[b];
+    });
+    std::size_t removed = 0;
+    for (const std::uint32_t c : order_) {
+        if (removed + out.size[c] <= cap)
+            removed += out.size[c];
+        else
+            out.noise[c] = 0;
+    }
 }
 
 }  // namespace kfd

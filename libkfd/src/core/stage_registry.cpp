@@ -3,6 +3,7 @@
 #include "kfd/core/denoise_stage.h"
 #include "kfd/core/distance_stage.h"
 #include "kfd/core/keyframe_stage.h"
+#include "kfd/core/odometry_check_stage.h"
 
 namespace kfd {
 
@@ -37,6 +38,7 @@ void registerCoreStages(StageRegistry& registry) {
     registry.add<DistanceStage>();
     registry.add<KeyframeStage>();
     registry.add<DenoiseStage>();
+    registry.add<OdometryCheckStage>();  // kfd's, beyond the paper
 }
 
 StageRegistry makeStageRegistry(std::initializer_list<void (*)(StageRegistry&)> registrars) {

@@ -55,7 +55,9 @@ decltype(auto) asRawlogError(Fn&& fn, const std::string& field = {}) {
 class Run {
   public:
     Run(const RawlogFilterOptions& o, RawlogFilterSummary& s)
-        : opts_(o), sum_(s), filter_(o.pipeline) {}
+        : opts_(o), sum_(s), filter_(o.pipeline) {
+        filter_.setLaserOnly(o.laser_only);
+    }
 
     void execute() {
         const auto t0 = std::chrono::steady_clock::now();

@@ -1,6 +1,8 @@
 #include "kfd/mrpt/scan_adapter.h"
 
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 
 #include "kfd/mrpt/source.h"
@@ -29,6 +31,9 @@ void toCore(const mrpt::obs::CObservation2DRangeScan& obs, Scan& out) {
     for (std::size_t i = 0; i < n; ++i) valid[i] = obs.getScanRangeValidity(i) ? 1 : 0;
     out.timestamp = stampOf(obs);
     out.sensor_pose = Pose2D{obs.sensorPose.x(), obs.sensorPose.y(), obs.sensorPose.yaw()};
+    out.max_range = obs.maxRange > 0.0f && std::isfinite(obs.maxRange)
+                        ? obs.maxRange
+                        : std::numeric_limits<float>::infinity();
 }
 
 }  // namespace kfd

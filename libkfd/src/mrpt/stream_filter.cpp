@@ -1,5 +1,6 @@
 #include "kfd/mrpt/stream_filter.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -53,7 +54,7 @@ StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
     ScanRecord& rec = res.record;
     rec.index = counters_.scans_in++;
     rec.sensor = obs.sensorLabel;
-    rec.odometry = odometry;
+    if (!laser_only_) rec.odometry = odometry;
     // The check converts into a spare buffer; the scan's sensor (and its pipeline) is looked up
     // only once the scan is known to be usable, and takes the buffer by a swap (no copy).
     const ScanCheck check = checkScan(obs, &rec.odometry, spare_scan_);
@@ -123,6 +124,14 @@ void StreamFilter::record(StreamResult& res) {
     rec.clusters = n.clusters;
     rec.noise_clusters = n.noise_clusters;
     rec.removed_noise = rep.noiseRemoved();
+    if (const auto* o = rep.find<OdometryCheck::Result>()) {
+        rec.odometry_check = o->verdict;
+        counters_.scans_odometry_frozen += o->verdict == OdometryVerdict::Frozen;
+        counters_.scans_odometry_jump += o->verdict == OdometryVerdict::Jump;
+    }
+    rec.denoise_bound = n.capped             ? DenoiseBound::Capped
+                        : n.stale_references ? DenoiseBound::StaleReferences
+                                             : DenoiseBound::None;
     rec.points_out = rep.points_out;
     rec.microseconds = rep.microseconds;
 
@@ -137,6 +146,13 @@ void StreamFilter::record(StreamResult& res) {
         ++c.scans_kept;
         c.points_removed_range += rec.removed_range;
         c.points_removed_noise += rec.removed_noise;
+        c.scans_denoise_stale += rec.denoise_bound == DenoiseBound::StaleReferences;
+        c.scans_denoise_capped += rec.denoise_bound == DenoiseBound::Capped;
+        const std::size_t usable = rep.points_in - rec.removed_range;
+        if (usable > 0)
+            c.max_removed_noise_share =
+                std::max(c.max_removed_noise_share, static_cast<double>(rec.removed_noise) /
+                                                        static_cast<double>(usable));
         c.points_removed += rep.points_in - rep.points_out;
     } else {
         ++c.scans_dropped;

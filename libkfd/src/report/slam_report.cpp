@@ -41,6 +41,19 @@ std::string reportMarkdown(const IcpSlamSummary& sum) {
         "- time: pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s\n",
         sum.scans_in, sum.scans_kept, sum.dropped_pct, sum.points_removed, sum.points_in,
         sum.prefilter_us_per_scan, sum.icp_ms_per_scan, sum.cpu_s_total);
+    if (sum.icp_runs)
+        r += format("- ICP: %zu corrections, %zu rejected (goodness below the minimum), median "
+                    "goodness %.2f\n",
+                    sum.icp_runs, sum.icp_rejected, sum.icp_goodness_median);
+    if (!sum.lost_track_stamps.empty()) {
+        r += format("- **%zu suspected lost track%s** (%zu ICP corrections rejected in a row: the "
+                    "pose then follows odometry alone and the map is not updated), from t =",
+                    sum.lost_track_stamps.size(), sum.lost_track_stamps.size() == 1 ? "" : "s",
+                    kLostTrackRejections);
+        for (std::size_t i = 0; i < sum.lost_track_stamps.size() && i < 10; ++i)
+            r += format("%s %.3f", i ? "," : "", sum.lost_track_stamps[i]);
+        r += sum.lost_track_stamps.size() > 10 ? ", ... s\n" : " s\n";
+    }
     if (sum.scans_corridor)
         r += format("- corridor switch: %zu scans degenerate (orange in the figure)\n",
                     sum.scans_corridor);
@@ -177,6 +190,17 @@ std::string toJson(const IcpSlamSummary& s) {
     j["odometry_bad"] = s.odometry_bad;
     j["points_in"] = s.points_in;
     j["points_removed"] = s.points_removed;
+    j["points_removed_noise"] = s.points_removed_noise;
+    j["max_removed_noise_share"] = s.max_removed_noise_share;  // of a kept scan's valid returns
+    j["icp_runs"] = s.icp_runs;
+    j["icp_rejected"] = s.icp_rejected;
+    j["icp_goodness_median"] = s.icp_goodness_median;
+    j["lost_tracks_suspected"] = s.lost_track_stamps.size();
+    j["lost_track_stamps"] = s.lost_track_stamps;
+    j["scans_odometry_frozen"] = s.scans_odometry_frozen;
+    j["scans_odometry_jump"] = s.scans_odometry_jump;
+    j["scans_denoise_stale"] = s.scans_denoise_stale;
+    j["scans_denoise_capped"] = s.scans_denoise_capped;
     j["prefilter_us_per_scan"] = s.prefilter_us_per_scan;
     j["icp_ms_per_scan"] = s.icp_ms_per_scan;
     j["icp_ms_per_kept_scan"] = s.icp_ms_per_kept_scan;

@@ -73,6 +73,7 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
     const auto labels = readLabels(labels_csv);
     const auto source = openSource(rawlog);
     StreamFilter filter(pipeline);
+    filter.setLaserOnly(laser_only);
     DenoiseQuality q;
     std::vector<std::uint8_t> before;
     std::vector<NoiseKind> kind;
@@ -90,7 +91,7 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
                 kind[l.beam] = l.kind;
                 model[l.beam] = l.model;
             }
-        const auto r = filter.process(*scan, laser_only ? std::nullopt : e.odometry);
+        const auto r = filter.process(*scan, e.odometry);
         q.microseconds += r.report.microseconds;
         for (std::size_t i = 0; i < n; ++i) {
             if (!before[i]) continue;

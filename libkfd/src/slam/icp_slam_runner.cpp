@@ -12,7 +12,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
+#include <cstdlib>
 #include <ctime>
+#include <string_view>
 #include <filesystem>
 #include <fstream>
 
@@ -188,9 +191,10 @@ std::vector<ScanStamp> scanOdometry(const std::string& rawlog, const SourceOptio
 double pipelineDropPct(const std::string& rawlog, const SourceOptions& options,
                        const Pipeline::Params& pipeline, std::size_t skip_scans, bool laser_only) {
     StreamFilter filter(pipeline);
+    filter.setLaserOnly(laser_only);
     forEachRunScan(rawlog, options, skip_scans,
                    [&](CObservation2DRangeScan& scan, std::optional<Pose2D> odo) {
-                       filter.process(scan, laser_only ? std::nullopt : odo);
+                       filter.process(scan, odo);
                    });
     return filter.counters().notKeptPercent();
 }
@@ -236,6 +240,7 @@ class Run {
         matchDropRate();
         readGroundTruth();
         StreamFilter prefilter(sum_.pipeline);
+        prefilter.setLaserOnly(opts_.laser_only);
         prefilter_ = &prefilter;
         initBuilder();
         openOutputs();
@@ -282,7 +287,59 @@ class Run {
     mrpt::obs::CActionCollection no_odometry_;  // laser_only: what the builder gets (empty)
     mrpt::obs::CActionCollection finite_actions_;
     bool origin_set_ = false;  // the first absolute odometry set res_.map_origin
+    // ICP's correction of the current step, from the builder's log (onBuilderLog).
+    void onBuilderLog(std::string_view msg);
+    void noteIcp();
+    std::optional<double> step_goodness_;
+    bool step_rejected_ = false;
+    std::vector<double> goodness_;    // every correction's
+    std::size_t rejected_streak_ = 0;
+    double streak_start_ = 0.0;
 };
+
+// MRPT's map builder says how each ICP correction went only in its log: "Fit:%.1f%%" when
+// accepted, "Ignoring ICP of low quality: X" (X in %) when rejected.
+void Run::onBuilderLog(std::string_view msg) {
+    const auto number_after = [&](std::string_view key) -> std::optional<double> {
+        const auto at = msg.find(key);
+        if (at == std::string_view::npos) return std::nullopt;
+        const std::string rest(msg.substr(at + key.size(), 32));
+        char* end = nullptr;
+        const double v = std::strtod(rest.c_str(), &end);
+        if (end == rest.c_str() || !std::isfinite(v)) return std::nullopt;
+        return v / 100.0;
+    };
+    if (const auto fit = number_after("Fit:")) {
+        step_goodness_ = *fit;
+        step_rejected_ = false;
+    } else if (const auto low = number_after("Ignoring ICP of low quality:")) {
+        step_goodness_ = *low;
+        step_rejected_ = true;
+    }
+}
+
+// The step's correction, if ICP ran: counted, and a streak of rejections is a suspected lost
+// track (its first rejection's stamp).
+void Run::noteIcp() {
+    if (!step_goodness_) return;
+    const double stamp = step_scans_.empty() ? 0.0 : stampForOutput(step_scans_.back().stamp);
+    ++sum_.icp_runs;
+    goodness_.push_back(*step_goodness_);
+    if (step_rejected_) {
+        ++sum_.icp_rejected;
+        if (rejected_streak_++ == 0) streak_start_ = stamp;
+        if (rejected_streak_ == kLostTrackRejections)
+            sum_.lost_track_stamps.push_back(streak_start_);
+    } else {
+        rejected_streak_ = 0;
+    }
+    for (ScanRecord& s : step_scans_)
+        if (s.kept) {
+            s.icp_goodness = *step_goodness_;
+            s.icp_rejected = step_rejected_;
+        }
+    step_goodness_.reset();
+}
 
 // Options that contradict each other, before anything is read.
 void Run::checkOptions() {
@@ -387,6 +444,11 @@ void Run::initBuilder() {
     callMrpt(
         [&] {
             builder_.setVerbosityLevel(mrpt::system::LVL_ERROR);
+            // ICP's goodness per correction reaches kfd through the log (onBuilderLog).
+            builder_.setVerbosityLevelForCallbacks(mrpt::system::LVL_INFO);
+            builder_.logRegisterCallback([this](std::string_view msg,
+                                                mrpt::system::VerbosityLevel, std::string_view,
+                                                mrpt::Clock::time_point) { onBuilderLog(msg); });
             builder_.ICP_options.loadFromConfigFile(*cfg_, kSect);
             builder_.ICP_params.loadFromConfigFile(*cfg_, "ICP");
             builder_.initialize();
@@ -427,6 +489,7 @@ void Run::loop() {
         throwIfCancelled();
         if (!steps.feed(e, st) || e.objects_read < rawlog_offset_ || skipper.skip(st)) continue;
         step(st, e);
+        noteIcp();
         writeStep();
         ++step_no_;
         ++sum_.entries;
@@ -508,7 +571,7 @@ bool Run::toMapFrame(mrpt::obs::CObservationOdometry& odo) {
 
 // A scan through the door; true when it goes on to ICP. Its record waits for the step's pose.
 bool Run::prefilterScan(CObservation2DRangeScan& scan, const SourceEntry& e) {
-    StreamResult r = prefilter_->process(scan, opts_.laser_only ? std::nullopt : e.odometry);
+    StreamResult r = prefilter_->process(scan, e.odometry);
     step_scans_.push_back(std::move(r.record));
     return r.keep;
 }
@@ -565,6 +628,11 @@ void Run::evaluate() {
     sum_.icp_ms_per_scan = sum_.scans_in ? 1e3 * builder_s_ / scans_in : 0;
     sum_.icp_ms_per_kept_scan =
         sum_.scans_kept ? 1e3 * builder_s_ / static_cast<double>(sum_.scans_kept) : 0;
+    if (!goodness_.empty()) {
+        std::vector<double> g = goodness_;
+        std::nth_element(g.begin(), g.begin() + static_cast<std::ptrdiff_t>(g.size() / 2), g.end());
+        sum_.icp_goodness_median = g[g.size() / 2];
+    }
     if (opts_.write_map) {
         res_.map.emplace();
         builder_.getCurrentlyBuiltMap(*res_.map);

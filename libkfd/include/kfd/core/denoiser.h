@@ -56,6 +56,8 @@ class Denoiser {
         double theta_threshold = 0.0;    // rad
         double sigma = 0.0;              // m, evidence: range noise estimated from the scan
         std::size_t free_points = 0;     // evidence: returns the previous keyframe saw through
+        bool stale_references = false;   // evidence: bound on removal ignored its references
+        bool capped = false;             // evidence: removal cut to the bound
     };
 
     Denoiser() { initialize(Params{}); }

@@ -53,6 +53,11 @@ namespace kfd {
 ///     min_object_size_m returns at its range, clamped to [1, max_small_points]: single beams
 ///     at 5 m on a 1-degree scanner, up to 3 at 1 m on a 0.25-degree one. Without temporal
 ///     evidence (first scan, too large a step, a new geometry) only small segments go.
+///  5. Bounded removal (issue 22): when the removals of step 4 exceed max_removed_fraction of
+///     the scan's valid returns, the references are stale (a turn or a walk away, odometry
+///     that lied), not the scan: step 4 runs again without temporal evidence. When even that
+///     exceeds the bound, the smallest segments go first until the bound is reached. Both are
+///     reported (Result::stale_references, Result::capped).
 class EvidenceFilter {
   public:
     struct Params {
@@ -75,6 +80,9 @@ class EvidenceFilter {
         std::size_t refine_iterations = 3;   // Gauss-Newton steps aligning to the keyframe
         std::size_t refine_samples = 128;    // returns used per step (every n/128-th)
         double refine_gate_m = 1.0;          // m: pairing gate of the first step (halved after)
+        /// Largest share of a scan's valid returns removed (step 5), in (0, 1]; 1 = no bound.
+        /// 5 %: issue 22's bound; real bursts cover 0.3-1.2 % of a log's returns (RESULTS).
+        double max_removed_fraction = 0.05;
     };
 
     struct Result {
@@ -87,6 +95,9 @@ class EvidenceFilter {
         bool temporal = false;           // temporal evidence was used for this scan
         bool refined = false;            // the odometry step was refined against the keyframe
         double sigma = 0.0;              // m: range noise used
+        std::size_t removal_wanted = 0;  // returns steps 1-4 would have removed
+        bool stale_references = false;   // step 5: temporal evidence ignored for this scan
+        bool capped = false;             // step 5: spatial removal cut to the bound too
     };
 
     EvidenceFilter() { initialize(Params{}); }
@@ -134,6 +145,10 @@ class EvidenceFilter {
     bool refineStep(const Scan& scan, const Reference& ref, Pose2D& d) const;
     bool trackedMotion(const Reference& ref, float qx, float qy, float rho, std::size_t k0) const;
     void keepAsReference(const Scan& scan);
+    // Step 4: marks noise segments; returns the returns it would remove (`kept_ev`: evidence).
+    std::size_t markNoise(Clusters& out, bool temporal, const std::vector<std::uint8_t>& ev);
+    // Step 5: the smallest noise segments only, up to `cap` returns.
+    void capNoise(Clusters& out, std::size_t cap);
 
     Params params_;
     double lambda_ = 0.0;
@@ -147,6 +162,8 @@ class EvidenceFilter {
     std::vector<float> sums_;             // per segment: range sum
     std::vector<std::uint32_t> unknown_;  // beams classified unknown against the newest keyframe
     std::vector<std::uint32_t> free_in_, supported_in_, classified_in_;  // per segment
+    std::vector<std::uint32_t> order_;                                    // segments by size
+    std::vector<std::uint8_t> small_;                                     // per segment: small
     double sigma_smoothed_ = -1.0;
     Reference refs_[2];  // [0] the newest keyframe
     Pose2D pose_;        // this scan's refined pose (when have_pose_)

@@ -142,6 +142,9 @@ struct Scan {
     double timestamp = std::numeric_limits<double>::quiet_NaN();  // s (any epoch), NaN = unknown
     std::optional<Pose2D> odometry;  // absolute odometry at the scan, when known
     Pose2D sensor_pose;              // the sensor on the robot (MRPT's sensorPose), m and rad
+    /// The sensor's own maximum range (m; MRPT's maxRange, a LaserScan's range_max): Algorithm
+    /// 1's default upper limit. +inf when the source does not say.
+    float max_range = std::numeric_limits<float>::infinity();
 
     std::size_t size() const { return range.size(); }
     /// Beams whose valid flag is set (vectorised: a few hundred instructions for 1081 beams).

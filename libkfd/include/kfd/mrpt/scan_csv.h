@@ -21,13 +21,19 @@ class ScanCsvError : public Error {
 ///
 ///     index,timestamp,sensor,kept,reason,p_common,p_threshold,references,points_in,
 ///     removed_range,clusters,noise_clusters,removed_noise,points_out,microseconds,
-///     view_change,changed_fraction,degeneracy,corridor,odom_x,odom_y,odom_phi,x,y,phi
+///     view_change,changed_fraction,degeneracy,corridor,denoise_bound,odometry_check,icp_goodness,odom_x,odom_y,odom_phi,
+///     x,y,phi
 ///
 /// index, timestamp (s, 0 when unknown), sensor, kept (1/0) and reason as in ScanRecord;
 /// p_common, p_threshold, references: the keyframe stage's Formula 3 values (0 without it);
 /// points_in, removed_range, clusters, noise_clusters, removed_noise, points_out: beams and
 /// clusters; microseconds: the pipeline's time; view_change, changed_fraction, degeneracy,
-/// corridor (1/0): the view selector and corridor switch; odom_x, odom_y, odom_phi: the odometry
+/// corridor (1/0): the view selector and corridor switch; denoise_bound: "none", or how the
+/// evidence denoiser's bound on removal acted ("stale_references": temporal evidence ignored,
+/// "capped": cut to the bound); odometry_check: "none" (no odometry or no check), "ok",
+/// "frozen" or "jump" (kfd/core/odometry_check.h: withheld from the stages); icp_goodness:
+/// kfd-icp-slam, ICP's goodness when it corrected this scan's pose (0-1; "r" appended when the
+/// map builder rejected the correction), else empty; odom_x, odom_y, odom_phi: the odometry
 /// the scan came with (m, m, rad; empty when unknown or --laser-only); x, y, phi: the SLAM's pose
 /// of the scan (kfd-icp-slam; empty in kfd-filter). A skipped scan's reason is
 /// "skipped:<why>", its points_in its beam count, its other numbers 0 and degeneracy 1.

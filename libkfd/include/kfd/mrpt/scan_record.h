@@ -8,9 +8,23 @@
 #include <optional>
 #include <string>
 
+#include "kfd/core/odometry_check.h"
 #include "kfd/core/scan.h"
 
 namespace kfd {
+
+/// How the evidence denoiser's bound on removal acted on a scan (EvidenceFilter step 5).
+enum class DenoiseBound {
+    None,             // removed what the evidence said (within the bound)
+    StaleReferences,  // the references disagreed with too much of the scan: spatial only
+    Capped,           // even so above the bound: the smallest segments only
+};
+/// "none", "stale_references", "capped".
+inline const char* toString(DenoiseBound b) {
+    return b == DenoiseBound::Capped            ? "capped"
+           : b == DenoiseBound::StaleReferences ? "stale_references"
+                                                : "none";
+}
 
 /// One scan as the door saw it: the row of the per-scan CSV (kfd/mrpt/scan_csv.h documents
 /// the columns). A skipped scan (bad geometry) has `skipped` set, points_in = its beam count
@@ -38,7 +52,13 @@ struct ScanRecord {
     double degeneracy = 1.0;
     bool corridor = false;           // the corridor switch found the scan degenerate
     bool corridor_keyframe = false;  // ... and made it a keyframe by odometry or time
+    DenoiseBound denoise_bound = DenoiseBound::None;  // the evidence denoiser's bound acted
+    OdometryVerdict odometry_check = OdometryVerdict::None;  // the odometry check's verdict
     std::optional<Pose2D> odometry;  // the odometry the door was given, after its check
+    /// kfd-icp-slam: ICP's goodness when the map builder corrected this (kept) scan's pose,
+    /// else NaN; icp_rejected when the builder rejected that correction (below its minimum).
+    double icp_goodness = std::numeric_limits<double>::quiet_NaN();
+    bool icp_rejected = false;
 };
 
 /// Counters of a run through the door, filled by StreamFilter::process for every scan: the
@@ -57,6 +77,12 @@ struct ScanCounters {
     std::size_t geometry_resets = 0;       // a sensor's geometry changed: its state was reset
     std::size_t scans_corridor = 0;        // scans the corridor switch found degenerate
     std::size_t keyframes_corridor = 0;    // keyframes the switch made (odometry or time)
+    std::size_t scans_odometry_frozen = 0;  // scans whose odometry stood still as they changed
+    std::size_t scans_odometry_jump = 0;    // scans whose odometry jumped where they did not
+    std::size_t scans_denoise_stale = 0;   // kept scans whose denoiser found its references stale
+    std::size_t scans_denoise_capped = 0;  // kept scans whose removal was cut to the bound
+    /// The largest share of a kept scan's valid returns the denoising stages removed (0-1).
+    double max_removed_noise_share = 0.0;
     std::size_t points_in = 0;             // valid beams of the scans that ran
     std::size_t points_removed_range = 0;  // by Algorithm 1, in kept scans
     std::size_t points_removed_noise = 0;  // by the denoising stages, in kept scans

@@ -62,6 +62,11 @@ class StreamFilter {
     /// summaries).
     const ScanCounters& counters() const { return counters_; }
 
+    /// Laser only: the odometry given to process() is ignored (kfd decides from the scans
+    /// alone; what --laser-only sets in every tool that reads logs).
+    void setLaserOnly(bool on) { laser_only_ = on; }
+    bool laserOnly() const { return laser_only_; }
+
     /// Forgets every sensor (the counters stay).
     void reset() { sensors_.clear(); }
     std::size_t sensorCount() const { return sensors_.size(); }
@@ -85,6 +90,7 @@ class StreamFilter {
     std::map<std::string, Sensor> sensors_;
     Scan spare_scan_;  // the next scan's buffer (swapped with its sensor's)
     ScanCounters counters_;
+    bool laser_only_ = false;
 };
 
 /// Empty when a run through the door had a usable scan (one that reached the pipeline); else

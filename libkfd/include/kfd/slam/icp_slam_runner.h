@@ -88,7 +88,19 @@ struct IcpSlamSummary : ScanCounters {
     std::size_t relations_local_count = 0, relations_long_count = 0;
     std::optional<double> ate_rmse;  // m, against ground_truth_tum after SE(2) alignment
     std::string relations_file;
+    /// ICP's corrections (MRPT's map builder logs each one's goodness, the share of the scan's
+    /// points matched): how many ran, how many it rejected (goodness below
+    /// minICPgoodnessToAccept: the pose then follows odometry alone) and the median goodness.
+    std::size_t icp_runs = 0, icp_rejected = 0;
+    double icp_goodness_median = 0.0;
+    /// Suspected lost tracks: kLostTrackRejections ICP corrections rejected in a row (the
+    /// builder dead-reckons and stops inserting into the map). The stamp (s) of the first
+    /// rejection of each such streak.
+    std::vector<double> lost_track_stamps;
 };
+
+/// ICP corrections rejected in a row that make a suspected lost track.
+inline constexpr std::size_t kLostTrackRejections = 3;
 
 /// Everything a run produced, for the report (kfd/report/slam_report.h) and other callers.
 struct IcpSlamResult {
