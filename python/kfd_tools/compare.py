@@ -6,7 +6,11 @@ mode) n, median, IQR and mean +- std over the runs of: the relations error split
 process CPU time (user + sys of kfd-icp-slam, from the kernel) and CPU per scan; and paired
 comparisons (runs matched by repeat): every mode against a baseline mode and named pairs, with
 wins / losses / ties, the two-sided exact sign test, the exact Wilcoxon signed-rank test and the
-median ratio with a seeded bootstrap 95 % interval. Lower is better for every metric.
+median ratio with a seeded bootstrap 95 % interval. Lower is better for every metric. It
+judges them (report.py): failed runs per mode (did not finish, or an error above F x the
+baseline's median), the worst run of each mode, a verdict per pair (better / worse / no
+significant difference, at which CPU ratio), a warning when there are too few runs for any
+p < 0.05, and the reason of every "–".
 
 Repeat K (0 ... R-1) skips the first K scans of the log (kfd-icp-slam --skip-scans K): the same
 problem, a different run of a chaotic estimator. A simulated log (sim:WORLD:SENSOR:SPEED) is
@@ -15,7 +19,7 @@ also simulated again with seed K + 1.
   kfd-compare run --logs intel aces --modes none kfd odometry@kfd --repeats 20 --out OUT
   kfd-compare run ... --emit-jobs jobs.txt      # one shell command per line, then:
   parallel -j 8 < jobs.txt                       # (or xargs -P, a Slurm array), then:
-  kfd-compare collect OUT                        # report.md, runs.csv, runs.json, plots/
+  kfd-compare collect OUT       # summary.md, report.md, runs.csv, runs.json, plots/
   kfd-compare diagnose OUT --modes kfd odometry@kfd   # where the drops cost: diagnose.md
 
 Logs: a dataset folder name under --datasets (NAME/NAME.rawlog with NAME.relations) or a path
@@ -39,7 +43,7 @@ import sys
 import time
 
 from . import diagnose as kfd_diagnose
-from . import stats as kfd_stats
+from . import report as kfd_report
 
 # The package is python/kfd_tools in the source tree (tools in build/apps) or, installed,
 # DATADIR/kfd/python/kfd_tools (tools in the prefix's bin, else on PATH).
@@ -65,14 +69,7 @@ else:
 JOB_COMMAND = ([os.environ["KFD_COMPARE_LAUNCHER"]] if os.environ.get("KFD_COMPARE_LAUNCHER")
                else [sys.executable, "-m", "kfd_tools.compare"])
 MAX_DT = {"mit-killian": 0.22}  # estimated stamps (its PROVENANCE.md)
-# (metric key, label, unit): what every table and plot reports
-METRICS = [("local", "relations error, local", "m"), ("long", "relations error, long", "m"),
-           ("all", "relations error, all", "m"), ("ate", "ATE RMSE", "m"),
-           ("drop", "dropped", "%"), ("cpu", "CPU (user+sys)", "s"),
-           ("cpu_ms_per_scan", "CPU per scan", "ms")]
-PAIR_METRICS = ["local", "long", "all", "ate", "cpu"]
-NAMED_PAIRS = [("kfd", "odometry@kfd"), ("kfd", "keyframe"), ("kfd+lo", "decimate@kfd+lo"),
-               ("kfd", "decimate@kfd")]
+METRICS = kfd_report.METRICS  # (metric key, label, unit): what every table and plot reports
 
 
 class CompareError(Exception):
@@ -191,19 +188,51 @@ def simulated_log(a, log, repeat):
     return path, path[:-len(".rawlog")] + ".gt.tum"
 
 
+def read_json(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def write_run(done, run):
+    """run.json, complete or absent (an atomic rename)."""
+    os.makedirs(os.path.dirname(done), exist_ok=True)
+    tmp = done + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump(run, f, indent=1)
+    os.replace(tmp, done)
+
+
+def run_failed(done, ident, error, command, **more):
+    """Record a run that did not finish (run.json with finished: false, counted as a failed run
+    by collect), then raise CompareError(error)."""
+    write_run(done, dict(ident, finished=False, error=error, command=command, **more))
+    raise CompareError("%s on %s %s r%d\n  %s" % (
+        error, ident["log"], ident["mode"], ident["repeat"],
+        " ".join(shlex.quote(c) for c in command)))
+
+
 def run_job(a):
     """One kfd-icp-slam run: writes run.json (the summary, kernel CPU times, the command) into
-    its run folder; a folder that already holds run.json is kept (resume)."""
+    its run folder; a folder that already holds the run.json of a finished run is kept
+    (resume). A run that fails gets a run.json with finished: false and its error (kept for
+    collect; run again on resume) and raises CompareError."""
     log = resolve_log(a.log, a.datasets)
     mode, match, laser = parse_mode(a.mode)
     folder = run_dir(a.out, log["name"], a.config, a.mode, a.repeat)
     done = os.path.join(folder, "run.json")
     if os.path.exists(done):
-        return json.load(open(done))
-    rawlog, rel, gt, seed = log.get("rawlog"), log.get("relations"), log.get("gt"), None
+        previous = read_json(done)
+        if previous.get("finished", True):
+            return previous
+    rawlog, rel, gt = log.get("rawlog"), log.get("relations"), log.get("gt")
+    ident = {"log": log["name"], "config": config_tag(a.config), "mode": a.mode,
+             "repeat": a.repeat, "seed": a.repeat + 1 if log["kind"] == "sim" else None,
+             "skip_scans": a.repeat}
     if log["kind"] == "sim":
-        rawlog, gt = simulated_log(a, log, a.repeat)
-        seed = a.repeat + 1
+        try:
+            rawlog, gt = simulated_log(a, log, a.repeat)
+        except subprocess.CalledProcessError as e:
+            run_failed(done, ident, "kfd-simulate failed (exit %d)" % e.returncode, e.cmd)
     cmd = [a.exe, a.config, rawlog, "-o", folder, "-m", mode, "-q", "--skip-scans",
            str(a.repeat), "--split-seconds", repr(a.split_seconds)] + source_args(a)
     if not a.map:
@@ -223,37 +252,36 @@ def run_job(a):
     with open(folder + ".stderr", "w") as err:
         p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err)
         _, status, ru = os.wait4(p.pid, 0)
+        p.returncode = os.waitstatus_to_exitcode(status)  # reaped here, not by Popen
     wall = time.monotonic() - t0
-    code = os.waitstatus_to_exitcode(status)
+    code = p.returncode
     if code != 0:
-        msg = open(folder + ".stderr").read().strip().splitlines()
-        raise CompareError("kfd-icp-slam failed (exit %d) on %s %s r%d: %s\n  %s" % (
-            code, log["name"], a.mode, a.repeat, msg[0] if msg else "",
-            " ".join(shlex.quote(c) for c in cmd)))
+        with open(folder + ".stderr") as f:
+            msg = f.read().strip().splitlines()
+        how = "exit %d" % code if code > 0 else "killed by signal %d" % -code
+        run_failed(done, ident, "kfd-icp-slam failed (%s): %s" % (
+            how, msg[0] if msg else "no message"), cmd, exit_code=code, wall_s=wall,
+            stderr=os.path.relpath(folder + ".stderr", a.out))
     os.remove(folder + ".stderr")
-    s = json.load(open(os.path.join(folder, "summary.json")))
+    s = read_json(os.path.join(folder, "summary.json"))
 
     def trans(key):
         r = s.get(key)
         return r.get("trans_mean_m") if r else None
 
     cpu = ru.ru_utime + ru.ru_stime - s.get("cpu_s_match", 0.0)
-    run = {"log": log["name"], "config": config_tag(a.config), "mode": a.mode,
-           "repeat": a.repeat, "seed": seed, "skip_scans": a.repeat,
-           "local": trans("relations_local"), "long": trans("relations_long"),
-           "all": trans("relations"), "ate": s.get("ate_rmse_m"), "drop": s["dropped_pct"],
-           "cpu": cpu, "cpu_ms_per_scan": 1e3 * cpu / max(1, s["scans_in"]),
-           "cpu_user_s": ru.ru_utime, "cpu_sys_s": ru.ru_stime,
-           "cpu_match_s": s.get("cpu_s_match", 0.0), "wall_s": wall,
-           "scans_in": s["scans_in"], "scans_kept": s["scans_kept"],
-           "relations_local_used": (s.get("relations_local") or {}).get("used"),
-           "relations_long_used": (s.get("relations_long") or {}).get("used"),
-           "target_drop_pct": s.get("target_drop_pct"), "laser_only": s.get("laser_only"),
-           "command": cmd}
-    tmp = done + ".tmp"
-    with open(tmp, "w") as f:
-        json.dump(run, f, indent=1)
-    os.replace(tmp, done)
+    run = dict(ident, **{
+        "local": trans("relations_local"), "long": trans("relations_long"),
+        "all": trans("relations"), "ate": s.get("ate_rmse_m"), "drop": s["dropped_pct"],
+        "cpu": cpu, "cpu_ms_per_scan": 1e3 * cpu / max(1, s["scans_in"]),
+        "cpu_user_s": ru.ru_utime, "cpu_sys_s": ru.ru_stime,
+        "cpu_match_s": s.get("cpu_s_match", 0.0), "wall_s": wall,
+        "scans_in": s["scans_in"], "scans_kept": s["scans_kept"],
+        "relations_local_used": (s.get("relations_local") or {}).get("used"),
+        "relations_long_used": (s.get("relations_long") or {}).get("used"),
+        "target_drop_pct": s.get("target_drop_pct"), "laser_only": s.get("laser_only"),
+        "finished": True, "command": cmd})
+    write_run(done, run)
     return run
 
 
@@ -311,152 +339,81 @@ def cmd_run(a):
                     el / n * (len(jobs) - n)), file=sys.stderr, flush=True)
     for j, e in failed:
         print("[kfd-compare] failed: %s" % e, file=sys.stderr)
-    collect(a.out, a.baseline, a.pairs, a.plots, a.quiet)
+    collect(a.out, a.baseline, a.pairs, a.plots, a.quiet, a.failure_factor)
     return 1 if failed else 0
 
 
 # --- collect ---------------------------------------------------------------------------------
 
 def load_runs(out):
+    """Every run under OUT/runs: its run.json (a finished run, or the record of one that
+    failed), and for a job that stopped before writing one (its rKK.stderr left, no run.json) a
+    record with finished: false; collect counts both kinds as failed runs."""
     runs = []
     base = os.path.join(out, "runs")
     if not os.path.isdir(base):
         raise CompareError("no runs under %s (run kfd-compare run first)" % base)
     for dirpath, _, files in os.walk(base):
         if "run.json" in files:
-            runs.append(json.load(open(os.path.join(dirpath, "run.json"))))
+            runs.append(read_json(os.path.join(dirpath, "run.json")))
+        for name in files:
+            if name.endswith(".stderr") and not os.path.exists(
+                    os.path.join(dirpath, name[:-len(".stderr")], "run.json")):
+                runs.append(unfinished_run(base, dirpath, name, out))
     if not runs:
         raise CompareError("no finished run under " + base)
     runs.sort(key=lambda r: (r["log"], r["config"], r["mode"], r["repeat"]))
     return runs
 
 
-def fmt(x, digits=3):
-    if x is None or (isinstance(x, float) and math.isnan(x)):
-        return "–"
-    return ("%." + str(digits) + "f") % x
+def unfinished_run(base, dirpath, name, out):
+    """The record of a job that left runs/LOG/CONFIG/MODE/rKK.stderr and no run.json."""
+    log, config, mode = os.path.relpath(dirpath, base).split(os.sep)
+    repeat = int(name[1:-len(".stderr")])
+    return {"log": log, "config": config, "mode": mode, "repeat": repeat, "skip_scans": repeat,
+            "finished": False, "stderr": os.path.relpath(os.path.join(dirpath, name), out),
+            "error": "no run.json: the job stopped before kfd-icp-slam finished (or is still "
+                     "running)"}
 
 
-def fmt_p(p):
-    return "%.2g" % p if p < 0.01 else "%.2f" % p
+fmt = kfd_report.fmt  # the report's number formats
+fmt_p = kfd_report.fmt_p
+RUN_COLUMNS = ["log", "config", "mode", "repeat", "seed", "skip_scans"] + \
+    [m for m, _, _ in METRICS] + \
+    ["cpu_user_s", "cpu_sys_s", "cpu_match_s", "wall_s", "scans_in", "scans_kept",
+     "relations_local_used", "relations_long_used", "target_drop_pct", "laser_only",
+     "finished", "failed", "failure", "folder"]
 
 
-def collect(out, baseline="none", pairs=None, plots=True, quiet=False):
+def collect(out, baseline="none", pairs=None, plots=True, quiet=False,
+            failure_factor=kfd_report.FAILURE_FACTOR):
+    """report.md, summary.md, runs.csv and runs.json (and plots/) of the runs under OUT."""
+    if not failure_factor > 0:
+        raise CompareError("--failure-factor must be > 0 (got %g)" % failure_factor)
     runs = load_runs(out)
-    by = {}
-    for r in runs:
-        by.setdefault((r["log"], r["config"]), {}).setdefault(r["mode"], {})[r["repeat"]] = r
-    # every run, CSV and JSON
-    keys = ["log", "config", "mode", "repeat", "seed", "skip_scans"] + [m for m, _, _ in METRICS] \
-        + ["cpu_user_s", "cpu_sys_s", "cpu_match_s", "wall_s", "scans_in", "scans_kept",
-           "relations_local_used", "relations_long_used", "target_drop_pct", "laser_only"]
+    groups, stats = kfd_report.analyse(runs, baseline,
+                                       [tuple(x.split(":", 1)) for x in pairs or []],
+                                       failure_factor)
     with open(os.path.join(out, "runs.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
+        w = csv.DictWriter(f, fieldnames=RUN_COLUMNS, extrasaction="ignore")
         w.writeheader()
         for r in runs:
             w.writerow(r)
-    stats = {"runs": runs, "summary": [], "pairs": []}
-    lines = ["# kfd-compare report", "",
-             "%d runs under `%s`. Medians over repeats (repeat K skips the first K scans; "
-             "simulated logs also use seed K + 1); IQR in brackets; lower is better. Paired "
-             "comparisons match runs by repeat: W/L/T = runs where the first mode is better / "
-             "worse / equal; p: two-sided exact sign test and exact Wilcoxon signed-rank test; "
-             "ratio: median of the per-run ratios first/second with a bootstrap 95 %% interval "
-             "(2000 resamples, seed 1). CPU is user + sys of kfd-icp-slam (the drop-rate "
-             "matching pre-pass excluded)." % (len(runs), out), ""]
-    for (log, config), modes in sorted(by.items()):
-        lines += ["## %s, %s" % (log, config), "",
-                  "| mode | n | dropped % | local (m) | long (m) | all (m) | ATE (m) | CPU (s) "
-                  "| CPU/scan (ms) |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
-        for mode in sorted(modes, key=lambda m: (m != baseline, m)):
-            rs = list(modes[mode].values())
-            row = {"log": log, "config": config, "mode": mode}
-            cells = []
-            for m, _, _ in METRICS:
-                s = kfd_stats.summary([r[m] for r in rs if r.get(m) is not None])
-                row[m] = s
-                d = 1 if m == "drop" else 2 if m in ("cpu", "cpu_ms_per_scan") else 3
-                cells.append("–" if s["n"] == 0 else "%s [%s–%s]" % (
-                    fmt(s["median"], d), fmt(s["q1"], d), fmt(s["q3"], d)))
-            stats["summary"].append(row)
-            lines.append("| %s | %d | %s |" % (mode, len(rs), " | ".join(
-                [cells[4], cells[0], cells[1], cells[2], cells[3], cells[5], cells[6]])))
-        lines.append("")
-        wanted = [(m, baseline) for m in sorted(modes) if m != baseline and baseline in modes]
-        for p in NAMED_PAIRS + [tuple(x.split(":", 1)) for x in (pairs or [])]:
-            if p[0] in modes and p[1] in modes and p not in wanted:
-                wanted.append(p)
-        if wanted:
-            lines += ["| A vs B | metric | n | W/L/T | p sign | p Wilcoxon | ratio A/B [95 %] |",
-                      "|---|---|---:|---:|---:|---:|---:|"]
-        for first, second in wanted:
-            common = sorted(set(modes[first]) & set(modes[second]))
-            for m in PAIR_METRICS:
-                xs = [(modes[first][k].get(m), modes[second][k].get(m)) for k in common]
-                xs = [(x, y) for x, y in xs if x is not None and y is not None]
-                if not xs:
-                    continue
-                res = kfd_stats.paired([x for x, _ in xs], [y for _, y in xs])
-                stats["pairs"].append(dict(res, log=log, config=config, a=first, b=second,
-                                           metric=m))
-                lines.append("| %s vs %s | %s | %d | %d/%d/%d | %s | %s | %s [%s–%s] |" % (
-                    first, second, m, res["n"], res["wins"], res["losses"], res["ties"],
-                    fmt_p(res["p_sign"]), fmt_p(res["p_wilcoxon"]), fmt(res["median_ratio"]),
-                    fmt(res["ratio_lo"]), fmt(res["ratio_hi"])))
-        lines.append("")
-        if plots:
-            plot(out, log, config, modes, baseline)
-            lines += ["![%s %s](plots/%s-%s.png)" % (log, config, log, config), ""]
+    if plots:
+        for g in groups:
+            plot(out, g.log, g.config, g.modes, baseline)
     with open(os.path.join(out, "runs.json"), "w") as f:
         json.dump(stats, f, indent=1)
     with open(os.path.join(out, "summary.md"), "w") as f:
-        f.write(compact(stats, baseline))
+        f.write(kfd_report.summary_md(groups, stats))
     with open(os.path.join(out, "report.md"), "w") as f:
-        f.write("\n".join(lines))
+        f.write(kfd_report.report_md(groups, stats, out, plots))
     if not quiet:
-        print("[kfd-compare] %d runs: %s, %s, %s" % (
-            len(runs), os.path.join(out, "report.md"), os.path.join(out, "runs.csv"),
-            os.path.join(out, "runs.json")), file=sys.stderr)
+        failed = sum(1 for r in runs if r["failed"])
+        print("[kfd-compare] %d runs (%d failed): %s, %s, %s, %s" % (
+            len(runs), failed, os.path.join(out, "summary.md"), os.path.join(out, "report.md"),
+            os.path.join(out, "runs.csv"), os.path.join(out, "runs.json")), file=sys.stderr)
     return stats
-
-
-def compact(stats, baseline):
-    """summary.md: per config, one row per (log, mode) with medians, and one row per (log,
-    pair) with wins/losses and sign-test p for the local, long and all relations error, ATE and
-    the CPU ratio."""
-    lines = ["# kfd-compare summary", ""]
-    configs = sorted({r["config"] for r in stats["summary"]})
-    for config in configs:
-        rows = [r for r in stats["summary"] if r["config"] == config]
-        lines += ["## %s" % config, "",
-                  "| log | mode | n | dropped % | local (m) | long (m) | ATE (m) | CPU (s) |",
-                  "|---|---|---:|---:|---:|---:|---:|---:|"]
-        for r in sorted(rows, key=lambda r: (r["log"], r["mode"] != baseline, r["mode"])):
-            def med(m, d=3):
-                return fmt(r[m]["median"], d) if r[m]["n"] else "–"
-            lines.append("| %s | %s | %d | %s | %s | %s | %s | %s |" % (
-                r["log"], r["mode"], r["drop"]["n"], med("drop", 1), med("local"), med("long"),
-                med("ate"), med("cpu", 2)))
-        lines += ["", "| log | A vs B | n | local W/L (p) | long W/L (p) | all W/L (p) | "
-                  "ATE W/L (p) | CPU ratio A/B [95 %] |", "|---|---|---:|---:|---:|---:|---:|---:|"]
-        pairs = {}
-        for p in stats["pairs"]:
-            if p["config"] == config:
-                pairs.setdefault((p["log"], p["a"], p["b"]), {})[p["metric"]] = p
-
-        def wl(p):
-            return "–" if p is None else "%d/%d (%s)" % (p["wins"], p["losses"],
-                                                         fmt_p(p["p_sign"]))
-        for (log, a, b), ms in sorted(pairs.items()):
-            c = ms.get("cpu")
-            lines.append("| %s | %s vs %s | %d | %s | %s | %s | %s | %s |" % (
-                log, a, b, max(p["n"] for p in ms.values()), wl(ms.get("local")),
-                wl(ms.get("long")), wl(ms.get("all")), wl(ms.get("ate")),
-                "–" if c is None else "%s [%s–%s]" % (fmt(c["median_ratio"], 2),
-                                                      fmt(c["ratio_lo"], 2),
-                                                      fmt(c["ratio_hi"], 2))))
-        lines.append("")
-    return "\n".join(lines)
 
 
 def plot(out, log, config, modes, baseline):
@@ -505,6 +462,10 @@ def main(argv=None):
     report = argparse.ArgumentParser(add_help=False)  # how runs are compared: run and collect
     report.add_argument("--baseline", default="none")
     report.add_argument("--pairs", nargs="*", default=[], help="more pairs A:B")
+    report.add_argument("--failure-factor", type=float, default=kfd_report.FAILURE_FACTOR,
+                        metavar="F", help="a run fails when its local or long relations error "
+                        "is above F x the baseline's median on its log and config (default %g)"
+                        % kfd_report.FAILURE_FACTOR)
     report.add_argument("--no-plots", dest="plots", action="store_false")
     report.add_argument("-q", "--quiet", action="store_true")
     r = sub.add_parser("run", parents=[tools, report], help="run (or emit) every job, then collect")
@@ -547,7 +508,7 @@ def main(argv=None):
                 f.write(text)
             sys.stdout.write(text)
             return 0
-        collect(a.dir, a.baseline, a.pairs, a.plots, a.quiet)
+        collect(a.dir, a.baseline, a.pairs, a.plots, a.quiet, a.failure_factor)
         return 0
     except (CompareError, subprocess.CalledProcessError, OSError) as e:
         print("kfd-compare: %s" % e, file=sys.stderr)

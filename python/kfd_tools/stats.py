@@ -2,6 +2,7 @@
 depend on a library version): summaries, the two-sided exact sign test, the Wilcoxon
 signed-rank test (exact, with ties and zeros) and a seeded bootstrap interval of the median
 ratio. Lower values are better everywhere (errors, CPU time)."""
+import functools
 import math
 import random
 
@@ -66,6 +67,16 @@ def sign_test(wins, losses):
     k = min(wins, losses)
     tail = sum(math.comb(n, i) for i in range(k + 1)) / 2 ** n
     return min(1.0, 2.0 * tail)
+
+
+@functools.lru_cache(maxsize=None)
+def smallest_p(n):
+    """The smallest two-sided p the exact sign test and the exact Wilcoxon signed-rank test can
+    give for n paired runs: every difference of one sign (and, for Wilcoxon, all |d| distinct).
+    When it is >= a level alpha, no difference can be significant at that level. n = 0 gives 1."""
+    if n <= 0:
+        return 1.0
+    return min(sign_test(n, 0), wilcoxon(list(range(1, n + 1)), [0] * n)[2])
 
 
 def ranks(values):

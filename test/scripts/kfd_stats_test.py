@@ -35,6 +35,16 @@ class SignTest(unittest.TestCase):
         self.assertEqual(st.wins_losses_ties([1, 2, 3, 4], [2, 2, 1, 4]), (1, 1, 2))
 
 
+class SmallestP(unittest.TestCase):
+    def test_one_sign_for_every_pair_is_the_best_either_test_can_do(self):
+        # 2 / 2^n: n = 5 cannot reach 0.05 (2/32), n = 6 can (2/64)
+        self.assertAlmostEqual(st.smallest_p(5), 2 / 32)
+        self.assertAlmostEqual(st.smallest_p(6), 2 / 64)
+        self.assertGreaterEqual(st.smallest_p(5), 0.05)
+        self.assertLess(st.smallest_p(6), 0.05)
+        self.assertEqual(st.smallest_p(0), 1.0)
+
+
 class Wilcoxon(unittest.TestCase):
     def test_all_positive_differences(self):
         # n = 5, W+ = 15: only 1 of 32 sign patterns reaches it; two-sided 2/32
