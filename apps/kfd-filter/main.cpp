@@ -151,8 +151,7 @@ int main(int argc, char** argv) {
                "output: a rawlog, or for a bag input a bag (X.bag);\n"
                "written to a temporary file, then renamed")
         ->type_name("FILE");
-    kfd::app::addSourceOptions(cli, opts.source, list, opts.laser_only,
-                               " (the output keeps it)");
+    kfd::app::addSourceOptions(cli, opts.source, list, opts.laser_only, " (the output keeps it)");
     cli.option("--removed-as", removed_as, "bag output: removed points as nan or inf (REP 117)")
         ->type_name("MARK")
         ->check(CLI::IsMember({"nan", "inf"}))

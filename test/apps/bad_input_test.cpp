@@ -1071,20 +1071,20 @@ TEST(BadInputCorruptLength, FuzzFindingsAreClearErrors) {
     Dir d;
     const auto bag =
         d.write("in.bag", fileBytes(corpus + "bag/finding-connection-header-field-length.bag"));
-    expectCorruptLengthRefused(d, bag, bag + ": byte 23586: a header field is longer than its header",
-                               "out.bag");
+    expectCorruptLengthRefused(
+        d, bag, bag + ": byte 23586: a header field is longer than its header", "out.bag");
     const std::string image = fileBytes(corpus + "rawlog/finding-opencv-image-size.rawlog");
     const auto rawlog = d.write("in.rawlog", image);
-    const std::string says = "cannot read object #0 of " + rawlog +
-                             ": an object claims more memory than the ";
+    const std::string says =
+        "cannot read object #0 of " + rawlog + ": an object claims more memory than the ";
     const Snapshot snap({rawlog});
     for (const std::string exe : {KFD_FILTER_EXE, KFD_ICP_SLAM_EXE}) {
         const auto before = listing(d.path);
         const bool filter = exe == KFD_FILTER_EXE;
         const Result r =
-            filter ? run(exe, {"-q", "-i", rawlog, "-o", d / "out.rawlog"}, d.path, kOneGiB)
-                   : run(exe, {"-q", kSlamIni, rawlog, "-o", d / "slam", "--no-map"}, d.path,
-                         kOneGiB);
+            filter
+                ? run(exe, {"-q", "-i", rawlog, "-o", d / "out.rawlog"}, d.path, kOneGiB)
+                : run(exe, {"-q", kSlamIni, rawlog, "-o", d / "slam", "--no-map"}, d.path, kOneGiB);
         EXPECT_EQ(r.status, 1) << r.err;
         EXPECT_EQ(r.first().rfind((filter ? "kfd-filter: " : "kfd-icp-slam: ") + says, 0), 0u)
             << r.first();

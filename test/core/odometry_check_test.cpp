@@ -23,14 +23,13 @@ struct Segment {
 
 // A 6 x 4 m room with a 0.6 m box in it, or a 2 m wide corridor 100 m long.
 std::vector<Segment> room() {
-    return {{-3, -2, 3, -2},     {3, -2, 3, 2},     {3, 2, -3, 2},      {-3, 2, -3, -2},
-            {1, 0.5, 1.6, 0.5},  {1.6, 0.5, 1.6, 1.1}, {1.6, 1.1, 1, 1.1}, {1, 1.1, 1, 0.5}};
+    return {{-3, -2, 3, -2},    {3, -2, 3, 2},        {3, 2, -3, 2},      {-3, 2, -3, -2},
+            {1, 0.5, 1.6, 0.5}, {1.6, 0.5, 1.6, 1.1}, {1.6, 1.1, 1, 1.1}, {1, 1.1, 1, 0.5}};
 }
 std::vector<Segment> corridor() { return {{-50, -1, 50, -1}, {-50, 1, 50, 1}}; }
 
 // A 361-beam, 180-degree scan from `pose` (the sensor on the robot's origin).
-Scan cast(const std::vector<Segment>& world, const Pose2D& pose,
-          std::optional<Pose2D> odometry) {
+Scan cast(const std::vector<Segment>& world, const Pose2D& pose, std::optional<Pose2D> odometry) {
     Scan s = test::emptyScan(361, kPi);
     for (std::size_t i = 0; i < s.size(); ++i) {
         const double a = pose.phi + s.geometry.angle(i);
@@ -91,14 +90,15 @@ TEST(OdometryCheck, StillOdometryOfAStillSensorIsKept) {
 }
 
 TEST(OdometryCheck, AJumpTheScansDoNotShowIsWithheldAndTakenOut) {
+    // 20 steps of 5 cm set the pace; then the odometry jumps 1.5 m sideways at scan 20.
     OdometryCheck check;
-    for (int k = 0; k < 12; ++k) {
+    for (int k = 0; k < 26; ++k) {
         const Pose2D truth{-2.0 + 0.05 * k, -0.5, 0.0};
         Pose2D odo = truth;
-        if (k >= 6) odo.y += 1.5;  // the odometry jumps 1.5 m sideways at scan 6
+        if (k >= 20) odo.y += 1.5;
         Scan s = cast(room(), truth, odo);
         const auto r = check.check(s);
-        if (k == 6) {
+        if (k == 20) {
             EXPECT_EQ(r.verdict, OdometryVerdict::Jump);
             EXPECT_GT(r.agree_still, r.agree_odometry + 0.3);
             EXPECT_FALSE(s.odometry);
@@ -106,9 +106,20 @@ TEST(OdometryCheck, AJumpTheScansDoNotShowIsWithheldAndTakenOut) {
         }
         EXPECT_EQ(r.verdict, OdometryVerdict::Ok) << k;
         ASSERT_TRUE(s.odometry);
-        // After the jump the odometry carries on from scan 5: 0.05 m short, not 1.5 m off.
+        // After the jump the odometry carries on from scan 19: 0.05 m short, not 1.5 m off.
         EXPECT_NEAR(s.odometry->y, truth.y, 1e-9) << k;
-        EXPECT_NEAR(s.odometry->x, k > 6 ? truth.x - 0.05 : truth.x, 1e-9) << k;
+        EXPECT_NEAR(s.odometry->x, k > 20 ? truth.x - 0.05 : truth.x, 1e-9) << k;
+    }
+}
+
+TEST(OdometryCheck, StepsAtTheLogsPaceAreNeverJumps) {
+    // Odometry driving forward while the scans show the sensor backing up (what a point between
+    // beams on a grazing wall can look like): at the log's own pace this is never a jump.
+    OdometryCheck check;
+    for (int k = 0; k < 30; ++k) {
+        const Pose2D truth{1.0 - 0.1 * k, -0.5, 0.0};
+        Scan s = cast(room(), truth, Pose2D{-truth.x, truth.y, 0.0});
+        EXPECT_EQ(check.check(s).verdict, OdometryVerdict::Ok) << k;
     }
 }
 
@@ -143,6 +154,7 @@ TEST(OdometryCheck, BadParametersAreRejected) {
     bad([](auto& p) { p.max_samples = 2; });
     bad([](auto& p) { p.still_m = -1.0; });
     bad([](auto& p) { p.min_beams = 0; });
+    bad([](auto& p) { p.jump_pace_factor = 0.5; });
 }
 
 }  // namespace

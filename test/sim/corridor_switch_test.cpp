@@ -37,7 +37,9 @@ Filtered filterSimulated(const TempDir& dir, const std::string& world) {
     std::ifstream csv(f.stats_csv);
     std::string line, header;
     std::getline(csv, header);
-    EXPECT_NE(header.find(",view_change,changed_fraction,degeneracy,corridor,denoise_bound,odometry_check,icp_goodness,"), std::string::npos);
+    EXPECT_NE(header.find(",view_change,changed_fraction,degeneracy,corridor,denoise_bound,"
+                          "odometry_check,icp_goodness,"),
+              std::string::npos);
     while (std::getline(csv, line)) {
         ++r.rows;
         std::stringstream fields(line);

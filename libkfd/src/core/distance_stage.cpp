@@ -11,10 +11,10 @@ namespace kfd {
 std::vector<StageKey> DistanceStage::keys() {
     using P = Params;
     // max_range: a number narrows the scan's own maximum; "scan" (the default) keeps it.
-    StageKey max = keys::real<P>(
-        "max_range", "max_range",
-        "Algorithm 1: longest usable range (m); scan = the scan's own maximum", 0, 1000, true,
-        [](P& p) -> double& { return p.max_range; });
+    StageKey max =
+        keys::real<P>("max_range", "max_range",
+                      "Algorithm 1: longest usable range (m); scan = the scan's own maximum", 0,
+                      1000, true, [](P& p) -> double& { return p.max_range; });
     max.range = "scan or " + max.range;
     max.set = [lo_open_set = max.set](void* p, const std::string& text) {
         if (text == "scan")

@@ -490,8 +490,7 @@ std::size_t EvidenceFilter::markNoise(Clusters& out, bool temporal,
             std::min(static_cast<double>(params_.max_small_points) + 1.0, std::max(2.0, need)));
         const bool small = out.size[c] < bar;
         const bool supported = temporal && supported_in_[c] > 0;
-        const bool free =
-            temporal && classified_in_[c] > 0 && 2 * free_in_[c] >= classified_in_[c];
+        const bool free = temporal && classified_in_[c] > 0 && 2 * free_in_[c] >= classified_in_[c];
         out.noise[c] = (small && !supported) || free ? 1 : 0;
         small_[c] = small ? 1 : 0;
     }
@@ -511,7 +510,7 @@ void EvidenceFilter::capNoise(Clusters& out, std::size_t cap) {
     // Smallest first; among equals the farthest (fewest returns expected of an object there).
     std::sort(order_.begin(), order_.end(), [&](std::uint32_t a, std::uint32_t b) {
         return out.size[a] != out.size[b] ? out.size[a] < out.size[b]
-                                           : out.mean_range[a] > out.mean_range[b];
+                                          : out.mean_range[a] > out.mean_range[b];
     });
     std::size_t removed = 0;
     for (const std::uint32_t c : order_) {

@@ -151,8 +151,8 @@ void StreamFilter::record(StreamResult& res) {
         const std::size_t usable = rep.points_in - rec.removed_range;
         if (usable > 0)
             c.max_removed_noise_share =
-                std::max(c.max_removed_noise_share, static_cast<double>(rec.removed_noise) /
-                                                        static_cast<double>(usable));
+                std::max(c.max_removed_noise_share,
+                         static_cast<double>(rec.removed_noise) / static_cast<double>(usable));
         c.points_removed += rep.points_in - rep.points_out;
     } else {
         ++c.scans_dropped;

@@ -42,14 +42,16 @@ std::string reportMarkdown(const IcpSlamSummary& sum) {
         sum.scans_in, sum.scans_kept, sum.dropped_pct, sum.points_removed, sum.points_in,
         sum.prefilter_us_per_scan, sum.icp_ms_per_scan, sum.cpu_s_total);
     if (sum.icp_runs)
-        r += format("- ICP: %zu corrections, %zu rejected (goodness below the minimum), median "
-                    "goodness %.2f\n",
-                    sum.icp_runs, sum.icp_rejected, sum.icp_goodness_median);
+        r += format(
+            "- ICP: %zu corrections, %zu rejected (goodness below the minimum), median "
+            "goodness %.2f\n",
+            sum.icp_runs, sum.icp_rejected, sum.icp_goodness_median);
     if (!sum.lost_track_stamps.empty()) {
-        r += format("- **%zu suspected lost track%s** (%zu ICP corrections rejected in a row: the "
-                    "pose then follows odometry alone and the map is not updated), from t =",
-                    sum.lost_track_stamps.size(), sum.lost_track_stamps.size() == 1 ? "" : "s",
-                    kLostTrackRejections);
+        r += format(
+            "- **%zu suspected lost track%s** (%zu ICP corrections rejected in a row: the "
+            "pose then follows odometry alone and the map is not updated), from t =",
+            sum.lost_track_stamps.size(), sum.lost_track_stamps.size() == 1 ? "" : "s",
+            kLostTrackRejections);
         for (std::size_t i = 0; i < sum.lost_track_stamps.size() && i < 10; ++i)
             r += format("%s %.3f", i ? "," : "", sum.lost_track_stamps[i]);
         r += sum.lost_track_stamps.size() > 10 ? ", ... s\n" : " s\n";

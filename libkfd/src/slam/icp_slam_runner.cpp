@@ -9,15 +9,15 @@
 #include <mrpt/poses/CPose3DPDF.h>
 #include <mrpt/slam/CMetricMapBuilderICP.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <algorithm>
 #include <cstdlib>
 #include <ctime>
-#include <string_view>
 #include <filesystem>
 #include <fstream>
+#include <string_view>
 
 #include "kfd/baselines/decimate_stage.h"
 #include "kfd/baselines/motion_stage.h"
@@ -292,7 +292,7 @@ class Run {
     void noteIcp();
     std::optional<double> step_goodness_;
     bool step_rejected_ = false;
-    std::vector<double> goodness_;    // every correction's
+    std::vector<double> goodness_;  // every correction's
     std::size_t rejected_streak_ = 0;
     double streak_start_ = 0.0;
 };
@@ -446,8 +446,8 @@ void Run::initBuilder() {
             builder_.setVerbosityLevel(mrpt::system::LVL_ERROR);
             // ICP's goodness per correction reaches kfd through the log (onBuilderLog).
             builder_.setVerbosityLevelForCallbacks(mrpt::system::LVL_INFO);
-            builder_.logRegisterCallback([this](std::string_view msg,
-                                                mrpt::system::VerbosityLevel, std::string_view,
+            builder_.logRegisterCallback([this](std::string_view msg, mrpt::system::VerbosityLevel,
+                                                std::string_view,
                                                 mrpt::Clock::time_point) { onBuilderLog(msg); });
             builder_.ICP_options.loadFromConfigFile(*cfg_, kSect);
             builder_.ICP_params.loadFromConfigFile(*cfg_, "ICP");

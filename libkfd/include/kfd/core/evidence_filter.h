@@ -162,8 +162,8 @@ class EvidenceFilter {
     std::vector<float> sums_;             // per segment: range sum
     std::vector<std::uint32_t> unknown_;  // beams classified unknown against the newest keyframe
     std::vector<std::uint32_t> free_in_, supported_in_, classified_in_;  // per segment
-    std::vector<std::uint32_t> order_;                                    // segments by size
-    std::vector<std::uint8_t> small_;                                     // per segment: small
+    std::vector<std::uint32_t> order_;                                   // segments by size
+    std::vector<std::uint8_t> small_;                                    // per segment: small
     double sigma_smoothed_ = -1.0;
     Reference refs_[2];  // [0] the newest keyframe
     Pose2D pose_;        // this scan's refined pose (when have_pose_)

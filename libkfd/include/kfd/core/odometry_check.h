@@ -35,11 +35,15 @@ const char* toString(OdometryVerdict v);
 ///    scan is compared with the first scan of that still stretch. Once more than
 ///    frozen_changed_fraction of the beams both saw changed, the sensor moved: the odometry
 ///    is frozen, and withheld until it moves again.
-///  - Jump: a step of odometry that moves the beams beyond their tolerance is tested against
-///    the previous scan: the previous points moved by the step, and left where they were,
-///    are projected into this scan. When standing still explains jump_margin more of the beams
-///    than the step does, the step is a jump: this scan gets no odometry, and later odometry is
-///    rebased so that the jump is taken out (the pose carries on from the previous scan).
+///  - Jump: a step of odometry far beyond the log's own pace (more than jump_pace_factor times
+///    the median speed of the last steps, in translation or rotation, plus one tolerance) is
+///    tested against the previous scan: the previous points moved by the step, and left where
+///    they were, are compared with this scan's surface between the beams bracketing them. When
+///    standing still explains jump_margin more of the previous returns than the step does,
+///    the step is a jump: this scan gets no odometry, and later odometry is rebased so that the
+///    jump is taken out (the pose carries on from the previous scan). Steps at the log's pace
+///    are never tested: on the Freiburg logs a test of every step flagged ordinary 0.1 m steps
+///    (a point between beams on a grazing wall; docs/RESULTS.md).
 /// A corridor (where moving along it changes no beam) passes both tests: nothing contradicts.
 class OdometryCheck {
   public:
@@ -51,6 +55,8 @@ class OdometryCheck {
         double still_deg = 0.01;               // deg: the same, in rotation
         double frozen_changed_fraction = 0.3;  // frozen beyond this share of changed beams
         double jump_margin = 0.3;              // jump: still explains this share more
+        double jump_pace_factor = 3.0;         // jump candidates: beyond this x the median pace
+        std::size_t pace_steps = 32;           // steps in the median pace
         std::size_t min_beams = 20;            // beams both saw, fewer: no test
     };
 
@@ -88,8 +94,11 @@ class OdometryCheck {
     double still_rad_ = 0.0;
     Samples prev_, anchor_, cur_;
     bool have_prev_ = false, have_anchor_ = false, frozen_ = false;
+    bool beyondPace(const Pose2D& step, double dt);
     std::optional<Pose2D> prev_raw_;  // the previous scan's odometry as given
-    Pose2D correction_;               // rebased = correction (+) raw
+    double prev_stamp_ = 0.0;
+    std::vector<double> pace_m_, pace_rad_, sorted_;  // recent steps' speeds (per s or per step)
+    Pose2D correction_;                               // rebased = correction (+) raw
 };
 
 }  // namespace kfd

@@ -29,7 +29,7 @@ struct RawlogFilterOptions {
     BagWriterOptions bag;   // a bag output's compression and removed-point mark
     std::string stats_csv;  // optional per-scan CSV (kfd/mrpt/scan_csv.h)
     Pipeline::Params pipeline;
-    int compress_level = 1;  // gzip level of the output (0 = store, 9 = smallest)
+    int compress_level = 1;   // gzip level of the output (0 = store, 9 = smallest)
     bool laser_only = false;  // ignore the log's odometry in kfd's decisions (it stays in the
                               // output): StreamFilter::setLaserOnly
     /// Called about every `progress_every` objects and once at the end.

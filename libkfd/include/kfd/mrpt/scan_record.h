@@ -52,7 +52,7 @@ struct ScanRecord {
     double degeneracy = 1.0;
     bool corridor = false;           // the corridor switch found the scan degenerate
     bool corridor_keyframe = false;  // ... and made it a keyframe by odometry or time
-    DenoiseBound denoise_bound = DenoiseBound::None;  // the evidence denoiser's bound acted
+    DenoiseBound denoise_bound = DenoiseBound::None;         // the evidence denoiser's bound acted
     OdometryVerdict odometry_check = OdometryVerdict::None;  // the odometry check's verdict
     std::optional<Pose2D> odometry;  // the odometry the door was given, after its check
     /// kfd-icp-slam: ICP's goodness when the map builder corrected this (kept) scan's pose,
@@ -71,16 +71,16 @@ struct ScanCounters {
     /// outputs like a non-keyframe, not counted in scans_dropped.
     std::size_t scans_skipped = 0;
     std::size_t skipped_by_reason[kScanSkipReasons] = {};  // indexed by ScanSkipReason
-    std::size_t beams_bad_range = 0;       // beams marked invalid: NaN, +-inf, negative, huge range
-    std::size_t odometry_bad = 0;          // scans whose odometry was not finite (used as unknown)
-    std::size_t stamps_backwards = 0;      // scans stamped before their sensor's previous scan
-    std::size_t geometry_resets = 0;       // a sensor's geometry changed: its state was reset
-    std::size_t scans_corridor = 0;        // scans the corridor switch found degenerate
-    std::size_t keyframes_corridor = 0;    // keyframes the switch made (odometry or time)
+    std::size_t beams_bad_range = 0;     // beams marked invalid: NaN, +-inf, negative, huge range
+    std::size_t odometry_bad = 0;        // scans whose odometry was not finite (used as unknown)
+    std::size_t stamps_backwards = 0;    // scans stamped before their sensor's previous scan
+    std::size_t geometry_resets = 0;     // a sensor's geometry changed: its state was reset
+    std::size_t scans_corridor = 0;      // scans the corridor switch found degenerate
+    std::size_t keyframes_corridor = 0;  // keyframes the switch made (odometry or time)
     std::size_t scans_odometry_frozen = 0;  // scans whose odometry stood still as they changed
     std::size_t scans_odometry_jump = 0;    // scans whose odometry jumped where they did not
-    std::size_t scans_denoise_stale = 0;   // kept scans whose denoiser found its references stale
-    std::size_t scans_denoise_capped = 0;  // kept scans whose removal was cut to the bound
+    std::size_t scans_denoise_stale = 0;    // kept scans whose denoiser found its references stale
+    std::size_t scans_denoise_capped = 0;   // kept scans whose removal was cut to the bound
     /// The largest share of a kept scan's valid returns the denoising stages removed (0-1).
     double max_removed_noise_share = 0.0;
     std::size_t points_in = 0;             // valid beams of the scans that ran
