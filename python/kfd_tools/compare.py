@@ -280,6 +280,7 @@ def run_job(a):
         "relations_local_used": (s.get("relations_local") or {}).get("used"),
         "relations_long_used": (s.get("relations_long") or {}).get("used"),
         "target_drop_pct": s.get("target_drop_pct"), "laser_only": s.get("laser_only"),
+        "icp_rejected": s.get("icp_rejected"), "lost_tracks": s.get("lost_tracks_suspected"),
         "finished": True, "command": cmd})
     write_run(done, run)
     return run
@@ -382,7 +383,7 @@ RUN_COLUMNS = ["log", "config", "mode", "repeat", "seed", "skip_scans"] + \
     [m for m, _, _ in METRICS] + \
     ["cpu_user_s", "cpu_sys_s", "cpu_match_s", "wall_s", "scans_in", "scans_kept",
      "relations_local_used", "relations_long_used", "target_drop_pct", "laser_only",
-     "finished", "failed", "failure", "folder"]
+     "icp_rejected", "lost_tracks", "finished", "failed", "failure", "folder"]
 
 
 def collect(out, baseline="none", pairs=None, plots=True, quiet=False,

@@ -408,13 +408,16 @@ def mode_table(g):
 
 
 def worst_cells(g, mode, dashes):
-    """repeat, local, long, ATE, folder of mode's worst run."""
+    """repeat, local, long, ATE, ICP rejected / lost tracks, folder of mode's worst run."""
     w = g.worst[mode]
     if w is None:
-        return [dashes(g.why_missing(worst_key(g.judged), mode))] * 5
+        return [dashes(g.why_missing(worst_key(g.judged), mode))] * 6
+    icp = ("%d / %d" % (w["icp_rejected"], w["lost_tracks"])
+           if w.get("icp_rejected") is not None and w.get("lost_tracks") is not None
+           else dashes("kfd-icp-slam did not report ICP's corrections (a run before issue 22)"))
     return ["r%02d" % w["repeat"]] + [
         fmt(w[m]) if w.get(m) is not None else dashes(g.why_cell(m, w))
-        for m in ("local", "long", "ate")] + ["`%s`" % w["folder"]]
+        for m in ("local", "long", "ate")] + [icp, "`%s`" % w["folder"]]
 
 
 def worst_table(g):
@@ -424,8 +427,9 @@ def worst_table(g):
     dashes = Dashes()
     lines = ["Worst run per mode (largest %s; its folder, relative to OUT, has its map figure "
              "when run with --maps):" % NAMES[key], "",
-             "| mode | repeat | local (m) | long (m) | ATE (m) | folder |",
-             "|---|---:|---:|---:|---:|---|"]
+             "| mode | repeat | local (m) | long (m) | ATE (m) | ICP rejected / lost tracks | "
+             "folder |",
+             "|---|---:|---:|---:|---:|---:|---|"]
     for mode in g.order:
         lines.append("| %s | %s |" % (mode, " | ".join(worst_cells(g, mode, dashes))))
     return lines + dashes.legend()
@@ -530,14 +534,15 @@ def summary_worst(gs):
     dashes = Dashes()
     lines = ["Worst run per mode (largest long error, local without long relations, ATE "
              "without relations):", "",
-             "| log | mode | by | repeat | local (m) | long (m) | ATE (m) | folder |",
-             "|---|---|---|---:|---:|---:|---:|---|"]
+             "| log | mode | by | repeat | local (m) | long (m) | ATE (m) | "
+             "ICP rejected / lost tracks | folder |",
+             "|---|---|---|---:|---:|---:|---:|---:|---|"]
     for g in gs:
         key = worst_key(g.judged)
         for mode in g.order:
             cells = [NAMES[key]] + worst_cells(g, mode, dashes) if key else \
                 [dashes("no error metric on this log: %s; %s" % (g.absent("all"),
-                                                                 g.absent("ate")))] * 6
+                                                                 g.absent("ate")))] * 7
             lines.append("| %s | %s | %s |" % (g.log, mode, " | ".join(cells)))
     return lines + dashes.legend()
 

@@ -3,6 +3,11 @@
 
 #include <cmath>
 
+#include <filesystem>
+#include <string>
+
+#include "kfd/mrpt/config.h"
+#include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/stream_filter.h"
 
@@ -154,4 +159,33 @@ TEST(ScanAdapter, RoundTripKeepsGeometryAndValidity) {
     EXPECT_FALSE(core.valid[7]);
     for (std::size_t i : {0u, 90u, 180u})
         EXPECT_NEAR(core.geometry.angle(i), s.getScanAngle(i), 1e-6);
+}
+
+// Issue 22: a log whose odometry reads zero while the sensor moves (what MRPT's converters write
+// for a laser-only log) is decided as the same log laser only: the odometry check withholds
+// the frozen odometry once the scans changed, so keyframes and removals agree.
+TEST(StreamFilter, FrozenOdometryIsDecidedAsLaserOnly) {
+    const std::string log = std::string(KFD_DATASETS_DIR) + "/mines-urg/exp1.rawlog";
+    if (!std::filesystem::exists(log)) GTEST_SKIP() << "dataset missing: " << log;
+    kfd::StreamFilter frozen(kfd::kfdDefaults()), laser_only(kfd::kfdDefaults());
+    laser_only.setLaserOnly(true);
+    auto source = kfd::openSource(log);
+    kfd::SourceEntry e;
+    std::size_t scans = 0, same = 0, withheld = 0;
+    while (source->next(e))
+        e.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
+            auto copy = *s;
+            const auto a = frozen.process(*s, kfd::Pose2D{});
+            const auto b = laser_only.process(copy, e.odometry);
+            ++scans;
+            same += a.keep == b.keep;
+            withheld += a.record.odometry_check == kfd::OdometryVerdict::Frozen;
+        });
+    ASSERT_GT(scans, 700u);
+    EXPECT_GT(withheld, scans * 9 / 10);  // all but the first ~2 s
+    EXPECT_GE(same, scans * 99 / 100);
+    const double ra = static_cast<double>(frozen.counters().points_removed_noise);
+    const double rb = static_cast<double>(laser_only.counters().points_removed_noise);
+    EXPECT_NEAR(ra, rb, 0.02 * rb);
+    EXPECT_LE(frozen.counters().max_removed_noise_share, 0.05 + 1e-12);
 }

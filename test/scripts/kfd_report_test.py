@@ -39,7 +39,7 @@ def write_run(out, log, mode, repeat, local=None, long=None, ate=None, cpu=10.0,
            "skip_scans": repeat, "local": local, "long": long,
            "all": None if not rel else (local or 0) + (long or 0), "ate": ate, "drop": 50.0,
            "cpu": cpu, "cpu_ms_per_scan": cpu, "scans_in": 1000, "scans_kept": 500,
-           "finished": True, "command": command(relations=rel, gt=ate is not None)}
+           "icp_rejected": 7 * repeat, "lost_tracks": repeat % 2, "finished": True, "command": command(relations=rel, gt=ate is not None)}
     run.update(more)
     with open(os.path.join(folder, "run.json"), "w") as f:
         json.dump(run, f)
@@ -193,7 +193,8 @@ class FewRuns(Base):
         aces = section(self.report, "aces, cfg")
         row = table_row(aces, ["kfd", "r%02d" % k])
         self.assertEqual(row[2:4], ["%.3f" % (0.11 + 0.01 * k), "28.500"])
-        self.assertEqual(row[5], "`runs/aces/cfg/kfd/r%02d`" % k)
+        self.assertEqual(row[5], "%d / %d" % (7 * k, k % 2))  # ICP rejected / lost tracks
+        self.assertEqual(row[6], "`runs/aces/cfg/kfd/r%02d`" % k)
         self.assertEqual(reason(aces, ["kfd", "r%02d" % k], 4),
                          "no ground-truth trajectory (.gt.tum) for this log")
         self.assertIn("| aces | kfd | long error | r%02d |" % k, self.summary)

@@ -199,6 +199,7 @@ std::string toJson(const IcpSlamSummary& s) {
     j["icp_goodness_median"] = s.icp_goodness_median;
     j["lost_tracks_suspected"] = s.lost_track_stamps.size();
     j["lost_track_stamps"] = s.lost_track_stamps;
+    j["scans_kept_for_recovery"] = s.scans_kept_for_recovery;
     j["scans_odometry_frozen"] = s.scans_odometry_frozen;
     j["scans_odometry_jump"] = s.scans_odometry_jump;
     j["scans_denoise_stale"] = s.scans_denoise_stale;

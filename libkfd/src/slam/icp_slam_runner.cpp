@@ -295,6 +295,10 @@ class Run {
     std::vector<double> goodness_;  // every correction's
     std::size_t rejected_streak_ = 0;
     double streak_start_ = 0.0;
+    // After ICP rejected a correction, every scan goes to the map builder until it accepts one
+    // again: the pre-filter's drops never widen the gap a struggling ICP has to bridge.
+    bool recovering_ = false;
+    std::size_t kept_for_recovery_ = 0;
 };
 
 // MRPT's map builder says how each ICP correction went only in its log: "Fit:%.1f%%" when
@@ -333,6 +337,7 @@ void Run::noteIcp() {
     } else {
         rejected_streak_ = 0;
     }
+    recovering_ = step_rejected_;
     for (ScanRecord& s : step_scans_)
         if (s.kept) {
             s.icp_goodness = *step_goodness_;
@@ -572,6 +577,13 @@ bool Run::toMapFrame(mrpt::obs::CObservationOdometry& odo) {
 // A scan through the door; true when it goes on to ICP. Its record waits for the step's pose.
 bool Run::prefilterScan(CObservation2DRangeScan& scan, const SourceEntry& e) {
     StreamResult r = prefilter_->process(scan, e.odometry);
+    if (!r.keep && recovering_ && r.skipped == ScanSkipReason::None) {
+        // Dropped by the pre-filter while ICP is recovering from a rejected correction: it
+        // goes to the map builder all the same (as cleaned by the stages that ran).
+        r.keep = r.record.kept = true;
+        r.record.reason = "icp_recovery";
+        ++kept_for_recovery_;
+    }
     step_scans_.push_back(std::move(r.record));
     return r.keep;
 }
@@ -622,6 +634,9 @@ void Run::closeOutputs() {
 // The summary from the door's counters, the map, ATE and the relations error (local and long).
 void Run::evaluate() {
     static_cast<ScanCounters&>(sum_) = prefilter_->counters();
+    sum_.scans_kept += kept_for_recovery_;  // the door counted them as dropped
+    sum_.scans_dropped -= kept_for_recovery_;
+    sum_.scans_kept_for_recovery = kept_for_recovery_;
     sum_.dropped_pct = sum_.notKeptPercent();
     const double scans_in = static_cast<double>(sum_.scans_in);
     sum_.prefilter_us_per_scan = sum_.scans_in ? 1e6 * sum_.filter_seconds / scans_in : 0;

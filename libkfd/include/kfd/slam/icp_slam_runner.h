@@ -97,6 +97,9 @@ struct IcpSlamSummary : ScanCounters {
     /// builder dead-reckons and stops inserting into the map). The stamp (s) of the first
     /// rejection of each such streak.
     std::vector<double> lost_track_stamps;
+    /// Scans the pre-filter dropped that went to the map builder all the same because ICP had
+    /// rejected its last correction (counted in scans_kept; reason "icp_recovery" in scans.csv).
+    std::size_t scans_kept_for_recovery = 0;
 };
 
 /// ICP corrections rejected in a row that make a suspected lost track.
