@@ -9,6 +9,7 @@
 
 #include "kfd/baselines/decimate_stage.h"
 #include "kfd/core/cancel.h"
+#include "kfd/core/keyframe_stage.h"
 #include "kfd/eval/trajectory.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/default_stages.h"
@@ -580,4 +581,25 @@ TEST(IcpSlamRunner, SummaryJsonKeepsEveryKeyInOrder) {
     const std::string bare = kfd::toJson(s);
     EXPECT_EQ(bare.find("ate_rmse_m"), std::string::npos);
     EXPECT_EQ(bare.find("relations"), std::string::npos);
+}
+
+TEST(IcpSlamRunner, KeyframeGuardsFollowTheSlamsLocalisationGate) {
+    // sick-180-5hz.ini: ICP corrects after 0.2 m or 5 deg; kfd's guards (0.5 m, 15 deg) are
+    // lowered to that. The every-scan variant has no gate: the guards stay.
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    auto o = options(kSena, dir / "gated", kfd::PrefilterMode::Kfd);
+    o.write_map = false;
+    const auto gated = runAndReport(o);
+    EXPECT_DOUBLE_EQ(gated.guard_translation_m, 0.2);
+    EXPECT_DOUBLE_EQ(gated.guard_rotation_deg, 5.0);
+    EXPECT_EQ(gated.pipeline.get<kfd::KeyframeStage>().max_translation_m, 0.2);
+    o.config_file = std::string(KFD_SOURCE_DIR) + "/share/kfd-icp-slam/sick-180-5hz-every-scan.ini";
+    o.output_dir = dir / "every";
+    const auto every = runAndReport(o);
+    EXPECT_DOUBLE_EQ(every.guard_translation_m, 0.5);
+    EXPECT_DOUBLE_EQ(every.guard_rotation_deg, 15.0);
+    EXPECT_LE(every.scans_kept, gated.scans_kept);  // the gate's guards keep at least as many
+    EXPECT_NE(text(dir / "gated/summary.json").find("\"guard_translation_m\": 0.2"),
+              std::string::npos);
 }

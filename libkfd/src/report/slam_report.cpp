@@ -200,6 +200,8 @@ std::string toJson(const IcpSlamSummary& s) {
     j["lost_tracks_suspected"] = s.lost_track_stamps.size();
     j["lost_track_stamps"] = s.lost_track_stamps;
     j["scans_kept_for_recovery"] = s.scans_kept_for_recovery;
+    j["guard_translation_m"] = s.guard_translation_m;  // after the SLAM's localisation gate
+    j["guard_rotation_deg"] = s.guard_rotation_deg;
     j["scans_odometry_frozen"] = s.scans_odometry_frozen;
     j["scans_odometry_jump"] = s.scans_odometry_jump;
     j["scans_denoise_stale"] = s.scans_denoise_stale;

@@ -23,6 +23,7 @@
 #include "kfd/baselines/motion_stage.h"
 #include "kfd/core/cancel.h"
 #include "kfd/core/format.h"
+#include "kfd/core/keyframe_stage.h"
 #include "kfd/eval/ate.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/open_source.h"
@@ -395,6 +396,18 @@ void Run::prepare() {
 
     // Pre-filter configuration: [KFD] when present, else kfd's defaults (share/kfd/default.ini).
     kfd_params_ = cfg_->sectionExists("KFD") ? loadIni(*cfg_, "KFD") : kfdDefaults();
+    // The SLAM's localisation gate: ICP corrects the pose only after this much odometry since
+    // its last correction. kfd's keyframe guards (those that are on) never let more pass
+    // between kept scans, so a drop never skips the scan the gate would have matched.
+    {
+        auto& kf = kfd_params_.get<KeyframeStage>();
+        const double gate_m = cfg_->read_double(kSect, "localizationLinDistance", 0.2);
+        const double gate_deg = cfg_->read_double(kSect, "localizationAngDistance", 5.0);
+        if (gate_m > 0.0 && kf.max_translation_m > gate_m) kf.max_translation_m = gate_m;
+        if (gate_deg > 0.0 && kf.max_rotation_deg > gate_deg) kf.max_rotation_deg = gate_deg;
+        sum_.guard_translation_m = kf.max_translation_m;
+        sum_.guard_rotation_deg = kf.max_rotation_deg;
+    }
     sum_.pipeline = pipelineForMode(opts_.mode, kfd_params_);
     sum_.laser_only = opts_.laser_only;
     if (!(opts_.split_seconds >= 0.0) || !std::isfinite(opts_.split_seconds))

@@ -100,6 +100,10 @@ struct IcpSlamSummary : ScanCounters {
     /// Scans the pre-filter dropped that went to the map builder all the same because ICP had
     /// rejected its last correction (counted in scans_kept; reason "icp_recovery" in scans.csv).
     std::size_t scans_kept_for_recovery = 0;
+    /// The keyframe guards the run used (0 = off): the [KFD] section's, lowered to the SLAM's
+    /// localisation gate (localizationLinDistance, localizationAngDistance) when that is
+    /// shorter, so that kfd never drops the scan ICP's gate would have matched.
+    double guard_translation_m = 0.0, guard_rotation_deg = 0.0;
 };
 
 /// ICP corrections rejected in a row that make a suspected lost track.
