@@ -40,8 +40,14 @@ using kfd::test::fileBytes;
 struct Result {
     int status = -1;  // exit status, or 128 + signal when killed by one
     std::string out, err;
-    /// The first line of stderr.
-    std::string first() const { return err.substr(0, err.find('\n')); }
+    /// The first line of stderr that the app wrote: a sanitizer runtime's own lines ("==PID==",
+    /// e.g. ASan's warning when an impossible malloc returns null in the sanitizer job) are not.
+    std::string first() const {
+        std::size_t at = 0;
+        while (err.compare(at, 2, "==") == 0 && err.find('\n', at) != std::string::npos)
+            at = err.find('\n', at) + 1;
+        return err.substr(at, err.find('\n', at) - at);
+    }
 };
 
 // AddressSanitizer reserves terabytes of address space: no RLIMIT_AS under it.
