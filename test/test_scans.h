@@ -124,6 +124,37 @@ inline void invalidate(Scan& s, std::size_t first, std::size_t last) {
     for (std::size_t i = first; i <= last; ++i) s.valid[i] = 0;
 }
 
+/// A wall of a hand-made world, from (x0, y0) to (x1, y1) (m).
+struct Segment {
+    double x0, y0, x1, y1;
+};
+
+/// A scan taken at `pose` in a world of segments (ray casting; no return beyond 30 m), with
+/// `pose` as its odometry.
+inline Scan castScan(const std::vector<Segment>& world, const Pose2D& pose, std::size_t beams = 361,
+                     double aperture = kPi) {
+    Scan s = emptyScan(beams, aperture);
+    for (std::size_t i = 0; i < beams; ++i) {
+        const double a = pose.phi + s.geometry.angle(i);
+        const double dx = std::cos(a), dy = std::sin(a);
+        double best = 30.0;
+        for (const auto& w : world) {
+            const double ex = w.x1 - w.x0, ey = w.y1 - w.y0;
+            const double den = dx * ey - dy * ex;
+            if (std::abs(den) < 1e-12) continue;
+            const double t = ((w.x0 - pose.x) * ey - (w.y0 - pose.y) * ex) / den;
+            const double u = ((w.x0 - pose.x) * dy - (w.y0 - pose.y) * dx) / den;
+            if (t > 1e-6 && u >= 0.0 && u <= 1.0) best = std::min(best, t);
+        }
+        if (best < 30.0) {
+            s.range[i] = static_cast<float>(best);
+            s.valid[i] = 1;
+        }
+    }
+    s.odometry = pose;
+    return s;
+}
+
 /// A wall at 3 m over 90 degrees (181 beams, see flatWall) with isolated outliers: beams 20 and
 /// 150 at 8 m (behind the wall) and beam 90 at 1 m (in front of it).
 inline Scan wallWithOutliers() {

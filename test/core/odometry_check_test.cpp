@@ -17,9 +17,7 @@
 namespace kfd {
 namespace {
 
-struct Segment {
-    double ax, ay, bx, by;
-};
+using test::Segment;
 
 // A 6 x 4 m room with a 0.6 m box in it, or a 2 m wide corridor 100 m long.
 std::vector<Segment> room() {
@@ -28,24 +26,9 @@ std::vector<Segment> room() {
 }
 std::vector<Segment> corridor() { return {{-50, -1, 50, -1}, {-50, 1, 50, 1}}; }
 
-// A 361-beam, 180-degree scan from `pose` (the sensor on the robot's origin).
+// A 361-beam, 180-degree scan from `pose` (the sensor on the robot's origin) with `odometry`.
 Scan cast(const std::vector<Segment>& world, const Pose2D& pose, std::optional<Pose2D> odometry) {
-    Scan s = test::emptyScan(361, kPi);
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        const double a = pose.phi + s.geometry.angle(i);
-        const double dx = std::cos(a), dy = std::sin(a);
-        double best = std::numeric_limits<double>::infinity();
-        for (const auto& w : world) {
-            const double ex = w.bx - w.ax, ey = w.by - w.ay;
-            const double den = dx * ey - dy * ex;
-            if (std::fabs(den) < 1e-12) continue;
-            const double t = ((w.ax - pose.x) * ey - (w.ay - pose.y) * ex) / den;
-            const double u = ((w.ax - pose.x) * dy - (w.ay - pose.y) * dx) / den;
-            if (t > 0.0 && u >= 0.0 && u <= 1.0) best = std::min(best, t);
-        }
-        s.range[i] = static_cast<float>(best);
-        s.valid[i] = std::isfinite(best) && best < 30.0 ? 1 : 0;
-    }
+    Scan s = test::castScan(world, pose);
     s.odometry = odometry;
     return s;
 }

@@ -14,33 +14,12 @@
 namespace kfd {
 namespace {
 
-struct Segment {
-    double x0, y0, x1, y1;
-};
+using test::Segment;
 
-/// A scan taken at `pose` in a world of segments (ray casting; no return beyond 30 m).
+/// A scan taken at `pose` in a world of segments (test::castScan).
 Scan cast(const std::vector<Segment>& world, const Pose2D& pose, std::size_t beams = 361,
           double aperture = kPi) {
-    Scan s = test::emptyScan(beams, aperture);
-    for (std::size_t i = 0; i < beams; ++i) {
-        const double a = pose.phi + s.geometry.angle(i);
-        const double dx = std::cos(a), dy = std::sin(a);
-        double best = 30.0;
-        for (const auto& w : world) {
-            const double ex = w.x1 - w.x0, ey = w.y1 - w.y0;
-            const double den = dx * ey - dy * ex;
-            if (std::abs(den) < 1e-12) continue;
-            const double t = ((w.x0 - pose.x) * ey - (w.y0 - pose.y) * ex) / den;
-            const double u = ((w.x0 - pose.x) * dy - (w.y0 - pose.y) * dx) / den;
-            if (t > 1e-6 && u >= 0.0 && u <= 1.0) best = std::min(best, t);
-        }
-        if (best < 30.0) {
-            s.range[i] = static_cast<float>(best);
-            s.valid[i] = 1;
-        }
-    }
-    s.odometry = pose;
-    return s;
+    return test::castScan(world, pose, beams, aperture);
 }
 
 std::vector<Segment> room(double half) {

@@ -54,7 +54,7 @@ void OdometryCheck::reset() {
 }
 
 // Whether `step` (over dt s; dt <= 0: per step) is far beyond the recent pace of the moving
-// robot (still steps do not count: starting off after a stop is no jump); records it.
+// robot; records it in the pace unless it is a jump or a turn in place (no translation).
 bool OdometryCheck::beyondPace(const Pose2D& step, double dt) {
     const double per = dt > 0.0 && std::isfinite(dt) ? 1.0 / dt : 1.0;
     const double m = std::hypot(step.x, step.y) * per, rad = std::fabs(step.phi) * per;
@@ -70,7 +70,7 @@ bool OdometryCheck::beyondPace(const Pose2D& step, double dt) {
         beyond = m > k * median(pace_m_) + params_.tolerance_m * per ||
                  rad > k * median(pace_rad_) + kPi / 180.0 * per;  // + 1 degree
     }
-    if (m * (per > 0 ? 1.0 / per : 1.0) < params_.still_m) return beyond;  // not a moving step
+    if (std::hypot(step.x, step.y) < params_.still_m) return beyond;  // a turn in place
     if (!beyond) {  // a jump does not set the pace
         if (pace_m_.size() == params_.pace_steps) {
             pace_m_.erase(pace_m_.begin());
