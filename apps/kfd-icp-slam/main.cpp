@@ -118,6 +118,11 @@ int main(int argc, char** argv) {
         if (s.icp_runs)
             std::printf("  ICP        %zu corrections, %zu rejected, median goodness %.2f\n",
                         s.icp_runs, s.icp_rejected, s.icp_goodness_median);
+        if (s.rematches)
+            std::printf(
+                "  re-match   %zu after a rejection (%zu by the gap check, %zu then "
+                "accepted), %zu dropped scans matched again\n",
+                s.rematches, s.gap_checks_failed, s.rematches_recovered, s.scans_rematched);
         if (!s.lost_track_stamps.empty())
             std::printf(
                 "  WARNING    %zu suspected lost track%s (%zu ICP corrections rejected in a row), "

@@ -46,6 +46,11 @@ std::string reportMarkdown(const IcpSlamSummary& sum) {
             "- ICP: %zu corrections, %zu rejected (goodness below the minimum), median "
             "goodness %.2f\n",
             sum.icp_runs, sum.icp_rejected, sum.icp_goodness_median);
+    if (sum.rematches)
+        r += format(
+            "- re-matches after a rejected correction: %zu (%zu of them after kfd's gap check; "
+            "ICP then accepted the rejected scan in %zu), %zu dropped scans matched again\n",
+            sum.rematches, sum.gap_checks_failed, sum.rematches_recovered, sum.scans_rematched);
     if (!sum.lost_track_stamps.empty()) {
         r += format(
             "- **%zu suspected lost track%s** (%zu ICP corrections rejected in a row: the "
@@ -200,6 +205,10 @@ std::string toJson(const IcpSlamSummary& s) {
     j["lost_tracks_suspected"] = s.lost_track_stamps.size();
     j["lost_track_stamps"] = s.lost_track_stamps;
     j["scans_kept_for_recovery"] = s.scans_kept_for_recovery;
+    j["rematches"] = s.rematches;
+    j["rematches_recovered"] = s.rematches_recovered;
+    j["scans_rematched"] = s.scans_rematched;
+    j["gap_checks_failed"] = s.gap_checks_failed;
     j["guard_translation_m"] = s.guard_translation_m;  // after the SLAM's localisation gate
     j["guard_rotation_deg"] = s.guard_rotation_deg;
     j["scans_odometry_frozen"] = s.scans_odometry_frozen;

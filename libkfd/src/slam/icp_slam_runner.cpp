@@ -31,6 +31,7 @@
 #include "kfd/mrpt/scan_csv.h"
 #include "kfd/mrpt/source.h"
 #include "kfd/mrpt/stream_filter.h"
+#include "kfd/slam/gap_check.h"
 
 namespace kfd {
 namespace {
@@ -38,6 +39,8 @@ namespace {
 namespace fs = std::filesystem;
 using mrpt::obs::CObservation2DRangeScan;
 constexpr const char* kSect = "MappingApplication";
+// At most this many dropped scans wait for a re-match (since ICP's last accepted correction).
+constexpr std::size_t kMaxHeld = 64;
 
 // One step of MRPT's icp-slam: an observation on its own, or an odometry action with a sensory
 // frame.
@@ -263,6 +266,10 @@ class Run {
     void openOutputs();
     void loop();
     void step(IcpSlamStep& step, const SourceEntry& e);
+    template <class Process>
+    void timed(Process&& process);
+    void feedOdometry(const mrpt::poses::CPose2D& odometry);
+    void rematch(const IcpSlamStep& step);
     bool toMapFrame(mrpt::obs::CObservationOdometry& odo);
     bool prefilterScan(CObservation2DRangeScan& scan, const SourceEntry& e);
     mrpt::obs::CActionCollection* actionFor(const IcpSlamStep& step);
@@ -291,6 +298,7 @@ class Run {
     // ICP's correction of the current step, from the builder's log (onBuilderLog).
     void onBuilderLog(std::string_view msg);
     void noteIcp();
+    void recordVerdict();
     std::optional<double> step_goodness_;
     bool step_rejected_ = false;
     std::vector<double> goodness_;  // every correction's
@@ -300,6 +308,37 @@ class Run {
     // again: the pre-filter's drops never widen the gap a struggling ICP has to bridge.
     bool recovering_ = false;
     std::size_t kept_for_recovery_ = 0;
+    // Re-matching (rematch()): the scans the pre-filter dropped since ICP last accepted a
+    // correction, each with the odometry the map builder had then; after a rejected correction
+    // they go through ICP in order, then the rejected scan again. Their scans.csv rows wait in
+    // pending_ (from the first held scan on) until ICP accepts a correction or they are
+    // replayed.
+    struct Held {
+        CObservation2DRangeScan::Ptr scan;
+        std::optional<mrpt::poses::CPose2D> odometry;  // the builder's, when it had one
+        std::size_t row;                               // its entry in pending_
+    };
+    struct PendingRow {
+        ScanRecord record;
+        Pose2D pose;
+        std::size_t trajectory_index;
+    };
+    std::vector<Held> held_;
+    std::size_t held_this_step_ = 0;  // held_ entries added by the current step
+    std::vector<PendingRow> pending_;
+    void flushPending();
+    // The odometry the map builder last got (MRPT's CMetricMapBuilderICP accumulates the
+    // actions' pose changes, or takes an odometry observation as it is), and its stamp.
+    std::optional<mrpt::poses::CPose2D> builder_odometry_;
+    mrpt::Clock::time_point builder_odometry_t_{};
+    std::size_t rematches_ = 0, rematches_recovered_ = 0, kept_for_rematch_ = 0;
+    // The gap check (kfd/slam/gap_check.h): a correction across scans the pre-filter dropped
+    // must reach a share of the log's recent median goodness, else it is rejected (MRPT's own
+    // test, with a raised minimum) and re-matched.
+    double min_goodness_ = 0.4;  // the configuration's minICPgoodnessToAccept
+    std::optional<GapCheck> gap_check_;
+    void noteAccepted(double goodness) { gap_check_->accepted(goodness); }
+    double gapGoodness() const { return gap_check_->minimum(); }
 };
 
 // MRPT's map builder says how each ICP correction went only in its log: "Fit:%.1f%%" when
@@ -330,14 +369,24 @@ void Run::noteIcp() {
     const double stamp = step_scans_.empty() ? 0.0 : stampForOutput(step_scans_.back().stamp);
     ++sum_.icp_runs;
     goodness_.push_back(*step_goodness_);
-    if (step_rejected_) {
+    if (step_rejected_ && *step_goodness_ > min_goodness_) {
+        // rejected by the gap check only: re-matched (rematch()), not a rejection of the SLAM's
+        ++sum_.gap_checks_failed;
+    } else if (step_rejected_) {
         ++sum_.icp_rejected;
         if (rejected_streak_++ == 0) streak_start_ = stamp;
         if (rejected_streak_ == kLostTrackRejections)
             sum_.lost_track_stamps.push_back(streak_start_);
     } else {
         rejected_streak_ = 0;
+        held_.clear();  // nothing to re-match before an accepted correction
+        noteAccepted(*step_goodness_);
     }
+    recordVerdict();
+}
+
+// The step's verdict on its kept scans' records; a rejection starts the recovery.
+void Run::recordVerdict() {
     recovering_ = step_rejected_;
     for (ScanRecord& s : step_scans_)
         if (s.kept) {
@@ -468,6 +517,8 @@ void Run::initBuilder() {
                                                 std::string_view,
                                                 mrpt::Clock::time_point) { onBuilderLog(msg); });
             builder_.ICP_options.loadFromConfigFile(*cfg_, kSect);
+            min_goodness_ = builder_.ICP_options.minICPgoodnessToAccept;
+            gap_check_.emplace(min_goodness_);
             builder_.ICP_params.loadFromConfigFile(*cfg_, "ICP");
             builder_.initialize();
             builder_.options.alwaysInsertByClass.fromString(
@@ -508,6 +559,7 @@ void Run::loop() {
         if (!steps.feed(e, st) || e.objects_read < rawlog_offset_ || skipper.skip(st)) continue;
         step(st, e);
         noteIcp();
+        rematch(st);
         writeStep();
         ++step_no_;
         ++sum_.entries;
@@ -527,49 +579,150 @@ void Run::loop() {
     if (opts_.on_progress) progress(1.0);
 }
 
+// A call into the map builder, timed; what it throws names the step, its last scan's stamp
+// and the log.
+template <class Process>
+void Run::timed(Process&& process) {
+    const auto t0 = std::chrono::steady_clock::now();
+    callMrpt(
+        process,
+        [&] {
+            char where[96];
+            std::snprintf(where, sizeof(where), "MRPT's ICP map builder failed at step %zu",
+                          step_no_);
+            std::string doing = where;
+            if (!step_scans_.empty()) {
+                std::snprintf(where, sizeof(where), " (scan at t = %.6f s)",
+                              step_scans_.back().stamp);
+                doing += where;
+            }
+            return doing + " of " + sum_.rawlog;
+        },
+        sum_.rawlog);
+    builder_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 // One step: its scans through the door (every mode, `none` included), the kept ones and the
 // odometry to the map builder.
 void Run::step(IcpSlamStep& st, const SourceEntry& e) {
     step_scans_.clear();
-    // The map builder's time; what it throws names the step, its last scan's stamp and the log.
-    auto timed = [&](auto&& process) {
-        const auto t0 = std::chrono::steady_clock::now();
-        callMrpt(
-            process,
-            [&] {
-                char where[96];
-                std::snprintf(where, sizeof(where), "MRPT's ICP map builder failed at step %zu",
-                              step_no_);
-                std::string doing = where;
-                if (!step_scans_.empty()) {
-                    std::snprintf(where, sizeof(where), " (scan at t = %.6f s)",
-                                  step_scans_.back().stamp);
-                    doing += where;
-                }
-                return doing + " of " + sum_.rawlog;
-            },
-            sum_.rawlog);
-        builder_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    };
+    held_this_step_ = 0;
     if (st.observation) {
         bool process = true;
-        if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(st.observation))
+        if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(st.observation)) {
             process = prefilterScan(*scan, e);
-        else if (auto* odo = dynamic_cast<mrpt::obs::CObservationOdometry*>(st.observation.get()))
+            if (held_this_step_) held_.back().scan = scan;
+        } else if (auto* odo =
+                       dynamic_cast<mrpt::obs::CObservationOdometry*>(st.observation.get())) {
             process = !opts_.laser_only && toMapFrame(*odo);
-        if (process) timed([&] { builder_.processObservation(st.observation); });
+            if (process) {
+                builder_odometry_ = mrpt::poses::CPose2D(odo->odometry);
+                builder_odometry_t_ = odo->timestamp;
+            }
+        }
+        if (process) {
+            // a scan after drops: the gap check
+            if (!held_.empty() && !held_this_step_)
+                builder_.ICP_options.minICPgoodnessToAccept = gapGoodness();
+            timed([&] { builder_.processObservation(st.observation); });
+            builder_.ICP_options.minICPgoodnessToAccept = min_goodness_;
+        }
         return;
     }
     for (auto it = st.frame->begin(); it != st.frame->end();) {
         auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(*it);
-        if (scan && !prefilterScan(*scan, e))
+        if (scan && !prefilterScan(*scan, e)) {
+            if (held_this_step_ && !held_.back().scan) held_.back().scan = scan;
             it = st.frame->erase(it);
-        else
+        } else {
             ++it;
+        }
     }
     // odometry kept even if the frame is empty
     mrpt::obs::CActionCollection* action = actionFor(st);
+    if (auto mv = action->getBestMovementEstimation(); mv && mv->poseChange) {
+        // what CMetricMapBuilderICP::processActionObservation accumulates
+        builder_odometry_ =
+            builder_odometry_.value_or(mrpt::poses::CPose2D()) + mv->poseChange->getMeanVal();
+        builder_odometry_t_ = mv->timestamp;
+    }
+    for (std::size_t k = held_.size() - held_this_step_; k < held_.size(); ++k)
+        held_[k].odometry = builder_odometry_;
+    if (held_.size() > held_this_step_ && scanCount(st))  // kept scans after drops: gap check
+        builder_.ICP_options.minICPgoodnessToAccept = gapGoodness();
     timed([&] { builder_.processActionObservation(*action, *st.frame); });
+    builder_.ICP_options.minICPgoodnessToAccept = min_goodness_;
+}
+
+// An odometry reading for the map builder during a re-match: stamped just after the last one
+// (its pose estimator wants increasing stamps; without velocities it does not extrapolate).
+void Run::feedOdometry(const mrpt::poses::CPose2D& odometry) {
+    auto odo = std::make_shared<mrpt::obs::CObservationOdometry>();
+    odo->odometry = odometry;
+    builder_odometry_t_ += std::chrono::microseconds(1);
+    odo->timestamp = builder_odometry_t_;
+    timed([&] { builder_.processObservation(odo); });
+}
+
+// After ICP rejected the step's correction: the scans dropped since its last accepted one go
+// through ICP in their order, each from the odometry the builder had then, and the step's
+// kept scans again from their own, so that ICP bridges the odometry in the log's own steps
+// (MRPT's builder leaves its map and its last correction untouched by a rejection). Their
+// rows say "icp_rematch". No replay of a replay: held_ is emptied either way.
+void Run::rematch(const IcpSlamStep& st) {
+    if (!recovering_ || held_.empty()) return;
+    ++rematches_;
+    const auto pose_now = [&] {
+        const auto m = builder_.getCurrentPoseEstimation()->getMeanVal();
+        return Pose2D{m.x() + res_.map_origin.x, m.y() + res_.map_origin.y, m.yaw()};
+    };
+    bool corrected = false;  // did a replayed scan move the pose?
+    for (const Held& h : held_) {
+        if (h.row >= pending_.size()) break;  // the step's own (a frame of several scans)
+        if (!h.scan) continue;
+        if (h.odometry) feedOdometry(*h.odometry);
+        step_goodness_.reset();
+        timed([&] { builder_.processObservation(h.scan); });
+        PendingRow& row = pending_[h.row];
+        row.record.kept = true;
+        row.record.reason = "icp_rematch";
+        if (step_goodness_) {
+            ++sum_.icp_runs;
+            sum_.icp_rejected += step_rejected_ ? 1 : 0;
+            goodness_.push_back(*step_goodness_);
+            row.record.icp_goodness = *step_goodness_;
+            row.record.icp_rejected = step_rejected_;
+            if (!step_rejected_) noteAccepted(*step_goodness_);
+            corrected = corrected || !step_rejected_;
+        }
+        row.pose = pose_now();
+        res_.trajectory[row.trajectory_index].pose = row.pose;
+        res_.keyframes.push_back(row.trajectory_index);
+        ++kept_for_rematch_;
+    }
+    held_.clear();
+    // Nothing corrected (every replay rejected, or under the SLAM's gate): the same prior on
+    // the same map would give the same fit; the scan stays rejected and the recovery goes on.
+    if (!corrected) return;
+    if (builder_odometry_) feedOdometry(*builder_odometry_);
+    step_goodness_.reset();
+    if (st.observation)
+        timed([&] { builder_.processObservation(st.observation); });
+    else
+        for (const auto& o : *st.frame)
+            if (IS_CLASS(*o, CObservation2DRangeScan))
+                timed([&] { builder_.processObservation(o); });
+    if (!step_goodness_) return;
+    ++sum_.icp_runs;
+    goodness_.push_back(*step_goodness_);
+    if (step_rejected_) {
+        ++sum_.icp_rejected;
+    } else {
+        ++rematches_recovered_;
+        rejected_streak_ = 0;
+        noteAccepted(*step_goodness_);
+    }
+    recordVerdict();
 }
 
 // An absolute odometry reading as the map builder gets it: in the local frame
@@ -596,6 +749,15 @@ bool Run::prefilterScan(CObservation2DRangeScan& scan, const SourceEntry& e) {
         r.keep = r.record.kept = true;
         r.record.reason = "icp_recovery";
         ++kept_for_recovery_;
+    }
+    if (!r.keep && r.skipped == ScanSkipReason::None) {
+        // held for a re-match (the caller sets the scan; the odometry follows with the action)
+        if (held_.size() == kMaxHeld) {  // a long gap: the oldest rows go out, none held
+            held_.clear();
+            flushPending();
+        }
+        held_.push_back({nullptr, builder_odometry_, pending_.size() + step_scans_.size()});
+        ++held_this_step_;
     }
     step_scans_.push_back(std::move(r.record));
     return r.keep;
@@ -633,11 +795,21 @@ void Run::writeStep() {
         const double t = stampForOutput(s.stamp);
         if (s.odometry) res_.odometry.push_back(StampedPose{t, *s.odometry});
         traj.push_back(StampedPose{t, p});
-        csv_.write(s, p);
+        pending_.push_back({s, p, traj.size() - 1});
     }
+    if (held_.empty()) flushPending();
+}
+
+// The rows waiting for a possible re-match, to scans.csv.
+void Run::flushPending() {
+    for (const PendingRow& row : pending_) csv_.write(row.record, row.pose);
+    pending_.clear();
 }
 
 void Run::closeOutputs() {
+    held_.clear();
+    flushPending();
+    std::sort(res_.keyframes.begin(), res_.keyframes.end());
     f_path_->close();
     csv_.close();
     writeTum((res_.output->path() / "trajectory.tum").string(), res_.trajectory,
@@ -650,6 +822,11 @@ void Run::evaluate() {
     sum_.scans_kept += kept_for_recovery_;  // the door counted them as dropped
     sum_.scans_dropped -= kept_for_recovery_;
     sum_.scans_kept_for_recovery = kept_for_recovery_;
+    sum_.scans_kept += kept_for_rematch_;
+    sum_.scans_dropped -= kept_for_rematch_;
+    sum_.scans_rematched = kept_for_rematch_;
+    sum_.rematches = rematches_;
+    sum_.rematches_recovered = rematches_recovered_;
     sum_.dropped_pct = sum_.notKeptPercent();
     const double scans_in = static_cast<double>(sum_.scans_in);
     sum_.prefilter_us_per_scan = sum_.scans_in ? 1e6 * sum_.filter_seconds / scans_in : 0;

@@ -100,6 +100,15 @@ struct IcpSlamSummary : ScanCounters {
     /// Scans the pre-filter dropped that went to the map builder all the same because ICP had
     /// rejected its last correction (counted in scans_kept; reason "icp_recovery" in scans.csv).
     std::size_t scans_kept_for_recovery = 0;
+    /// Re-matches: after a rejected correction, the scans the pre-filter dropped since ICP's
+    /// last accepted one went through ICP in order, then the rejected scan again (rematches
+    /// times; rematches_recovered times ICP then accepted it). scans_rematched of those scans
+    /// (counted in scans_kept; reason "icp_rematch" in scans.csv).
+    std::size_t rematches = 0, rematches_recovered = 0, scans_rematched = 0;
+    /// Corrections across scans the pre-filter dropped that fell below kfd's gap check (3/4 of
+    /// the recent median goodness; above the configuration's minimum): rejected and
+    /// re-matched, not counted in icp_rejected.
+    std::size_t gap_checks_failed = 0;
     /// The keyframe guards the run used (0 = off): the [KFD] section's, lowered to the SLAM's
     /// localisation gate (localizationLinDistance, localizationAngDistance) when that is
     /// shorter, so that kfd never drops the scan ICP's gate would have matched.
