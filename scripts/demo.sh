@@ -7,13 +7,28 @@
 #   defaults: rawlogs/office-mit-0.752.rawlog, share/kfd/kfd-40hz.ini,
 #   share/kfd-icp-slam/lidar-40hz.ini (for a 5 Hz log: share/kfd/default.ini and
 #   share/kfd-icp-slam/sick-180-5hz.ini). IN.gt.tum beside the log, when present, gives the ATE.
+# Every file the last line names is checked; a missing one is an error (exit 1).
+# KFD_DEMO_APPS=DIR: the apps already built in DIR (the test suite's check on a clean copy of
+# the tree, test/scripts/demo_test.sh): no install, no build.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-bash "$root/scripts/install-deps.sh"
-cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-targets=(kfd-filter kfd-icp-slam)
-cmake --build "$root/build" --target help | grep -q ' kfd-render$' && targets+=(kfd-render)
-cmake --build "$root/build" -j"$(nproc)" --target "${targets[@]}"
+apps="${KFD_DEMO_APPS:-$root/build/apps}"
+render=0
+if [ -n "${KFD_DEMO_APPS:-}" ]; then
+  [ -x "$apps/kfd-render" ] && render=1
+else
+  bash "$root/scripts/install-deps.sh"
+  cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+  targets=(kfd-filter kfd-icp-slam)
+  # kfd-render exists when CMake found OSMesa (the list read whole: grep -q would close the
+  # pipe early and pipefail would count the build tool's broken pipe as no kfd-render)
+  help="$(cmake --build "$root/build" --target help)"
+  if grep -q ' kfd-render$' <<<"$help"; then
+    targets+=(kfd-render)
+    render=1
+  fi
+  cmake --build "$root/build" -j"$(nproc)" --target "${targets[@]}"
+fi
 in="${1:-$root/rawlogs/office-mit-0.752.rawlog}"
 cfg="${2:-$root/share/kfd/kfd-40hz.ini}"
 slam_cfg="${3:-$root/share/kfd-icp-slam/lidar-40hz.ini}"
@@ -21,15 +36,24 @@ name="$(basename "$in" .rawlog)"
 out="$root/out"
 mkdir -p "$out"
 start=$(date +%s)
-"$root/build/apps/kfd-filter" -q -c "$cfg" -i "$in" -o "$out/$name.kfd.rawlog" \
+"$apps/kfd-filter" -q -c "$cfg" -i "$in" -o "$out/$name.kfd.rawlog" \
   --stats "$out/$name.kfd.csv"
 gt=()
 [ -f "${in%.rawlog}.gt.tum" ] && gt=(--gt "${in%.rawlog}.gt.tum")
-"$root/build/apps/kfd-icp-slam" -q "$slam_cfg" "$in" -o "$out/$name-slam" -m kfd "${gt[@]}"
-if [ -x "$root/build/apps/kfd-render" ]; then
-  "$root/build/apps/kfd-render" -i "$in" --index 300 -c "$cfg" -o "$out/$name-clusters.png" \
+"$apps/kfd-icp-slam" -q "$slam_cfg" "$in" -o "$out/$name-slam" -m kfd "${gt[@]}"
+made=("$name.kfd.rawlog" "$name.kfd.csv" "$name-slam/report.md" "$name-slam/map_figure.png"
+  "$name-slam/summary.json" "$name-slam/trajectory.tum")
+if [ "$render" = 1 ]; then
+  "$apps/kfd-render" -i "$in" --index 300 -c "$cfg" -o "$out/$name-clusters.png" \
     --extent 8 >/dev/null
+  made+=("$name-clusters.png")
+else
+  echo "[kfd] no OSMesa found by CMake: kfd-render not built, no scan figure" >&2
 fi
+for f in "${made[@]}"; do
+  [ -s "$out/$f" ] || { echo "[kfd] error: the main job did not write out/$f" >&2; exit 1; }
+done
+figure=""
+[ "$render" = 1 ] && figure="; out/$name-clusters.png"
 echo "[kfd] $(( $(date +%s) - start )) s: out/$name.kfd.rawlog (RawLogViewer) and .kfd.csv;" \
-  "out/$name-slam/report.md with map_figure.png, summary.json, trajectory.tum;" \
-  "out/$name-clusters.png"
+  "out/$name-slam/report.md with map_figure.png, summary.json, trajectory.tum$figure"
