@@ -51,7 +51,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 if os.path.isfile(os.path.join(ROOT, "CMakeLists.txt")):
     DEFAULT_EXE = os.path.join(ROOT, "build", "apps", "kfd-icp-slam")
     DEFAULT_SIM = os.path.join(ROOT, "build", "apps", "kfd-simulate")
-    DEFAULT_DATASETS = os.path.join(ROOT, "..", "shared", "datasets")
+    DEFAULT_DATASETS = os.path.normpath(os.path.join(ROOT, "..", "shared", "datasets"))
     DEFAULT_CONFIG = os.path.join(ROOT, "share", "kfd-icp-slam", "sick-180-5hz.ini")
 else:
     _DATADIR = os.path.dirname(ROOT)
@@ -108,6 +108,12 @@ def resolve_log(spec, datasets):
         rawlog = os.path.abspath(os.path.join(datasets, spec, spec + ".rawlog"))
         name = spec
     if not os.path.isfile(rawlog):
+        if spec == name and not os.path.isdir(datasets):
+            raise CompareError(
+                "log not found: %s: a dataset name is looked up as DATASETS/%s/%s.rawlog, and "
+                "the datasets folder %s does not exist (the Freiburg logs with their .relations "
+                "are not part of kfd: put them there, or give --datasets DIR, or a log's path)"
+                % (spec, spec, spec, datasets))
         raise CompareError("log not found: %s (%s)" % (spec, rawlog))
     # NAME.relations / NAME.gt.tum beside the log: for aces/aces.orig.bag, aces.orig.* or aces.*
     folder = os.path.dirname(rawlog)
@@ -446,55 +452,91 @@ def plot(out, log, config, modes, baseline):
 
 # --- command line ----------------------------------------------------------------------------
 
-def main(argv=None):
+class DefaultsHelpFormatter(argparse.HelpFormatter):
+    """Help with each option's default where it has a real one (not for flags, required
+    options, or options whose help already says it)."""
+
+    def _get_help_string(self, action):
+        h = action.help or ""
+        d = action.default
+        if (d is None or d is argparse.SUPPRESS or isinstance(d, bool) or action.required
+                or "default" in h or not action.option_strings):
+            return h
+        shown = " ".join(map(str, d)) if isinstance(d, (list, tuple)) else str(d)
+        return "%s (default: %s)" % (h, shown or "none")
+
+
+def build_parser():
+    """kfd-compare's command line: run, job, collect, diagnose."""
     ap = argparse.ArgumentParser(
         prog="kfd-compare", description=__doc__.split("\n\n")[0],
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="Exit status: 0 on success, 1 when a run failed or an input is bad, 2 on bad usage.")
     sub = ap.add_subparsers(dest="command", required=True)
+    # Every option says what it does and, when it has one, its default (argparse's %(default)s).
+    fmt = {"formatter_class": DefaultsHelpFormatter}
     tools = argparse.ArgumentParser(add_help=False)  # how one run is made: run and job
-    tools.add_argument("--datasets", default=DEFAULT_DATASETS)
-    tools.add_argument("--exe", default=DEFAULT_EXE, help="kfd-icp-slam")
-    tools.add_argument("--sim-exe", default=DEFAULT_SIM, help="kfd-simulate")
-    tools.add_argument("--split-seconds", type=float, default=10.0,
-                       help="relations over at most S s are local (default 10)")
-    tools.add_argument("--scan-topic", help="bags: kfd-icp-slam --scan-topic (default: automatic)")
-    tools.add_argument("--odom-topic", help="bags: kfd-icp-slam --odom-topic TOPIC|tf|none")
+    tools.add_argument("--datasets", default=DEFAULT_DATASETS,
+                       help="folder of the named datasets (NAME/NAME.rawlog, .relations); a "
+                       "fresh clone expects ../shared/datasets beside it")
+    tools.add_argument("--exe", default=DEFAULT_EXE, help="the kfd-icp-slam to run")
+    tools.add_argument("--sim-exe", default=DEFAULT_SIM, help="the kfd-simulate for sim: logs")
+    tools.add_argument("--split-seconds", type=float, default=10.0, metavar="S",
+                       help="relations over at most S s are local, the others long")
+    tools.add_argument("--scan-topic", help="bags: kfd-icp-slam --scan-topic (none: automatic)")
+    tools.add_argument("--odom-topic",
+                       help="bags: kfd-icp-slam --odom-topic TOPIC|tf|none (none: automatic)")
     report = argparse.ArgumentParser(add_help=False)  # how runs are compared: run and collect
-    report.add_argument("--baseline", default="none")
-    report.add_argument("--pairs", nargs="*", default=[], help="more pairs A:B")
+    report.add_argument("--baseline", default="none",
+                        help="the mode every other is compared with and failures are judged by")
+    report.add_argument("--pairs", nargs="*", default=[], metavar="A:B",
+                        help="more pairs to compare, mode A against mode B")
     report.add_argument("--failure-factor", type=float, default=kfd_report.FAILURE_FACTOR,
                         metavar="F", help="a run fails when its local or long relations error "
-                        "is above F x the baseline's median on its log and config (default %g)"
-                        % kfd_report.FAILURE_FACTOR)
-    report.add_argument("--no-plots", dest="plots", action="store_false")
-    report.add_argument("-q", "--quiet", action="store_true")
-    r = sub.add_parser("run", parents=[tools, report], help="run (or emit) every job, then collect")
-    r.add_argument("--logs", nargs="+", required=True, help="dataset names, log paths (.rawlog, .bag, .clf), sim:...")
-    r.add_argument("--modes", nargs="+", default=["none", "kfd", "odometry@kfd", "keyframe"])
+                        "is above F x the baseline's median on its log and config")
+    report.add_argument("--no-plots", dest="plots", action="store_false",
+                        help="no box plots (plots/*.png)")
+    report.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+    r = sub.add_parser("run", parents=[tools, report], help="run (or emit) every job, then collect",
+                       **fmt)
+    r.add_argument("--logs", nargs="+", required=True,
+                   help="dataset names, log paths (.rawlog, .bag, .clf), sim:...")
+    r.add_argument("--modes", nargs="+", default=["none", "kfd", "odometry@kfd", "keyframe"],
+                   help="pre-filter modes (kfd-icp-slam --mode; odometry@M: the odometry filter "
+                   "at M's drop rate)")
     r.add_argument("--configs", nargs="+", default=[DEFAULT_CONFIG], help="kfd-icp-slam .ini files")
-    r.add_argument("--repeats", "-R", type=int, default=20)
-    r.add_argument("--out", "-o", required=True)
-    r.add_argument("--jobs", "-j", type=int, default=os.cpu_count() or 1, help="local parallel runs")
+    r.add_argument("--repeats", "-R", type=int, default=20,
+                   help="runs per log, config and mode (repeat K starts K scans later)")
+    r.add_argument("--out", "-o", required=True,
+                   help="output folder (runs/, summary.md, report.md, runs.csv); a finished run "
+                   "in it is kept (resume)")
+    r.add_argument("--jobs", "-j", type=int, default=os.cpu_count() or 1,
+                   help="local parallel runs (default: every core)")
     r.add_argument("--emit-jobs", metavar="FILE", help="write one command per line and stop")
     r.add_argument("--maps", action="store_true", help="keep each run's map and map figure")
-    j = sub.add_parser("job", parents=[tools], help="one run (what --emit-jobs writes)")
-    j.add_argument("--out", required=True)
-    j.add_argument("--log", required=True)
-    j.add_argument("--config", required=True)
-    j.add_argument("--mode", required=True)
-    j.add_argument("--repeat", type=int, required=True)
-    j.add_argument("--map", action="store_true")
+    j = sub.add_parser("job", parents=[tools], help="one run (what --emit-jobs writes)", **fmt)
+    j.add_argument("--out", required=True, help="the comparison's output folder")
+    j.add_argument("--log", required=True, help="dataset name, log path or sim:...")
+    j.add_argument("--config", required=True, help="kfd-icp-slam .ini file")
+    j.add_argument("--mode", required=True, help="pre-filter mode")
+    j.add_argument("--repeat", type=int, required=True, help="repeat K: starts K scans later")
+    j.add_argument("--map", action="store_true", help="keep the run's map and map figure")
     c = sub.add_parser("collect", parents=[report],
-                       help="merge the finished runs of DIR into its report")
-    c.add_argument("dir")
-    g = sub.add_parser("diagnose", help="gaps between kept scans and the local error they cost")
-    g.add_argument("dir")
+                       help="merge the finished runs of DIR into its report", **fmt)
+    c.add_argument("dir", help="a comparison's output folder")
+    g = sub.add_parser("diagnose", help="gaps between kept scans and the local error they cost",
+                       **fmt)
+    g.add_argument("dir", help="a comparison's output folder")
     g.add_argument("--modes", nargs="+", required=True, help="modes to diagnose (2 or more)")
     g.add_argument("--reference", default="none", help="mode whose repeat 0 gives the motion")
-    g.add_argument("--datasets", default=DEFAULT_DATASETS)
-    g.add_argument("--split-seconds", type=float, default=10.0)
-    a = ap.parse_args(argv)
+    g.add_argument("--datasets", default=DEFAULT_DATASETS, help="folder of the named datasets")
+    g.add_argument("--split-seconds", type=float, default=10.0, metavar="S",
+                   help="relations over at most S s are local")
+    return ap
+
+
+def main(argv=None):
+    a = build_parser().parse_args(argv)
     try:
         if a.command == "run":
             return cmd_run(a)
