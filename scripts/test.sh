@@ -12,12 +12,13 @@ cmake --build "$root/build" -j"$(nproc)"
 cd "$root/build"
 status=0
 ctest --output-on-failure -j"$(nproc)" || status=$?
-# The tests that skipped themselves (GTEST_SKIP: real data or a tool missing), with the reason
-# each gave: a green run with skips says so last.
+# The tests that skipped themselves (GTEST_SKIP, unittest's skipTest: real data or a tool
+# missing), with the reason each gave: a green run with skips says so last.
 log=Testing/Temporary/LastTest.log
 if [ -f "$log" ]; then
   awk '/: Skipped$/ { getline reason; next_reason = reason }
        /^\[  SKIPPED \] [^ ]+ \(/ { n++; printf "  %s: %s\n", $4, next_reason; next_reason = "" }
+       / \.\.\. skipped / { n++; r = $0; sub(/.* \.\.\. skipped /, "", r); printf "  %s: %s\n", $1, r }
        END { if (n) printf "%d test%s skipped (above: why; the real logs are read from cmake -DKFD_DATASETS_DIR, " \
                            "default ../shared/datasets)\n", n, n == 1 ? "" : "s"
              else print "no test skipped" }' "$log"
