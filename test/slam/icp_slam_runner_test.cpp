@@ -43,6 +43,22 @@ std::size_t lines(const std::string& path) {
     return n;
 }
 
+// A CSV file's rows, split at commas (a trailing comma: an empty last field), header included.
+std::vector<std::vector<std::string>> csvRows(const std::string& path) {
+    std::vector<std::vector<std::string>> out;
+    std::ifstream in(path);
+    std::string line;
+    while (std::getline(in, line)) {
+        std::vector<std::string> fields;
+        std::stringstream ss(line);
+        std::string field;
+        while (std::getline(ss, field, ',')) fields.push_back(field);
+        if (!line.empty() && line.back() == ',') fields.emplace_back();
+        out.push_back(fields);
+    }
+    return out;
+}
+
 // A run and its report, as kfd-icp-slam does.
 kfd::IcpSlamSummary runAndReport(const kfd::IcpSlamOptions& o) {
     const auto result = kfd::IcpSlamRunner().run(o);
@@ -127,21 +143,7 @@ TEST(IcpSlamRunner, ScansCsvIsTheDoorsRecordWithThePose) {
     fo.stats_csv = dir / "stats.csv";
     fo.pipeline = kfd::kfdDefaults();
     const auto f = kfd::RawlogFilter().run(fo);
-    auto rows = [](const std::string& path) {
-        std::vector<std::vector<std::string>> out;
-        std::ifstream in(path);
-        std::string line;
-        while (std::getline(in, line)) {
-            std::vector<std::string> fields;
-            std::stringstream ss(line);
-            std::string field;
-            while (std::getline(ss, field, ',')) fields.push_back(field);
-            if (!line.empty() && line.back() == ',') fields.emplace_back();
-            out.push_back(fields);
-        }
-        return out;
-    };
-    const auto slam = rows(dir / "slam/scans.csv"), filter = rows(dir / "stats.csv");
+    const auto slam = csvRows(dir / "slam/scans.csv"), filter = csvRows(dir / "stats.csv");
     ASSERT_FALSE(slam.empty());
     ASSERT_FALSE(filter.empty());
     EXPECT_EQ(slam[0], filter[0]);  // one column set
@@ -628,27 +630,24 @@ TEST(IcpSlamRunner, ARejectedCorrectionIsReMatchedThroughTheDroppedScans) {
     EXPECT_GT(s.scans_rematched, 0u);
     EXPECT_LE(s.rematches_recovered, s.rematches);
     EXPECT_EQ(s.scans_kept + s.scans_dropped + s.scans_skipped, s.scans_in);
-    std::ifstream csv(dir / "kfd/scans.csv");
-    std::string line;
-    std::getline(csv, line);
-    std::size_t kept = 0, rematched = 0, rows = 0;
-    bool rematch_open = false;  // a rematched row waits for the re-fed scan's row
-    while (std::getline(csv, line)) {
-        ++rows;
-        std::stringstream ss(line);
-        std::vector<std::string> f;
-        for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
-        ASSERT_GE(f.size(), 22u) << line;
+    const auto csv = csvRows(dir / "kfd/scans.csv");
+    ASSERT_FALSE(csv.empty());
+    std::size_t kept = 0, rematched = 0;
+    bool rematch_open = false;  // rematched rows are followed by the rejected scan's row
+    for (std::size_t i = 1; i < csv.size(); ++i) {
+        const auto& f = csv[i];
+        ASSERT_GE(f.size(), 22u) << i;
         kept += f[3] == "1";
         if (f[4] == "icp_rematch") {
             ++rematched;
-            EXPECT_EQ(f[3], "1") << line;
+            EXPECT_EQ(f[3], "1") << i;
             rematch_open = true;
         } else if (rematch_open && f[3] == "1") {
-            EXPECT_FALSE(f[21].empty()) << line;  // the re-fed scan's own correction
+            EXPECT_FALSE(f[21].empty()) << i;  // its correction's verdict (re-fed or not)
             rematch_open = false;
         }
     }
+    const std::size_t rows = csv.size() - 1;
     EXPECT_EQ(rows, s.scans_in);
     EXPECT_EQ(kept, s.scans_kept);
     EXPECT_EQ(rematched, s.scans_rematched);

@@ -268,10 +268,12 @@ class Run {
     void step(IcpSlamStep& step, const SourceEntry& e);
     template <class Process>
     void timed(Process&& process);
+    template <class Process>
+    void match(bool after_drops, Process&& process);
     void feedOdometry(const mrpt::poses::CPose2D& odometry);
     void rematch(const IcpSlamStep& step);
     bool toMapFrame(mrpt::obs::CObservationOdometry& odo);
-    bool prefilterScan(CObservation2DRangeScan& scan, const SourceEntry& e);
+    bool prefilterScan(const CObservation2DRangeScan::Ptr& scan, const SourceEntry& e);
     mrpt::obs::CActionCollection* actionFor(const IcpSlamStep& step);
     void writeStep();
     void closeOutputs();
@@ -298,6 +300,8 @@ class Run {
     // ICP's correction of the current step, from the builder's log (onBuilderLog).
     void onBuilderLog(std::string_view msg);
     void noteIcp();
+    enum class Verdict { Accepted, Rejected, GapCheckFailed };
+    Verdict countCorrection();
     void recordVerdict();
     std::optional<double> step_goodness_;
     bool step_rejected_ = false;
@@ -337,8 +341,6 @@ class Run {
     // test, with a raised minimum) and re-matched.
     double min_goodness_ = 0.4;  // the configuration's minICPgoodnessToAccept
     std::optional<GapCheck> gap_check_;
-    void noteAccepted(double goodness) { gap_check_->accepted(goodness); }
-    double gapGoodness() const { return gap_check_->minimum(); }
 };
 
 // MRPT's map builder says how each ICP correction went only in its log: "Fit:%.1f%%" when
@@ -367,22 +369,38 @@ void Run::onBuilderLog(std::string_view msg) {
 void Run::noteIcp() {
     if (!step_goodness_) return;
     const double stamp = step_scans_.empty() ? 0.0 : stampForOutput(step_scans_.back().stamp);
-    ++sum_.icp_runs;
-    goodness_.push_back(*step_goodness_);
-    if (step_rejected_ && *step_goodness_ > min_goodness_) {
-        // rejected by the gap check only: re-matched (rematch()), not a rejection of the SLAM's
-        ++sum_.gap_checks_failed;
-    } else if (step_rejected_) {
-        ++sum_.icp_rejected;
-        if (rejected_streak_++ == 0) streak_start_ = stamp;
-        if (rejected_streak_ == kLostTrackRejections)
-            sum_.lost_track_stamps.push_back(streak_start_);
-    } else {
-        rejected_streak_ = 0;
-        held_.clear();  // nothing to re-match before an accepted correction
-        noteAccepted(*step_goodness_);
+    switch (countCorrection()) {
+        case Verdict::Accepted:
+            rejected_streak_ = 0;
+            held_.clear();  // nothing to re-match before an accepted correction
+            break;
+        case Verdict::Rejected:
+            if (rejected_streak_++ == 0) streak_start_ = stamp;
+            if (rejected_streak_ == kLostTrackRejections)
+                sum_.lost_track_stamps.push_back(streak_start_);
+            break;
+        case Verdict::GapCheckFailed:  // re-matched (rematch()), not a rejection of the SLAM's
+            break;
     }
     recordVerdict();
+}
+
+// A correction that ran (step_goodness_), counted: accepted (its goodness joins the gap
+// check's), rejected by the SLAM's own minimum (icp_rejected), or rejected by the gap check
+// only (gap_checks_failed: goodness above the configuration's minimum).
+Run::Verdict Run::countCorrection() {
+    ++sum_.icp_runs;
+    goodness_.push_back(*step_goodness_);
+    if (!step_rejected_) {
+        gap_check_->accepted(*step_goodness_);
+        return Verdict::Accepted;
+    }
+    if (*step_goodness_ > min_goodness_) {
+        ++sum_.gap_checks_failed;
+        return Verdict::GapCheckFailed;
+    }
+    ++sum_.icp_rejected;
+    return Verdict::Rejected;
 }
 
 // The step's verdict on its kept scans' records; a rejection starts the recovery.
@@ -602,6 +620,15 @@ void Run::timed(Process&& process) {
     builder_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// A call into the map builder with the step's scans; after drops (scans held since ICP's last
+// accepted correction, from earlier steps) under the gap check's minimum for that one call.
+template <class Process>
+void Run::match(bool after_drops, Process&& process) {
+    if (after_drops) builder_.ICP_options.minICPgoodnessToAccept = gap_check_->minimum();
+    timed(process);
+    builder_.ICP_options.minICPgoodnessToAccept = min_goodness_;
+}
+
 // One step: its scans through the door (every mode, `none` included), the kept ones and the
 // odometry to the map builder.
 void Run::step(IcpSlamStep& st, const SourceEntry& e) {
@@ -610,8 +637,7 @@ void Run::step(IcpSlamStep& st, const SourceEntry& e) {
     if (st.observation) {
         bool process = true;
         if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(st.observation)) {
-            process = prefilterScan(*scan, e);
-            if (held_this_step_) held_.back().scan = scan;
+            process = prefilterScan(scan, e);
         } else if (auto* odo =
                        dynamic_cast<mrpt::obs::CObservationOdometry*>(st.observation.get())) {
             process = !opts_.laser_only && toMapFrame(*odo);
@@ -620,23 +646,17 @@ void Run::step(IcpSlamStep& st, const SourceEntry& e) {
                 builder_odometry_t_ = odo->timestamp;
             }
         }
-        if (process) {
-            // a scan after drops: the gap check
-            if (!held_.empty() && !held_this_step_)
-                builder_.ICP_options.minICPgoodnessToAccept = gapGoodness();
-            timed([&] { builder_.processObservation(st.observation); });
-            builder_.ICP_options.minICPgoodnessToAccept = min_goodness_;
-        }
+        if (process)
+            match(!held_.empty() && !held_this_step_,
+                  [&] { builder_.processObservation(st.observation); });
         return;
     }
     for (auto it = st.frame->begin(); it != st.frame->end();) {
         auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(*it);
-        if (scan && !prefilterScan(*scan, e)) {
-            if (held_this_step_ && !held_.back().scan) held_.back().scan = scan;
+        if (scan && !prefilterScan(scan, e))
             it = st.frame->erase(it);
-        } else {
+        else
             ++it;
-        }
     }
     // odometry kept even if the frame is empty
     mrpt::obs::CActionCollection* action = actionFor(st);
@@ -648,10 +668,8 @@ void Run::step(IcpSlamStep& st, const SourceEntry& e) {
     }
     for (std::size_t k = held_.size() - held_this_step_; k < held_.size(); ++k)
         held_[k].odometry = builder_odometry_;
-    if (held_.size() > held_this_step_ && scanCount(st))  // kept scans after drops: gap check
-        builder_.ICP_options.minICPgoodnessToAccept = gapGoodness();
-    timed([&] { builder_.processActionObservation(*action, *st.frame); });
-    builder_.ICP_options.minICPgoodnessToAccept = min_goodness_;
+    match(held_.size() > held_this_step_ && scanCount(st),
+          [&] { builder_.processActionObservation(*action, *st.frame); });
 }
 
 // An odometry reading for the map builder during a re-match: stamped just after the last one
@@ -679,7 +697,6 @@ void Run::rematch(const IcpSlamStep& st) {
     bool corrected = false;  // did a replayed scan move the pose?
     for (const Held& h : held_) {
         if (h.row >= pending_.size()) break;  // the step's own (a frame of several scans)
-        if (!h.scan) continue;
         if (h.odometry) feedOdometry(*h.odometry);
         step_goodness_.reset();
         timed([&] { builder_.processObservation(h.scan); });
@@ -687,13 +704,10 @@ void Run::rematch(const IcpSlamStep& st) {
         row.record.kept = true;
         row.record.reason = "icp_rematch";
         if (step_goodness_) {
-            ++sum_.icp_runs;
-            sum_.icp_rejected += step_rejected_ ? 1 : 0;
-            goodness_.push_back(*step_goodness_);
+            const bool accepted = countCorrection() == Verdict::Accepted;
+            corrected = corrected || accepted;
             row.record.icp_goodness = *step_goodness_;
             row.record.icp_rejected = step_rejected_;
-            if (!step_rejected_) noteAccepted(*step_goodness_);
-            corrected = corrected || !step_rejected_;
         }
         row.pose = pose_now();
         res_.trajectory[row.trajectory_index].pose = row.pose;
@@ -713,14 +727,9 @@ void Run::rematch(const IcpSlamStep& st) {
             if (IS_CLASS(*o, CObservation2DRangeScan))
                 timed([&] { builder_.processObservation(o); });
     if (!step_goodness_) return;
-    ++sum_.icp_runs;
-    goodness_.push_back(*step_goodness_);
-    if (step_rejected_) {
-        ++sum_.icp_rejected;
-    } else {
+    if (countCorrection() == Verdict::Accepted) {
         ++rematches_recovered_;
         rejected_streak_ = 0;
-        noteAccepted(*step_goodness_);
     }
     recordVerdict();
 }
@@ -741,8 +750,8 @@ bool Run::toMapFrame(mrpt::obs::CObservationOdometry& odo) {
 }
 
 // A scan through the door; true when it goes on to ICP. Its record waits for the step's pose.
-bool Run::prefilterScan(CObservation2DRangeScan& scan, const SourceEntry& e) {
-    StreamResult r = prefilter_->process(scan, e.odometry);
+bool Run::prefilterScan(const CObservation2DRangeScan::Ptr& scan, const SourceEntry& e) {
+    StreamResult r = prefilter_->process(*scan, e.odometry);
     if (!r.keep && recovering_ && r.skipped == ScanSkipReason::None) {
         // Dropped by the pre-filter while ICP is recovering from a rejected correction: it
         // goes to the map builder all the same (as cleaned by the stages that ran).
@@ -751,12 +760,12 @@ bool Run::prefilterScan(CObservation2DRangeScan& scan, const SourceEntry& e) {
         ++kept_for_recovery_;
     }
     if (!r.keep && r.skipped == ScanSkipReason::None) {
-        // held for a re-match (the caller sets the scan; the odometry follows with the action)
+        // held for a re-match (a frame's odometry follows with its action: step())
         if (held_.size() == kMaxHeld) {  // a long gap: the oldest rows go out, none held
             held_.clear();
             flushPending();
         }
-        held_.push_back({nullptr, builder_odometry_, pending_.size() + step_scans_.size()});
+        held_.push_back({scan, builder_odometry_, pending_.size() + step_scans_.size()});
         ++held_this_step_;
     }
     step_scans_.push_back(std::move(r.record));
