@@ -94,6 +94,25 @@ TEST(OutputPaths, TempFileIsRemovedUnlessCommitted) {
     EXPECT_EQ(kfd::test::fileBytes(d / "keep.png"), "new");
 }
 
+TEST(OutputPaths, TempFileCreatesAMissingParentFolder) {
+    TempDir d;
+    {
+        kfd::TempOutputFile t(d / "out/figs/a.png");  // "-o out/a.png" in a fresh clone
+        EXPECT_EQ(t.path().parent_path(), fs::path(d / "out/figs"));
+        std::ofstream(t.path()) << "png";
+        t.commit();
+    }
+    EXPECT_EQ(kfd::test::fileBytes(d / "out/figs/a.png"), "png");
+    d.touch("file", "x");  // a parent that is a file: an error naming the output
+    try {
+        kfd::TempOutputFile t(d / "file/a.png");
+        ADD_FAILURE() << "no error";
+    } catch (const kfd::WriteError& e) {
+        EXPECT_NE(std::string(e.what()).find("cannot write " + d / "file/a.png"), std::string::npos)
+            << e.what();
+    }
+}
+
 TEST(OutputPaths, StagedNewFolderAppearsWholeOrNotAtAll) {
     TempDir d;
     {

@@ -296,6 +296,14 @@ std::size_t removeStaleTemporaries(const fs::path& final_path) {
 
 TempOutputFile::TempOutputFile(fs::path final_path) : final_(std::move(final_path)) {
     checkRegularOutput({"output", final_.string()});
+    if (final_.has_parent_path()) {  // "out/x.png" in a fresh clone: out/ is made, as for folders
+        std::error_code ec;
+        fs::create_directories(final_.parent_path(), ec);
+        if (ec)
+            throw WriteError("cannot write " + final_.string() + ": cannot create the folder " +
+                                 final_.parent_path().string() + ": " + ec.message(),
+                             final_.string());
+    }
     removeStaleTemporaries(final_);
     lock_ = createLockedTemporary(final_, false, temp_, final_.string());
 }

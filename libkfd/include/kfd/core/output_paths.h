@@ -116,7 +116,8 @@ std::size_t removeStaleTemporaries(const std::filesystem::path& final_path);
 /// A file written under a temporary name and moved over its final name by commit(). The
 /// temporary is created at once (exclusively, and locked for removeStaleTemporaries); until
 /// commit() the destructor removes it (on any failure or cancellation nothing partial
-/// remains). Stale temporaries of the same output are removed first.
+/// remains). Stale temporaries of the same output are removed first. A missing parent folder
+/// is created (and remains), as StagedOutputFolder does.
 class TempOutputFile {
   public:
     /// PathError when `final_path` exists and is not a regular file; WriteError when the
