@@ -229,7 +229,8 @@ std::string toJson(const IcpSlamSummary& s) {
         j["source"] = std::move(src);
     }
     j["laser_only"] = s.laser_only;
-    j["notices"] = s.notices;  // what the run did not honour (icp-slam keys, map kinds)
+    if (!s.notices.empty())  // what the run did not honour (icp-slam keys, map kinds)
+        j["notices"] = s.notices;
     if (s.ate_rmse) j["ate_rmse_m"] = *s.ate_rmse;
     if (s.relations) {
         const auto& r = *s.relations;
