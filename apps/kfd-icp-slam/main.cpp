@@ -17,10 +17,14 @@ int main(int argc, char** argv) {
         "([ICP], [MappingApplication], map definitions), with a pre-filter in front of scan\n"
         "matching configured by an optional [KFD] section (see kfd-filter --list-keys).\n"
         "LOG is an MRPT rawlog, a ROS 1 bag (LaserScan with Odometry or /tf) or a CARMEN log.",
-        "Writes trajectory.tum (a pose for every input scan), log_estimated_path.txt (icp-slam's\n"
-        "format), scans.csv, summary.json, final_map.simplemap, map.png, map_figure.png and\n"
-        "report.md into the output folder (staged in a temporary folder and moved in at the end;\n"
-        "the folder's other files are kept).\n"
+        "Writes trajectory.tum (a pose for every input scan), scans.csv, summary.json,\n"
+        "final_map.simplemap, map.png, map_figure.png and report.md into the output folder, and\n"
+        "icp-slam's files as [MappingApplication] asks: log_estimated_path.txt,\n"
+        "log_odometry_path.txt, log_times.txt, log_MemoryUsage.txt, _finalmap_.simplemap,\n"
+        "_finalmaps_.txt_*; every LOG_FREQUENCY steps mapbuild_posepdf_NNN.txt (SAVE_POSE_LOG)\n"
+        "and buildingmap_NNNNN.3Dscene (SAVE_3D_SCENE, for SceneViewer3D). A key it ignores\n"
+        "(SHOW_PROGRESS_3D_REAL_TIME: no window) is a warning on stderr. The folder is staged in\n"
+        "a temporary folder and moved in at the end; its other files are kept.\n"
         "Exit status: 0 on success, 1 on bad input or configuration (an output that is an input\n"
         "included), 2 on bad usage, 130/143 when interrupted (no output is left).");
     kfd::IcpSlamOptions o;
@@ -78,7 +82,9 @@ int main(int argc, char** argv) {
         ->type_name("S")
         ->capture_default_str();
     bool no_map = false;
-    cli.flag("--no-map", no_map, "skip final_map.simplemap and map.png");
+    cli.flag("--no-map", no_map,
+             "skip the maps: final_map.simplemap, map.png, map_figure.png,\nreport.md, "
+             "_finalmap_.simplemap, _finalmaps_.txt_*");
     cli.addQuiet();
     cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP
     return cli.run(argc, argv, [&] {
@@ -106,6 +112,8 @@ int main(int argc, char** argv) {
         }();
         kfd::writeIcpSlamReport(result);
         const auto& s = result.summary;
+        for (const auto& notice : s.notices)  // an icp-slam key or map kfd did not honour
+            std::fprintf(stderr, "kfd-icp-slam: warning: %s\n", notice.c_str());
         std::printf("kfd-icp-slam summary (mode %s)\n", kfd::toString(s.mode));
         std::printf("  input      %s\n  output     %s\n", s.rawlog.c_str(), s.output_dir.c_str());
         std::printf("  scans      in %zu, kept %zu, dropped %.1f %%\n", s.scans_in, s.scans_kept,

@@ -657,6 +657,28 @@ TEST(BadInputFullDisk, IcpSlamOutputFolder) {
                       "slam/", {in, cfg});
 }
 
+TEST(BadInputFullDisk, IcpSlamThreeDScenes) {
+    // icp-slam's periodic files (SAVE_3D_SCENE every step) go through kfd's checked writers
+    // too: the scenes fill the tmpfs first, and the error names the scene that did not fit.
+    Dir d;
+    SmallTmpfs t(d.path / "full");
+    KFD_REQUIRE_TMPFS(t);
+    const auto in = d.copy(kOffice, "in.rawlog");
+    std::string ini = fileBytes(kSlamIni);
+    for (const std::string key : {"LOG_FREQUENCY = 0", "SAVE_3D_SCENE = 0"}) {
+        const auto at = ini.find(key);
+        ASSERT_NE(at, std::string::npos) << key;
+        ini[at + key.size() - 1] = '1';
+    }
+    const auto cfg = d.write("slam.ini", ini);
+    expectFullDiskRow(d, t, KFD_ICP_SLAM_EXE, "kfd-icp-slam",
+                      [&](const fs::path& o) {
+                          return std::vector<std::string>{"-q", "--no-map", cfg,
+                                                          in,   "-o",       o / "slam"};
+                      },
+                      "slam/buildingmap_", {in, cfg});
+}
+
 TEST(BadInputFullDisk, SimulateAndInject) {
     Dir d;
     SmallTmpfs t(d.path / "full");

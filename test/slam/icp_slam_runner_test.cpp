@@ -1,14 +1,23 @@
 // kfd-icp-slam end to end: equality with MRPT's icp-slam, pose error on a real log, every mode.
 #include <gtest/gtest.h>
+#include <mrpt/img/CImage.h>
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/opengl/CGridPlaneXY.h>
+#include <mrpt/opengl/COpenGLScene.h>
+#include <mrpt/opengl/CPlanarLaserScan.h>
+#include <mrpt/serialization/CArchive.h>
 
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "kfd/baselines/decimate_stage.h"
 #include "kfd/core/cancel.h"
+#include "kfd/core/format.h"
 #include "kfd/core/keyframe_stage.h"
 #include "kfd/eval/trajectory.h"
 #include "kfd/mrpt/config.h"
@@ -664,4 +673,271 @@ TEST(IcpSlamRunner, ARejectedCorrectionIsReMatchedThroughTheDroppedScans) {
     EXPECT_EQ(none.rematches, 0u);
     EXPECT_EQ(none.scans_rematched, 0u);
     EXPECT_EQ(none.gap_checks_failed, 0u);
+}
+
+// --- icp-slam's output keys and files (issue 23) ---------------------------------------------
+
+namespace {
+
+// kConfig with [MappingApplication] keys set (each "KEY = VALUE" replaces the key's line, or is
+// added to the section when the file has none).
+std::string configWith(const fs::path& dir,
+                       const std::vector<std::pair<std::string, std::string>>& keys) {
+    std::string ini = text(kConfig);
+    for (const auto& [key, value] : keys) {
+        const auto at = ini.find("\n" + key + " ");
+        const std::string line = key + " = " + value;
+        if (at == std::string::npos)
+            ini.insert(ini.find("\n", ini.find("[MappingApplication]")) + 1, line + "\n");
+        else
+            ini.replace(at + 1, ini.find('\n', at + 1) - at - 1, line);
+    }
+    const std::string path = dir / "icp.ini";
+    std::ofstream(path) << ini;
+    return path;
+}
+
+// A text file's rows split at blanks and tabs.
+std::vector<std::vector<std::string>> rows(const std::string& path) {
+    std::vector<std::vector<std::string>> out;
+    std::ifstream in(path);
+    std::string line;
+    while (std::getline(in, line)) {
+        std::istringstream ss(line);
+        std::vector<std::string> fields;
+        for (std::string f; ss >> f;) fields.push_back(f);
+        out.push_back(fields);
+    }
+    return out;
+}
+
+// The files of `dir` whose names start with `prefix`.
+std::set<std::string> filesStarting(const fs::path& dir, const std::string& prefix) {
+    std::set<std::string> out;
+    for (const auto& e : fs::directory_iterator(dir))
+        if (e.path().filename().string().rfind(prefix, 0) == 0) out.insert(e.path().filename());
+    return out;
+}
+
+template <class T>
+void loadGz(const std::string& path, T& obj) {
+    mrpt::io::CFileGZInputStream f(path);
+    mrpt::serialization::archiveFrom(f) >> obj;
+}
+
+std::string simulatedLog(const fs::path& dir, double seconds) {
+    kfd::SimulationOptions so;
+    so.duration_s = seconds;
+    so.output = dir / "sim.rawlog";
+    return kfd::Simulator().run(so).rawlog;
+}
+
+}  // namespace
+
+// A user switching from MRPT's icp-slam finds its files: every step's logs, the pose PDFs and 3D
+// scenes every LOG_FREQUENCY steps, the final map and the map as text and as a grid image.
+TEST(IcpSlamLogs, OutputKeysWriteIcpSlamsFilesInItsFormats) {
+    TempDir dir;
+    const std::string rawlog = simulatedLog(dir.path, 4.0);
+    auto o = options(rawlog, dir / "out", kfd::PrefilterMode::Kfd);
+    o.config_file = configWith(dir.path, {{"LOG_FREQUENCY", "7"},
+                                          {"SAVE_POSE_LOG", "1"},
+                                          {"SAVE_3D_SCENE", "true"},
+                                          {"SHOW_LASER_SCANS_3D", "true"},
+                                          {"occupancyGrid_count", "1"}});
+    const auto s = runAndReport(o);
+    EXPECT_TRUE(s.notices.empty());
+    const std::size_t steps = s.entries;  // icp-slam's steps: a scan or an odometry reading
+    ASSERT_GT(steps, 20u);
+    // One line per step, numbered as log_estimated_path.txt: "step x y phi", "ms frames",
+    // "step<TAB>bytes".
+    for (const auto& [name, columns] :
+         {std::pair{"log_estimated_path.txt", 4u}, std::pair{"log_odometry_path.txt", 4u},
+          std::pair{"log_times.txt", 2u}, std::pair{"log_MemoryUsage.txt", 2u}}) {
+        SCOPED_TRACE(name);
+        const auto r = rows(dir / ("out/" + std::string(name)));
+        ASSERT_EQ(r.size(), steps);
+        for (std::size_t i = 0; i < r.size(); ++i) {
+            ASSERT_EQ(r[i].size(), columns) << i;
+            if (columns == 4u || std::string(name) == "log_MemoryUsage.txt") {
+                EXPECT_EQ(r[i][0], std::to_string(i));
+            }
+        }
+    }
+    EXPECT_NE(text(dir / "out/log_MemoryUsage.txt").find("0\t"), std::string::npos);
+    // The odometry accumulated from (0, 0, 0): the robot drove forward.
+    const auto odo = rows(dir / "out/log_odometry_path.txt");
+    EXPECT_EQ(odo.front()[1], "0.000000");
+    EXPECT_GT(std::stod(odo.back()[1]) * std::stod(odo.back()[1]) +
+                  std::stod(odo.back()[2]) * std::stod(odo.back()[2]),
+              1.0);
+    const auto times = rows(dir / "out/log_times.txt");
+    EXPECT_GE(std::stoi(times.back()[1]), 1);  // frames in the map
+    // Every 7th step, from step 0: the pose PDF (mean, then the 6x6 covariance) and the scene.
+    std::set<std::string> pdfs, scenes;
+    for (std::size_t k = 0; k < steps; k += 7) {
+        pdfs.insert(kfd::format("mapbuild_posepdf_%03zu.txt", k));
+        scenes.insert(kfd::format("buildingmap_%05zu.3Dscene", k));
+    }
+    EXPECT_EQ(filesStarting(dir / "out", "mapbuild_posepdf_"), pdfs);
+    EXPECT_EQ(filesStarting(dir / "out", "buildingmap_"), scenes);
+    const auto pdf = rows(dir / ("out/" + *pdfs.rbegin()));
+    ASSERT_EQ(pdf.size(), 7u);
+    for (const auto& r : pdf) EXPECT_EQ(r.size(), 6u);
+    // Each scene opens as SceneViewer3D opens it: the ground, the map and the robot, the step's
+    // scans (a step of an observations log is a scan or an odometry reading), and the mini-map.
+    std::size_t with_scans = 0;
+    for (const auto& name : scenes) {
+        SCOPED_TRACE(name);
+        mrpt::opengl::COpenGLScene scene;
+        loadGz(dir / ("out/" + name), scene);
+        const auto main = scene.getViewport("main");
+        ASSERT_TRUE(main);
+        EXPECT_GE(main->size(), 3u);
+        EXPECT_TRUE(main->getByClass<mrpt::opengl::CGridPlaneXY>());
+        with_scans += main->getByClass<mrpt::opengl::CPlanarLaserScan>() ? 1 : 0;
+        ASSERT_TRUE(scene.getViewport("mini-map"));
+        EXPECT_GE(scene.getViewport("mini-map")->size(), 2u);
+    }
+    EXPECT_GT(with_scans, 0u);
+    // The final map as icp-slam names it, the same as kfd's final_map.simplemap.
+    mrpt::maps::CSimpleMap mine, kfds;
+    loadGz(dir / "out/_finalmap_.simplemap", mine);
+    loadGz(dir / "out/final_map.simplemap", kfds);
+    EXPECT_GT(mine.size(), 0u);
+    EXPECT_EQ(mine.size(), kfds.size());
+    // Each map of the builder: the point map as "x y z" text, the grid as an image and limits.
+    const auto points = rows(dir / "out/_finalmaps_.txt_mrpt__maps__CSimplePointsMap_01.txt");
+    ASSERT_GT(points.size(), 100u);
+    EXPECT_EQ(points.front().size(), 3u);
+    const std::string png = dir / "out/_finalmaps_.txt_mrpt__maps__COccupancyGridMap2D_00.png";
+    mrpt::img::CImage img;
+    ASSERT_TRUE(img.loadFromFile(png)) << png;
+    EXPECT_GT(img.getWidth(), 10u);
+    const auto limits =
+        rows(dir / "out/_finalmaps_.txt_mrpt__maps__COccupancyGridMap2D_00_limits.txt");
+    ASSERT_EQ(limits.size(), 2u);
+    EXPECT_EQ(limits[1].size(), 4u);
+    EXPECT_LT(std::stod(limits[1][0]), std::stod(limits[1][1]));
+}
+
+// The periodic files only when asked; without the map (--no-map) none of the final maps.
+TEST(IcpSlamLogs, WithTheKeysOffOnlyThePerStepLogsAreWritten) {
+    TempDir dir;
+    const std::string rawlog = simulatedLog(dir.path, 2.0);
+    auto o = options(rawlog, dir / "out", kfd::PrefilterMode::None);  // kConfig: keys off
+    o.write_map = false;
+    const auto s = runAndReport(o);
+    EXPECT_TRUE(s.notices.empty());
+    for (const char* f : {"log_estimated_path.txt", "log_odometry_path.txt", "log_times.txt",
+                          "log_MemoryUsage.txt"})
+        EXPECT_EQ(lines(dir / ("out/" + std::string(f))), s.entries) << f;
+    for (const char* prefix : {"mapbuild_posepdf_", "buildingmap_", "_finalmap"})
+        EXPECT_TRUE(filesStarting(dir / "out", prefix).empty()) << prefix;
+    // SAVE_3D_SCENE and SAVE_POSE_LOG need LOG_FREQUENCY > 0: a notice each, nothing written.
+    o.config_file = configWith(dir.path, {{"SAVE_POSE_LOG", "1"}, {"SAVE_3D_SCENE", "1"}});
+    o.output_dir = dir / "out0";
+    const auto zero = runAndReport(o);
+    ASSERT_EQ(zero.notices.size(), 2u);
+    EXPECT_NE(zero.notices[0].find("SAVE_POSE_LOG"), std::string::npos) << zero.notices[0];
+    EXPECT_NE(zero.notices[1].find("SAVE_3D_SCENE"), std::string::npos) << zero.notices[1];
+    EXPECT_NE(zero.notices[1].find("LOG_FREQUENCY = 0"), std::string::npos) << zero.notices[1];
+    EXPECT_TRUE(filesStarting(dir / "out0", "buildingmap_").empty());
+}
+
+// MRPT's shipped icp-slam configurations open a live 3D window (SHOW_PROGRESS_3D_REAL_TIME):
+// kfd-icp-slam runs them, warns on stderr naming the key, and says so in summary.json.
+TEST(IcpSlamLogs, ALiveWindowIsAWarningNamingTheKey) {
+    TempDir dir;
+    const std::string rawlog = simulatedLog(dir.path, 2.0);
+    const std::string config = configWith(dir.path, {{"SHOW_PROGRESS_3D_REAL_TIME", "true"},
+                                                     {"SHOW_PROGRESS_3D_REAL_TIME_DELAY_MS", "5"}});
+    const std::string cmd = std::string("'") + KFD_ICP_SLAM_EXE + "' -q --no-map '" + config +
+                            "' '" + rawlog + "' -o '" + (dir / "out") + "' > '" + (dir / "stdout") +
+                            "' 2> '" + (dir / "stderr") + "'";
+    const int st = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << text(dir / "stderr");
+    const std::string err = text(dir / "stderr");
+    EXPECT_EQ(
+        err.rfind("kfd-icp-slam: warning: [MappingApplication] SHOW_PROGRESS_3D_REAL_TIME", 0), 0u)
+        << err;
+    EXPECT_NE(text(dir / "out/summary.json").find("SHOW_PROGRESS_3D_REAL_TIME"), std::string::npos);
+    EXPECT_TRUE(fs::exists(dir / "out/log_times.txt"));
+}
+
+// The numbered names are outputs too: an existing OUT/buildingmap_00000.3Dscene that is the
+// input log (a link to it) would be replaced at the end; refused before anything is written.
+TEST(IcpSlamLogs, ANumberedOutputThatIsAnInputIsRefused) {
+    EXPECT_TRUE(kfd::isIcpSlamNumberedOutput("buildingmap_00050.3Dscene"));
+    EXPECT_TRUE(kfd::isIcpSlamNumberedOutput("mapbuild_posepdf_123.txt"));
+    EXPECT_TRUE(
+        kfd::isIcpSlamNumberedOutput("_finalmaps_.txt_mrpt__maps__CSimplePointsMap_00.txt"));
+    EXPECT_FALSE(kfd::isIcpSlamNumberedOutput("buildingmap.rawlog"));
+    TempDir dir;
+    const std::string rawlog = simulatedLog(dir.path, 2.0);
+    fs::create_directories(dir / "out");
+    fs::create_symlink(rawlog, dir / "out/buildingmap_00000.3Dscene");
+    const std::string before = text(rawlog);
+    auto o = options(rawlog, dir / "out", kfd::PrefilterMode::None);
+    try {
+        runAndReport(o);
+        ADD_FAILURE() << "an output replacing the input log was accepted";
+    } catch (const kfd::PathError& e) {
+        EXPECT_NE(std::string(e.what()).find("buildingmap_00000.3Dscene"), std::string::npos)
+            << e.what();
+    }
+    EXPECT_EQ(text(rawlog), before);
+    EXPECT_FALSE(fs::exists(dir / "out/log_times.txt"));
+}
+
+// With the same log and keys, kfd-icp-slam --mode none writes MRPT's icp-slam's files: the same
+// names, the same bytes (the 3D scenes and the final map decompressed), the timings aside.
+TEST(IcpSlamLogs, ModeNoneWritesTheFilesOfMrptIcpSlam) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    if (std::system("command -v icp-slam > /dev/null") != 0)
+        GTEST_SKIP() << "MRPT's icp-slam not installed (mrpt-apps)";
+    TempDir dir;
+    // MRPT's grid-matching demo (an occupancy grid), no window, pose PDFs on, every 50 steps.
+    const std::string demo =
+        "/usr/share/mrpt/config_files/icp-slam/icp-slam_demo_classic_gridmatch.ini";
+    if (!fs::exists(demo)) GTEST_SKIP() << "missing " << demo;
+    std::string ini = text(demo);
+    const std::string mrpt_out = dir / "mrpt";
+    for (const auto& [key, value] :
+         {std::pair{"SHOW_PROGRESS_3D_REAL_TIME=", "0"}, std::pair{"SAVE_POSE_LOG=", "1"},
+          std::pair{"logOutput_dir=", mrpt_out.c_str()}}) {
+        const auto at = ini.find(std::string("\n") + key);
+        ASSERT_NE(at, std::string::npos) << key;
+        ini.replace(at + 1, ini.find('\n', at + 1) - at - 1, std::string(key) + value);
+    }
+    std::ofstream(dir / "icp.ini") << ini;
+    const std::string cmd =
+        "icp-slam '" + (dir / "icp.ini") + "' '" + kSena + "' > '" + (dir / "icp.log") + "' 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << text(dir / "icp.log");
+    auto o = options(kSena, dir / "kfd", kfd::PrefilterMode::None);
+    o.config_file = dir / "icp.ini";
+    runAndReport(o);
+    std::size_t compared = 0;
+    for (const auto& e : fs::directory_iterator(dir / "mrpt")) {
+        const std::string name = e.path().filename();
+        SCOPED_TRACE(name);
+        const fs::path mine = dir / ("kfd/" + name);
+        ASSERT_TRUE(fs::exists(mine));
+        if (name == "log_times.txt" || name == "log_MemoryUsage.txt") {
+            EXPECT_EQ(lines(mine), lines(e.path()));  // measured: the same lines, other numbers
+        } else if (name.find(".3Dscene") != std::string::npos ||
+                   name.find(".simplemap") != std::string::npos) {
+            mrpt::io::CFileGZInputStream a(mine.string()), b(e.path().string());
+            std::string da, db;
+            char buf[65536];
+            for (std::size_t n; (n = a.Read(buf, sizeof(buf))) > 0;) da.append(buf, n);
+            for (std::size_t n; (n = b.Read(buf, sizeof(buf))) > 0;) db.append(buf, n);
+            EXPECT_GT(da.size(), 0u);
+            EXPECT_TRUE(da == db);
+        } else {
+            EXPECT_TRUE(text(mine) == text(e.path()));
+        }
+        ++compared;
+    }
+    EXPECT_GE(compared, 14u);  // 4 logs, 5 scenes, 5 pose PDFs, the final map, its image + limits
 }

@@ -123,17 +123,9 @@ Trajectory inFrame(const Trajectory& t, const MapFrame& f) {
 
 void writeMap(const IcpSlamResult& res, const StagedOutputFolder& out) {
     const auto& sum = res.summary;
-    {  // as CMetricMapBuilder::saveCurrentMapToFile (gzip level 1), in the log's frame (like
-       // trajectory.tum); the map as built is in the map builder's frame (map_origin)
-        mrpt::maps::CSimpleMap saved = *res.map;
-        if (res.map_origin.x != 0.0 || res.map_origin.y != 0.0)
-            saved.changeCoordinatesOrigin(
-                mrpt::poses::CPose3D(res.map_origin.x, res.map_origin.y, 0.0, 0.0, 0.0, 0.0));
-        const std::string name = "final_map.simplemap";
-        GzOutputStream f(out.path() / name, out.finalName(name), 1);
-        f.write(saved);
-        f.close();
-    }
+    // in the log's frame (like trajectory.tum); the map as built is in the builder's frame
+    writeSimpleMap(*res.map, res.map_origin, out.path() / "final_map.simplemap",
+                   out.finalName("final_map.simplemap"));
     mrpt::maps::COccupancyGridMap2D grid(-10, 10, -10, 10, static_cast<float>(kMapResolution));
     const MapFrame frame = mapFrame(res, grid.insertionOptions.maxDistanceInsertion);
     mrpt::maps::CSimpleMap local = *res.map;  // poses copied, observations shared
@@ -237,6 +229,8 @@ std::string toJson(const IcpSlamSummary& s) {
         j["source"] = std::move(src);
     }
     j["laser_only"] = s.laser_only;
+    if (!s.notices.empty())  // what the run did not honour (icp-slam keys, map kinds)
+        j["notices"] = s.notices;
     if (s.ate_rmse) j["ate_rmse_m"] = *s.ate_rmse;
     if (s.relations) {
         const auto& r = *s.relations;

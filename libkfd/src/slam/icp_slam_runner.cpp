@@ -275,7 +275,7 @@ class Run {
     bool toMapFrame(mrpt::obs::CObservationOdometry& odo);
     bool prefilterScan(const CObservation2DRangeScan::Ptr& scan, const SourceEntry& e);
     mrpt::obs::CActionCollection* actionFor(const IcpSlamStep& step);
-    void writeStep();
+    void writeStep(double builder_ms);
     void closeOutputs();
     void evaluate();
 
@@ -288,8 +288,9 @@ class Run {
     StreamFilter* prefilter_ = nullptr;
     mrpt::slam::CMetricMapBuilderICP builder_;
     std::size_t rawlog_offset_ = 0;
-    std::optional<OutputFile> f_path_;  // log_estimated_path.txt
-    ScanCsvWriter csv_;                 // scans.csv
+    IcpSlamLogParams log_params_;      // [MappingApplication]'s output keys
+    std::optional<IcpSlamLogs> logs_;  // icp-slam's files
+    ScanCsvWriter csv_;                // scans.csv
     std::unique_ptr<Source> source_;
     double builder_s_ = 0.0;
     std::size_t step_no_ = 0;
@@ -454,6 +455,12 @@ void Run::prepare() {
     for (const char* name : kIcpSlamOutputFiles)
         outputs.push_back(
             {std::string("output ") + name, (fs::path(sum_.output_dir) / name).string()});
+    // icp-slam's numbered files: those the output folder holds already would be replaced
+    if (fs::is_directory(sum_.output_dir, ec))
+        for (const auto& entry : fs::directory_iterator(sum_.output_dir, ec))
+            if (isIcpSlamNumberedOutput(entry.path().filename().string()))
+                outputs.push_back(
+                    {"output " + entry.path().filename().string(), entry.path().string()});
     checkOutputPaths(inputs, outputs);
     for (const NamedPath& in : inputs)
         if (samePath(sum_.output_dir, in.path))
@@ -461,6 +468,7 @@ void Run::prepare() {
                 "the output folder " + sum_.output_dir + " is the " + in.role + " " + in.path,
                 sum_.output_dir);
 
+    log_params_ = IcpSlamLogParams::fromConfig(*cfg_, kSect, sum_.notices);
     // Pre-filter configuration: [KFD] when present, else kfd's defaults (share/kfd/default.ini).
     kfd_params_ = cfg_->sectionExists("KFD") ? loadIni(*cfg_, "KFD") : kfdDefaults();
     // The SLAM's localisation gate: ICP corrects the pose only after this much odometry since
@@ -555,7 +563,7 @@ void Run::openOutputs() {
     // Every file through kfd's checked writers: a failed write is a WriteError (ScanCsvError for
     // scans.csv) naming the file's final name and the reason.
     const StagedOutputFolder& out = *res_.output;
-    f_path_.emplace(out.path() / "log_estimated_path.txt", out.finalName("log_estimated_path.txt"));
+    logs_.emplace(out, log_params_);
     csv_.open((out.path() / "scans.csv").string(), out.finalName("scans.csv"));
     source_ = openLog(sum_.rawlog, opts_.source);
 }
@@ -575,10 +583,12 @@ void Run::loop() {
     while (nextEntry(*source_, e)) {
         throwIfCancelled();
         if (!steps.feed(e, st) || e.objects_read < rawlog_offset_ || skipper.skip(st)) continue;
+        const double builder_s0 = builder_s_;
+        logs_->beginStep(st.observation, st.action.get(), st.frame.get());
         step(st, e);
         noteIcp();
         rematch(st);
-        writeStep();
+        writeStep(1e3 * (builder_s_ - builder_s0));
         ++step_no_;
         ++sum_.entries;
         if (opts_.on_progress && step_no_ % 500 == 0)
@@ -789,13 +799,13 @@ mrpt::obs::CActionCollection* Run::actionFor(const IcpSlamStep& st) {
     return action;
 }
 
-// The step's pose (icp-slam's log line) and, for each of its scans, the trajectory, odometry,
+// The step's pose (icp-slam's files) and, for each of its scans, the trajectory, odometry,
 // keyframe and corridor entries and the scans.csv row.
-void Run::writeStep() {
+void Run::writeStep(double builder_ms) {
     const auto local = builder_.getCurrentPoseEstimation()->getMeanVal();
     const mrpt::poses::CPose3D pose(local.x() + res_.map_origin.x, local.y() + res_.map_origin.y,
                                     local.z(), local.yaw(), local.pitch(), local.roll());
-    *f_path_ << format("%i %f %f %f\n", static_cast<int>(step_no_), pose.x(), pose.y(), pose.yaw());
+    logs_->endStep(step_no_, builder_, builder_ms, pose, res_.map_origin);
     const Pose2D p{pose.x(), pose.y(), pose.yaw()};
     Trajectory& traj = res_.trajectory;
     for (const ScanRecord& s : step_scans_) {
@@ -819,7 +829,7 @@ void Run::closeOutputs() {
     held_.clear();
     flushPending();
     std::sort(res_.keyframes.begin(), res_.keyframes.end());
-    f_path_->close();
+    logs_->finish(builder_, res_.map_origin, opts_.write_map, sum_.notices);
     csv_.close();
     writeTum((res_.output->path() / "trajectory.tum").string(), res_.trajectory,
              res_.output->finalName("trajectory.tum"));
@@ -877,6 +887,17 @@ void Run::evaluate() {
 }
 
 }  // namespace
+
+bool isIcpSlamNumberedOutput(const std::string& file_name) {
+    for (const OutputNamePattern& p : kIcpSlamNumberedOutputs) {
+        const std::string_view name(file_name), prefix(p.prefix), suffix(p.suffix);
+        if (name.size() >= prefix.size() + suffix.size() &&
+            name.substr(0, prefix.size()) == prefix &&
+            name.substr(name.size() - suffix.size()) == suffix)
+            return true;
+    }
+    return false;
+}
 
 IcpSlamResult IcpSlamRunner::run(const IcpSlamOptions& opts) { return Run(opts).execute(); }
 

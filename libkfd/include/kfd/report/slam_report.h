@@ -11,7 +11,7 @@ namespace kfd {
 /// summary.json's text: every number of the summary, keys in a fixed order (mode, rawlog,
 /// stages, entries, scans_in, scans_kept, dropped_pct, points_in, points_removed,
 /// prefilter_us_per_scan, icp_ms_per_scan, icp_ms_per_kept_scan, cpu_s_total, wall_s_total,
-/// motion_distance_m, motion_angle_deg, then ate_rmse_m and relations when present).
+/// motion_distance_m, motion_angle_deg, then notices, ate_rmse_m and relations when present).
 std::string toJson(const IcpSlamSummary& s);
 
 /// Writes into result.summary.output_dir: summary.json and, when the result holds the built

@@ -17,6 +17,7 @@
 #include "kfd/eval/trajectory.h"
 #include "kfd/mrpt/scan_record.h"
 #include "kfd/mrpt/source.h"
+#include "kfd/slam/icp_slam_logs.h"
 #include "kfd/slam/prefilter_modes.h"
 
 namespace kfd {
@@ -113,6 +114,10 @@ struct IcpSlamSummary : ScanCounters {
     /// localisation gate (localizationLinDistance, localizationAngDistance) when that is
     /// shorter, so that kfd never drops the scan ICP's gate would have matched.
     double guard_translation_m = 0.0, guard_rotation_deg = 0.0;
+    /// What the run did not honour, one sentence each naming the configuration key or map (an
+    /// icp-slam key kfd-icp-slam ignores: IcpSlamLogParams::fromConfig; a map kind it cannot
+    /// save: IcpSlamLogs::finish). The caller shows them; the run went on.
+    std::vector<std::string> notices;
 };
 
 /// ICP corrections rejected in a row that make a suspected lost track.
@@ -144,10 +149,32 @@ struct IcpSlamResult {
 /// map builder in a local frame (IcpSlamResult::map_origin): a float resolves 1 mm at 10 km.
 inline constexpr double kLocalFrameM = 1.0e4;
 
-/// Every file kfd-icp-slam may write into its output folder (checked against the inputs).
-inline constexpr const char* kIcpSlamOutputFiles[] = {
-    "trajectory.tum", "log_estimated_path.txt", "scans.csv", "summary.json", "final_map.simplemap",
-    "map.png",        "map_figure.png",         "report.md"};
+/// Every file kfd-icp-slam may write into its output folder under a fixed name (checked against
+/// the inputs), icp-slam's (IcpSlamLogs) included.
+inline constexpr const char* kIcpSlamOutputFiles[] = {"trajectory.tum",
+                                                      "log_estimated_path.txt",
+                                                      "scans.csv",
+                                                      "summary.json",
+                                                      "final_map.simplemap",
+                                                      "map.png",
+                                                      "map_figure.png",
+                                                      "report.md",
+                                                      "log_odometry_path.txt",
+                                                      "log_times.txt",
+                                                      "log_MemoryUsage.txt",
+                                                      "_finalmap_.simplemap"};
+
+/// The numbered and per-map names of icp-slam's files (IcpSlamLogs): PREFIX, anything, SUFFIX.
+/// Existing files of the output folder with such a name are checked against the inputs too.
+struct OutputNamePattern {
+    const char* prefix;
+    const char* suffix;
+};
+inline constexpr OutputNamePattern kIcpSlamNumberedOutputs[] = {
+    {"mapbuild_posepdf_", ".txt"}, {"buildingmap_", ".3Dscene"}, {"_finalmaps_.txt_", ""}};
+
+/// True when `file_name` (no folder) has the form of a kIcpSlamNumberedOutputs name.
+bool isIcpSlamNumberedOutput(const std::string& file_name);
 
 /// Bad input, configuration or output (message says which).
 class SlamError : public Error {
@@ -183,8 +210,11 @@ class SlamOptionError : public SlamError {
 /// is (or aliases) one of them (PathError). Stops with kfd::Cancelled after
 /// kfd::requestCancel(). Writes into a staging folder (kfd::StagedOutputFolder: beside a new
 /// output folder, inside an existing one, whose other files are left alone), held by
-/// IcpSlamResult::output: trajectory.tum (one pose per input scan, TUM format),
-/// log_estimated_path.txt (icp-slam's "step x y phi", one per rawlog entry) and scans.csv (the
+/// IcpSlamResult::output: trajectory.tum (one pose per input scan, TUM format), icp-slam's files
+/// as [MappingApplication] asks (IcpSlamLogs: log_estimated_path.txt, log_odometry_path.txt,
+/// log_times.txt, log_MemoryUsage.txt, one line per icp-slam step; the periodic
+/// mapbuild_posepdf_NNN.txt and buildingmap_NNNNN.3Dscene; with write_map _finalmap_.simplemap
+/// and _finalmaps_.txt_*; the keys it cannot honour are summary.notices) and scans.csv (the
 /// door's per-scan records with the scan's pose, kfd/mrpt/scan_csv.h), through kfd's checked
 /// writers: a failed write is a WriteError (a ScanCsvError for scans.csv) naming the file's final
 /// name and the reason ("cannot write OUT/scans.csv: No space left on device").
