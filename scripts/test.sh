@@ -16,11 +16,6 @@ ctest --output-on-failure -j"$(nproc)" || status=$?
 # missing), with the reason each gave: a green run with skips says so last.
 log=Testing/Temporary/LastTest.log
 if [ -f "$log" ]; then
-  awk '/: Skipped$/ { getline reason; next_reason = reason }
-       /^\[  SKIPPED \] [^ ]+ \(/ { n++; printf "  %s: %s\n", $4, next_reason; next_reason = "" }
-       / \.\.\. skipped / { n++; r = $0; sub(/.* \.\.\. skipped /, "", r); printf "  %s: %s\n", $1, r }
-       END { if (n) printf "%d test%s skipped (above: why; the real logs are read from cmake -DKFD_DATASETS_DIR, " \
-                           "default ../shared/datasets)\n", n, n == 1 ? "" : "s"
-             else print "no test skipped" }' "$log"
+  bash "$root/scripts/list-skips.sh" "$log"
 fi
 exit $status

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "kfd/core/cancel.h"
+#include "kfd/core/format.h"
 
 namespace kfd::app {
 
@@ -16,14 +17,22 @@ ProgressPrinter::ProgressPrinter(std::string app)
     : app_(std::move(app)), tty_(isatty(fileno(stderr))) {}
 
 void ProgressPrinter::update(double fraction, std::size_t scans, std::size_t kept) {
+    print(fraction, kfd::plural(scans, "scan") + ", " + std::to_string(kept) + " kept");
+}
+
+void ProgressPrinter::update(double fraction, std::size_t scans) {
+    print(fraction, kfd::plural(scans, "scan"));
+}
+
+void ProgressPrinter::print(double fraction, const std::string& counts) {
     const int pct = static_cast<int>(100.0 * std::clamp(fraction, 0.0, 1.0));
     if (tty_) {
-        std::fprintf(stderr, "\r[%s] %3d%%  %zu scans, %zu kept", app_.c_str(), pct, scans, kept);
+        std::fprintf(stderr, "\r[%s] %3d%%  %s", app_.c_str(), pct, counts.c_str());
         open_line_ = pct < 100;
         if (!open_line_) std::fputc('\n', stderr);
     } else if (pct / 10 != last_decile_) {
         last_decile_ = pct / 10;
-        std::fprintf(stderr, "[%s] %3d%%  %zu scans, %zu kept\n", app_.c_str(), pct, scans, kept);
+        std::fprintf(stderr, "[%s] %3d%%  %s\n", app_.c_str(), pct, counts.c_str());
     }
 }
 

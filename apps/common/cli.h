@@ -32,15 +32,20 @@ void checkOutputPaths(const std::vector<kfd::NamedPath>& inputs,
                       const std::vector<kfd::NamedPath>& outputs);
 
 /// Progress lines on stderr: an updating line on a terminal, one line per 10 % otherwise (logs
-/// stay short).
+/// stay short). "[app]  42%  1200 scans, 310 kept", or "... 1200 scans" for apps that keep every
+/// scan (kfd-simulate, kfd-inject).
 class ProgressPrinter {
   public:
     explicit ProgressPrinter(std::string app);
     void update(double fraction, std::size_t scans, std::size_t kept);
+    /// The scans so far, without a "kept" count.
+    void update(double fraction, std::size_t scans);
     /// Ends an unfinished terminal line before an error message.
     void abort();
 
   private:
+    void print(double fraction, const std::string& counts);
+
     std::string app_;
     bool tty_;
     bool open_line_ = false;

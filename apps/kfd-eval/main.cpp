@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "common/cli.h"
+#include "kfd/core/format.h"
 #include "kfd/eval/ate.h"
 #include "kfd/eval/relations.h"
 
@@ -47,7 +48,8 @@ int main(int argc, char** argv) {
                                        std::to_string(rpe_delta) + ")");
         auto est = kfd::readTum(est_file);
         kfd::sortByTime(est);
-        std::printf("estimate   %s (%zu poses)\n", est_file.c_str(), est.size());
+        std::printf("estimate   %s (%s)\n", est_file.c_str(),
+                    kfd::plural(est.size(), "pose").c_str());
         if (split_s && rel_file.empty())
             throw kfd::app::UsageError("--split-seconds needs --relations");
         if (split_s && (!(*split_s >= 0.0) || !std::isfinite(*split_s)))
@@ -91,9 +93,9 @@ int main(int argc, char** argv) {
                 a.matched, a.unmatched, a.rmse, a.mean, a.max);
             const auto p = kfd::computeRpe(est, gt, rpe_delta, max_dt);
             std::printf(
-                "RPE        %.2f s: %zu pairs, %zu unmatched: trans RMSE %.4f m, rot RMSE "
-                "%.3f deg\n",
-                rpe_delta, p.pairs, p.unmatched, p.trans_rmse, p.rot_rmse_deg);
+                "RPE        %.2f s: %s, %zu unmatched: trans RMSE %.4f m, rot RMSE %.3f deg\n",
+                rpe_delta, kfd::plural(p.pairs, "pair").c_str(), p.unmatched, p.trans_rmse,
+                p.rot_rmse_deg);
         }
     });
 }

@@ -8,11 +8,29 @@
 
 #include "common/cli.h"
 #include "common/source_cli.h"
+#include "kfd/core/format.h"
 #include "kfd/core/window_helper.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/rawlog_filter.h"
 
 namespace {
+
+// "1.0 cm (the estimate's floor; the scans' residuals gave 0.4 cm)": the value the evidence
+// denoiser used and where it came from.
+std::string rangeNoise(const kfd::SensorSummary& sn) {
+    const double used = 100.0 * sn.range_noise_m, measured = 100.0 * sn.range_noise_measured_m;
+    const double floor = 100.0 * sn.range_noise_floor_m;
+    auto cm = [](double v) { return kfd::format("%.1f cm", v); };
+    if (sn.range_noise_configured) return cm(used) + " (configured: sigma_m)";
+    if (measured <= 0.0) return cm(used) + " (the estimate's floor: too few residuals to measure)";
+    // Each scan's estimate is raised to the floor before smoothing over scans: at the floor
+    // (as printed) the scans measured less.
+    if (cm(used) == cm(floor))
+        return cm(used) + " (the estimate's floor; the scans' residuals gave " + cm(measured) + ")";
+    if (cm(used) == cm(measured)) return cm(used) + " (from the scans' residuals)";
+    return cm(used) + " (from the scans' residuals, each scan's estimate at least the floor " +
+           cm(floor) + "; without the floor " + cm(measured) + ")";
+}
 
 void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSummary& s) {
     const double removed = static_cast<double>(s.points_removed_noise);
@@ -20,55 +38,66 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
     const std::string read = s.input_format == kfd::LogFormat::Rawlog
                                  ? s.layout
                                  : std::string(kfd::toString(s.input_format)) + ": " + s.layout;
-    std::printf("  input    %s (%s, %zu sensor%s)\n", o.input.c_str(), read.c_str(), s.sensors,
-                s.sensors == 1 ? "" : "s");
+    std::printf("  input    %s (%s, %s)\n", o.input.c_str(), read.c_str(),
+                kfd::plural(s.sensors, "sensor").c_str());
     std::printf("  output   %s (%s)\n", o.output.c_str(), kfd::toString(s.output_format));
     const kfd::SensorSummary& sn = s.sensor;
     if (sn.beams) {
         std::printf("  sensor   %s%s%zu beams over %.1f deg (%.3f deg per beam)", sn.label.c_str(),
                     sn.label.empty() ? "" : ": ", sn.beams, sn.aperture_deg, sn.resolution_deg);
-        if (sn.rate_hz > 0.0) std::printf(", %.1f Hz", sn.rate_hz);
+        if (sn.rate_hz > 0.0) std::printf(", %.1f Hz mean", sn.rate_hz);
+        if (sn.median_interval_s > 0.0)
+            std::printf(" (median interval %.3f s)", sn.median_interval_s);
         std::printf(", %s\n", sn.odometry ? "odometry" : "no odometry (laser only)");
         if (sn.range_noise_m > 0.0)
             std::printf(
-                "  derived  range noise %.1f cm (from the scans' residuals); resolution and "
-                "noise set the evidence denoiser's thresholds\n",
-                100.0 * sn.range_noise_m);
+                "  derived  range noise %s; resolution and noise set the evidence denoiser's "
+                "thresholds\n",
+                rangeNoise(sn).c_str());
     }
     std::printf("  scans    in %zu, kept %zu, dropped %zu (%.1f %%)\n", s.scans_in, s.scans_kept,
                 s.scans_dropped, s.droppedPercent());
     if (s.scans_corridor)
-        std::printf(
-            "  corridor %zu scans degenerate (%.1f %%): %zu keyframes by odometry or time\n",
-            s.scans_corridor,
-            100.0 * static_cast<double>(s.scans_corridor) /
-                static_cast<double>(std::max<std::size_t>(1, s.scans_in)),
-            s.keyframes_corridor);
+        std::printf("  corridor %s degenerate (%.1f %%): %s by odometry or time\n",
+                    kfd::plural(s.scans_corridor, "scan").c_str(),
+                    100.0 * static_cast<double>(s.scans_corridor) /
+                        static_cast<double>(std::max<std::size_t>(1, s.scans_in)),
+                    kfd::plural(s.keyframes_corridor, "keyframe").c_str());
     std::printf("  points   in %zu; in kept scans removed: %zu out of range, %zu noise (%.2f %%)\n",
                 s.points_in, s.points_removed_range, s.points_removed_noise,
                 s.points_in ? 100.0 * removed / static_cast<double>(s.points_in) : 0.0);
     if (s.scans_odometry_frozen || s.scans_odometry_jump)
         std::printf(
-            "  odometry withheld from %zu scans (%zu frozen while the scans changed, %zu jumps "
-            "the scans do not show): decided laser only\n",
-            s.scans_odometry_frozen + s.scans_odometry_jump, s.scans_odometry_frozen,
-            s.scans_odometry_jump);
+            "  odometry withheld from %s (%zu frozen while the scans changed, %s the scans do "
+            "not show): decided laser only\n",
+            kfd::plural(s.scans_odometry_frozen + s.scans_odometry_jump, "scan").c_str(),
+            s.scans_odometry_frozen, kfd::plural(s.scans_odometry_jump, "jump").c_str());
     if (s.points_removed_noise)
         std::printf("  denoise  at most %.2f %% of a kept scan's returns removed",
                     100.0 * s.max_removed_noise_share);
     if (s.scans_denoise_stale || s.scans_denoise_capped)
-        std::printf("; the bound on removal acted on %zu scans (%zu stale references, %zu capped)",
-                    s.scans_denoise_stale + s.scans_denoise_capped, s.scans_denoise_stale,
+        std::printf("; the bound on removal acted on %s (%s, %zu capped)",
+                    kfd::plural(s.scans_denoise_stale + s.scans_denoise_capped, "scan").c_str(),
+                    kfd::plural(s.scans_denoise_stale, "stale reference").c_str(),
                     s.scans_denoise_capped);
     if (s.points_removed_noise) std::printf("\n");
     if (s.output_format == kfd::LogFormat::Bag)
-        std::printf(
-            "  messages in %zu, out %zu, scans dropped %zu; %zu removed points written as %s\n",
-            s.objects_in, s.objects_out, s.objects_dropped, s.points_marked,
-            kfd::toString(o.bag.removed));
-    else
+        std::printf("  messages in %zu, out %zu, scans dropped %zu; %s written as %s\n",
+                    s.objects_in, s.objects_out, s.objects_dropped,
+                    kfd::plural(s.points_marked, "removed point").c_str(),
+                    kfd::toString(o.bag.removed));
+    else if (s.input_format == kfd::LogFormat::Rawlog)
         std::printf("  objects  in %zu, out %zu, dropped %zu, odometry actions merged %zu\n",
                     s.objects_in, s.objects_out, s.objects_dropped, s.actions_merged);
+    else  // the same unit on both sides: MRPT objects, read from lines or messages
+        std::printf(
+            "  objects  in %zu (read from %s), out %zu, dropped %zu, odometry actions "
+            "merged %zu\n",
+            s.objects_converted,
+            kfd::plural(s.objects_in,
+                        s.input_format == kfd::LogFormat::Carmen ? "CARMEN line" : "bag message")
+                .c_str(),
+            s.objects_out, s.objects_dropped, s.actions_merged);
     if (s.scans_skipped) {
         std::printf("  skipped  %zu (bad geometry, dropped from the output):", s.scans_skipped);
         for (std::size_t r = 1; r < kfd::kScanSkipReasons; ++r)
@@ -79,33 +108,61 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
     }
     if (s.beams_bad_range || s.odometry_bad || s.stamps_backwards)
         std::printf(
-            "  repaired %zu beams with a bad range marked invalid, %zu scans with "
-            "non-finite odometry, %zu stamps going backwards\n",
-            s.beams_bad_range, s.odometry_bad, s.stamps_backwards);
+            "  repaired %s with a bad range marked invalid, %s with non-finite odometry, "
+            "%s going backwards\n",
+            kfd::plural(s.beams_bad_range, "beam").c_str(),
+            kfd::plural(s.odometry_bad, "scan").c_str(),
+            kfd::plural(s.stamps_backwards, "stamp").c_str());
     if (s.geometry_resets)
         std::printf("  resets   %zu (scan geometry changed)\n", s.geometry_resets);
     const kfd::SourceCounters& src = s.source;  // what the bag or CARMEN source repaired
     if (src.lines_unparsable)
-        std::printf(
-            "  unparsed %zu lines that are not CARMEN text skipped (%llu bytes, the first "
-            "at line %zu)\n",
-            src.lines_unparsable, static_cast<unsigned long long>(src.bytes_unparsable),
-            src.first_unparsable_line);
+        std::printf("  unparsed %s not CARMEN text skipped (%s, the first at line %zu)\n",
+                    (kfd::plural(src.lines_unparsable, "line that is", "lines that are")).c_str(),
+                    kfd::plural(src.bytes_unparsable, "byte").c_str(), src.first_unparsable_line);
     if (src.scans_bad_angles)
         std::printf(
-            "  angles   %zu LaserScans whose angle fields do not match their beam count "
+            "  angles   %s whose angle fields do not match their beam count "
             "(skipped: bad_aperture)\n",
-            src.scans_bad_angles);
+            kfd::plural(src.scans_bad_angles, "LaserScan").c_str());
     if (src.stamps_zero)
-        std::printf("  stamps   %zu messages stamped 0 (unset): their bag time used\n",
-                    src.stamps_zero);
+        std::printf("  stamps   %s stamped 0 (unset): their bag time used\n",
+                    kfd::plural(src.stamps_zero, "message").c_str());
     if (src.scans_without_odometry)
         std::printf(
-            "  odometry %zu scans more than 1 s outside the odometry's time span: no "
-            "odometry for them\n",
-            src.scans_without_odometry);
+            "  odometry %s more than 1 s outside the odometry's time span: no odometry for "
+            "them\n",
+            kfd::plural(src.scans_without_odometry, "scan").c_str());
     std::printf("  time     wall %.2f s, filter %.3f s (%.1f us per scan)\n", s.wall_seconds,
                 s.filter_seconds, s.scans_in ? 1e6 * s.filter_seconds / s.scans_in : 0.0);
+}
+
+// --list-keys: one key a line, with its two defaults, its range and its meaning (unit).
+void printKeys() {
+    const auto& keys = kfd::configKeys();
+    int w_name = 3, w_default = 7, w_kfd = 5, w_range = 5;
+    for (const auto& k : keys) {
+        if (k.name == "pipeline") continue;  // its stage lists run over the columns
+        w_name = std::max(w_name, static_cast<int>(k.name.size()));
+        w_default = std::max(w_default, static_cast<int>(k.default_value.size()));
+        w_kfd = std::max(w_kfd, static_cast<int>(k.kfd_value.size()));
+        w_range = std::max(w_range, static_cast<int>(k.range.size()));
+    }
+    std::printf(
+        "default: the value of a key a configuration file (-c) leaves out; kfd: the value without "
+        "-c\n(share/kfd/default.ini). Units and meanings in the last column.\n");
+    auto row = [&](const std::string& name, const std::string& def, const std::string& kfd,
+                   const std::string& range, const std::string& help) {
+        std::printf("%-*s  %-*s  %-*s  %-*s  %s\n", w_name, name.c_str(), w_default, def.c_str(),
+                    w_kfd, kfd.c_str(), w_range, range.c_str(), help.c_str());
+    };
+    for (const auto& k : keys)
+        if (k.name == "pipeline")
+            std::printf("\npipeline: %s, of %s\n  default %s\n  kfd     %s\n\n", k.help.c_str(),
+                        k.range.c_str(), k.default_value.c_str(), k.kfd_value.c_str());
+    row("key", "default", "kfd", "range", "meaning");
+    for (const auto& k : keys)
+        if (k.name != "pipeline") row(k.name, k.default_value, k.kfd_value, k.range, k.help);
 }
 
 void printWindowSuggestion(const std::vector<double>& a) {
@@ -177,7 +234,9 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     cli.addQuiet();
     cli.flag("--print-config", print_config, "print the effective configuration and exit");
-    cli.flag("--list-keys", list_keys, "list every configuration key with its range and exit");
+    cli.flag("--list-keys", list_keys,
+             "list every configuration key with its defaults, range and\n"
+             "meaning, then exit");
     cli.option("--suggest-window", window,
                "Formulas 4-5: suggest the window m for speed V (m/s) and\n"
                "scan rate F (Hz), then exit",
@@ -186,11 +245,7 @@ int main(int argc, char** argv) {
     cli.addVersion(KFD_VERSION);
     cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP
     return cli.run(argc, argv, [&] {
-        if (list_keys) {
-            for (const auto& k : kfd::configKeys())
-                std::printf("%-22s %-28s %s\n", k.name.c_str(), k.range.c_str(), k.help.c_str());
-            return;
-        }
+        if (list_keys) return printKeys();
         if (!window.empty()) return printWindowSuggestion(window);
         if (list) {
             if (opts.input.empty()) throw kfd::app::UsageError("--list: no input log (-i)");

@@ -7,6 +7,7 @@
 
 #include "common/cli.h"
 #include "common/source_cli.h"
+#include "kfd/core/format.h"
 #include "kfd/report/slam_report.h"
 #include "kfd/slam/icp_slam_runner.h"
 
@@ -118,24 +119,36 @@ int main(int argc, char** argv) {
         std::printf("  input      %s\n  output     %s\n", s.rawlog.c_str(), s.output_dir.c_str());
         std::printf("  scans      in %zu, kept %zu, dropped %.1f %%\n", s.scans_in, s.scans_kept,
                     s.dropped_pct);
+        std::string not_in;  // the log's other scans (kfd-filter counts them in its "in")
+        auto notIn = [&](std::size_t n, const char* why) {
+            if (n) not_in += (not_in.empty() ? "" : ", ") + kfd::plural(n, "scan") + " " + why;
+        };
+        notIn(s.scans_without_step,
+              "in a sensory frame without an odometry action (MRPT's icp-slam reads no step "
+              "from it)");
+        notIn(s.scans_before_offset, "before rawlog_offset");
+        notIn(s.scans_skipped_start, "skipped at the start (--skip-scans)");
+        if (!not_in.empty()) std::printf("             not in: %s\n", not_in.c_str());
         std::printf("  points     removed %zu of %zu\n", s.points_removed, s.points_in);
         std::printf(
             "  time       pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s, "
             "wall %.2f s\n",
             s.prefilter_us_per_scan, s.icp_ms_per_scan, s.cpu_s_total, s.wall_s_total);
         if (s.icp_runs)
-            std::printf("  ICP        %zu corrections, %zu rejected, median goodness %.2f\n",
-                        s.icp_runs, s.icp_rejected, s.icp_goodness_median);
+            std::printf("  ICP        %s, %zu rejected, median goodness %.2f\n",
+                        kfd::plural(s.icp_runs, "correction").c_str(), s.icp_rejected,
+                        s.icp_goodness_median);
         if (s.rematches)
             std::printf(
                 "  re-match   %zu after a rejection (%zu by the gap check, %zu then "
-                "accepted), %zu dropped scans matched again\n",
-                s.rematches, s.gap_checks_failed, s.rematches_recovered, s.scans_rematched);
+                "accepted), %s matched again\n",
+                s.rematches, s.gap_checks_failed, s.rematches_recovered,
+                kfd::plural(s.scans_rematched, "dropped scan").c_str());
         if (!s.lost_track_stamps.empty())
             std::printf(
-                "  WARNING    %zu suspected lost track%s (%zu ICP corrections rejected in a row), "
+                "  WARNING    %s (%zu ICP corrections rejected in a row), "
                 "first at t = %.3f s: see report.md and scans.csv's icp_goodness\n",
-                s.lost_track_stamps.size(), s.lost_track_stamps.size() == 1 ? "" : "s",
+                kfd::plural(s.lost_track_stamps.size(), "suspected lost track").c_str(),
                 kfd::kLostTrackRejections, s.lost_track_stamps.front());
         if (s.ate_rmse) std::printf("  ATE        RMSE %.4f m\n", *s.ate_rmse);
         if (s.relations) {

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "common/cli.h"
+#include "kfd/core/format.h"
 #include "kfd/sim/noisy_log.h"
 
 int main(int argc, char** argv) {
@@ -39,9 +40,10 @@ int main(int argc, char** argv) {
     cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP
     return cli.run(argc, argv, [&] {
         if (auto* progress = cli.progress())
-            o.on_progress = [progress](double f) { progress->update(f, 0, 0); };
+            o.on_progress = [progress](double f, std::size_t scans) { progress->update(f, scans); };
         const auto s = kfd::writeNoisyLog(o);
-        std::printf("kfd-inject: %zu scans, %zu valid beams\n", s.scans, s.beams);
+        std::printf("kfd-inject: %s, %s\n", kfd::plural(s.scans, "scan").c_str(),
+                    kfd::plural(s.beams, "valid beam").c_str());
         std::printf("  outliers   isolated %zu, clustered %zu, edge %zu\n", s.by_kind[1],
                     s.by_kind[2], s.by_kind[3]);
         std::printf("  wrote      %s, %s\n", s.rawlog.c_str(), s.labels.c_str());

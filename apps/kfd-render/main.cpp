@@ -12,6 +12,7 @@
 #include "common/source_cli.h"
 #include "kfd/core/cancel.h"
 #include "kfd/core/denoiser.h"
+#include "kfd/core/format.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/png_output.h"
@@ -135,8 +136,8 @@ int main(int argc, char** argv) {
         kfd::writePng(img, tmp.path(), out);  // every write checked (WriteError)
         kfd::throwIfCancelled();  // interrupted while drawing: nothing is moved into place
         tmp.commit();
-        std::printf("kfd-render: scan at %.6f, %zu clusters, %zu noise points -> %s\n",
-                    kfd::stampOf(*chosen.back().scan), den.clusters, den.points_removed,
-                    out.c_str());
+        std::printf("kfd-render: scan at %.6f, %s, %s -> %s\n", kfd::stampOf(*chosen.back().scan),
+                    kfd::plural(den.clusters, "cluster").c_str(),
+                    kfd::plural(den.points_removed, "noise point").c_str(), out.c_str());
     });
 }

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "common/cli.h"
+#include "kfd/core/format.h"
 #include "kfd/sim/simulator.h"
 
 int main(int argc, char** argv) {
@@ -47,10 +48,10 @@ int main(int argc, char** argv) {
         if (o.gridmap.empty() != o.route.empty())
             throw kfd::app::UsageError("--gridmap and --route go together");
         if (auto* progress = cli.progress())
-            o.on_progress = [progress](double f) { progress->update(f, 0, 0); };
+            o.on_progress = [progress](double f, std::size_t scans) { progress->update(f, scans); };
         const auto s = kfd::Simulator().run(o);
-        std::printf("kfd-simulate: %zu scans, %.1f s, %.1f m driven\n", s.scans, s.duration_s,
-                    s.distance_m);
+        std::printf("kfd-simulate: %s, %.1f s, %.1f m driven\n",
+                    kfd::plural(s.scans, "scan").c_str(), s.duration_s, s.distance_m);
         std::printf("  outliers   isolated %zu, clustered %zu, edge %zu\n", s.noise_isolated,
                     s.noise_clustered, s.noise_edge);
         std::printf("  wrote      %s, %s, %s, %s\n", s.rawlog.c_str(), s.ground_truth.c_str(),

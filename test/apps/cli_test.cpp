@@ -11,9 +11,13 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/cli.h"
+#include "kfd/core/evidence_filter.h"
+#include "kfd/core/keyframe_selector.h"
+#include "kfd/core/stage_keys.h"
 #include "test_files.h"
 
 namespace {
@@ -329,6 +333,23 @@ TEST(CliApps, FilterVersionAndEarlyExits) {
     r = runApp(KFD_FILTER_EXE, "--list-keys");
     EXPECT_EQ(r.status, 0);
     EXPECT_NE(r.out.find("min_range"), std::string::npos) << r.out;
+    // Each key with its defaults, read here from the Params structs: "key default kfd range
+    // meaning" (the kfd column: share/kfd/default.ini, which leaves these keys out).
+    const kfd::EvidenceFilter::Params ev;
+    const kfd::KeyframeSelector::Params kf;
+    for (const auto& [key, value] :
+         {std::pair{"incidence_deg", kfd::keys::formatReal(ev.incidence_deg)},
+          {"max_removed_fraction", kfd::keys::formatReal(ev.max_removed_fraction)},
+          {"view_samples", std::to_string(kf.view.max_samples)}}) {
+        std::istringstream lines(r.out);
+        std::string line, name, def, kfd_value;
+        while (std::getline(lines, line) && line.rfind(std::string(key) + " ", 0) != 0) {
+        }
+        std::istringstream(line) >> name >> def >> kfd_value;
+        EXPECT_EQ(name, key) << r.out;
+        EXPECT_EQ(def, value) << line;
+        EXPECT_EQ(kfd_value, value) << line;
+    }
     r = runApp(KFD_FILTER_EXE, "--compress 0 --print-config");
     EXPECT_EQ(r.status, 0);
     EXPECT_EQ(r.out.rfind("[KFD]", 0), 0u) << r.out;

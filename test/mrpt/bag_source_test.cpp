@@ -220,6 +220,22 @@ TEST(BagSource, ANonFiniteStaticMountIsAnErrorNamingTheFrames) {
         << l.choices.back();
 }
 
+// --list's first line: "1 topic, 1 message", not "1 topics, 1 messages" (issue 23).
+TEST(BagSource, TheListingCountsTopicsAndMessagesInTheRightNumber) {
+    TempDir d;
+    {
+        BagBuilder b(d / "one.bag");
+        b.scan("/scan", BagBuilder::scanMsg(1.0, room(0, 0, 0, 20)));
+    }
+    EXPECT_EQ(kfd::listSource(d / "one.bag").detail, "ROS 1 bag, 1 topic, 1 message");
+    {
+        BagBuilder b(d / "two.bag");
+        b.scan("/scan", BagBuilder::scanMsg(1.0, room(0, 0, 0, 20)));
+        b.scan("/scan", BagBuilder::scanMsg(2.0, room(0, 0, 0, 20)));
+    }
+    EXPECT_EQ(kfd::listSource(d / "two.bag").detail, "ROS 1 bag, 1 topic, 2 messages");
+}
+
 TEST(BagSource, AnglesThatDoNotMatchTheBeamCountAreSkippedAndCounted) {
     TempDir d;
     {

@@ -6,9 +6,15 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "kfd/core/evidence_filter.h"
+#include "kfd/core/keyframe_selector.h"
+#include "kfd/core/keyframe_stage.h"
+#include "kfd/core/stage_keys.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/default_stages.h"
 #include "test_files.h"
@@ -299,6 +305,41 @@ TEST(Config, KeyTableIsDerivedFromTheStageRegistry) {
     std::size_t core_keys = 1;
     for (const auto& s : kfd::coreStageRegistry().stages()) core_keys += s.keys.size();
     EXPECT_EQ(kfd::configKeys(kfd::coreStageRegistry()).size(), core_keys);
+}
+
+// --list-keys's two defaults: the Params structs' (a configuration file that leaves the key
+// out) and kfd's (no configuration: share/kfd/default.ini), read from the structs themselves.
+TEST(Config, EveryKeyCarriesItsParamsDefaultAndKfdsDefault) {
+    std::map<std::string, kfd::ConfigKeyInfo> by_name;
+    for (const auto& k : kfd::configKeys()) by_name[k.name] = k;
+    const kfd::KeyframeSelector::Params kf;
+    const kfd::EvidenceFilter::Params ev;
+    // window: 8 in the struct, 1 in default.ini.
+    EXPECT_EQ(by_name["window"].default_value, std::to_string(kf.window));
+    EXPECT_EQ(by_name["window"].kfd_value,
+              std::to_string(kfd::kfdDefaults().get<kfd::KeyframeStage>().window));
+    EXPECT_NE(by_name["window"].default_value, by_name["window"].kfd_value);
+    // Keys default.ini leaves out: the struct's value in both.
+    for (const auto& [key, value] : {std::pair{"incidence_deg", ev.incidence_deg},
+                                     {"max_removed_fraction", ev.max_removed_fraction},
+                                     {"view_tolerance_m", kf.view.tolerance_m}}) {
+        EXPECT_EQ(by_name[key].default_value, kfd::keys::formatReal(value)) << key;
+        EXPECT_EQ(by_name[key].kfd_value, kfd::keys::formatReal(value)) << key;
+    }
+    // Every key: its values are what toIni prints for each configuration.
+    for (const auto& [params, field] :
+         {std::pair{kfd::Pipeline::Params{}, &kfd::ConfigKeyInfo::default_value},
+          {kfd::kfdDefaults(), &kfd::ConfigKeyInfo::kfd_value}}) {
+        const std::string ini = kfd::toIni(params);
+        for (const auto& k : kfd::configKeys()) {
+            if (k.name == "pipeline") continue;
+            EXPECT_NE(ini.find("\n" + k.name + " = " + k.*field + "\n"), std::string::npos)
+                << k.name;
+        }
+    }
+    std::string stages;
+    for (const auto& st : kfd::kfdDefaults().stages) stages += (stages.empty() ? "" : ",") + st;
+    EXPECT_EQ(by_name["pipeline"].kfd_value, stages);
 }
 
 TEST(Config, AngleGapFactorReachesBothDenoiseVariants) {

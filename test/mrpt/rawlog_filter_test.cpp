@@ -12,8 +12,10 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <random>
 #include <sstream>
 
+#include "kfd/core/evidence_filter.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/rawlog_filter.h"
 #include "test_files.h"
@@ -237,6 +239,118 @@ TEST(RawlogFilter, TwoSensorsAndAGeometryChangeInOneLog) {
     // A first scan per sensor, plus the first scan after FRONT's geometry change.
     EXPECT_GE(s.scans_kept, 3u);
     checkConservation(in, o.output, s);
+}
+
+namespace {
+
+// An observations-layout rawlog of one sensor in a round room (361 beams over 180 deg, 4 m) at
+// the given stamps, each range with Gaussian noise of `sigma_m`, and odometry at rest.
+void writeRoom(const std::string& path, const std::vector<double>& stamps, double sigma_m) {
+    mrpt::io::CFileGZOutputStream f(path);
+    auto arch = mrpt::serialization::archiveFrom(f);
+    std::mt19937 rng(7);
+    std::normal_distribution<float> noise(0.0f, static_cast<float>(sigma_m));
+    for (double t : stamps) {
+        CObservation2DRangeScan s;
+        s.sensorLabel = "LASER";
+        s.timestamp = mrpt::Clock::fromDouble(t);
+        s.aperture = static_cast<float>(M_PI);
+        s.maxRange = 20.0f;
+        s.resizeScanAndAssign(361, 4.0f, true);
+        for (std::size_t i = 0; i < 361; ++i) s.setScanRange(i, 4.0f + noise(rng));
+        arch << s;
+        mrpt::obs::CObservationOdometry odo;
+        odo.timestamp = s.timestamp;
+        arch << odo;
+    }
+}
+
+}  // namespace
+
+// The rate is the mean over the whole log, labelled, with the median interval: a log at 10 Hz
+// for its first 60 scans, then a 10 s gap, then 20 more (the first 50 scans alone say 10 Hz).
+TEST(RawlogFilter, TheRateIsTheLogsMeanAndTheMedianIntervalIsPrintedBeside) {
+    TempDir dir;
+    std::vector<double> stamps;
+    for (int k = 0; k < 80; ++k) stamps.push_back(1000.0 + 0.1 * k + (k >= 60 ? 10.0 : 0.0));
+    writeRoom(dir / "gap.rawlog", stamps, 0.0);
+    const auto s = kfd::RawlogFilter().run(optionsFor(dir / "gap.rawlog", dir / "out.rawlog"));
+    const double mean = 79.0 / (stamps.back() - stamps.front());  // 79 intervals over 17.9 s
+    EXPECT_NEAR(s.sensor.rate_hz, mean, 1e-6);
+    EXPECT_NEAR(s.sensor.median_interval_s, 0.1, 1e-5);
+    std::string text;
+    ASSERT_EQ(run(quoted(KFD_FILTER_EXE) + " -q -i " + quoted(dir / "gap.rawlog") + " -o " +
+                      quoted(dir / "out2.rawlog"),
+                  &text),
+              0)
+        << text;
+    char want[64];
+    std::snprintf(want, sizeof(want), ", %.1f Hz mean (median interval 0.100 s)", mean);
+    EXPECT_NE(text.find(want), std::string::npos) << want << " in\n" << text;
+}
+
+// Scans quieter than the evidence denoiser's floor (1 cm): the summary says the noise used is
+// the floor and what the residuals measured, not "from the scans' residuals".
+TEST(RawlogFilter, ARangeNoiseBelowTheFloorIsLabelledTheFloorWithTheMeasuredValue) {
+    TempDir dir;
+    std::vector<double> stamps;
+    for (int k = 0; k < 40; ++k) stamps.push_back(1000.0 + 0.2 * k);
+    writeRoom(dir / "quiet.rawlog", stamps, 0.003);  // 3 mm
+    const auto s = kfd::RawlogFilter().run(optionsFor(dir / "quiet.rawlog", dir / "out.rawlog"));
+    const double floor = kfd::EvidenceFilter::Params{}.min_sigma_m;
+    EXPECT_EQ(s.sensor.range_noise_floor_m, floor);
+    EXPECT_FALSE(s.sensor.range_noise_configured);
+    EXPECT_NEAR(s.sensor.range_noise_m, floor, 1e-12);            // used: the floor
+    EXPECT_NEAR(s.sensor.range_noise_measured_m, 0.003, 0.0015);  // measured: about 3 mm
+    std::string text;
+    ASSERT_EQ(run(quoted(KFD_FILTER_EXE) + " -q -i " + quoted(dir / "quiet.rawlog") + " -o " +
+                      quoted(dir / "out2.rawlog"),
+                  &text),
+              0)
+        << text;
+    char want[128];
+    std::snprintf(want, sizeof(want),
+                  "range noise %.1f cm (the estimate's floor; the scans' residuals gave %.1f cm)",
+                  100.0 * floor, 100.0 * s.sensor.range_noise_measured_m);
+    EXPECT_NE(text.find(want), std::string::npos) << want << " in\n" << text;
+    // sigma_m set: the value is labelled as configured.
+    std::ofstream(dir / "fixed.ini") << "[KFD]\nvariant = evidence\nsigma_m = 0.02\n";
+    ASSERT_EQ(run(quoted(KFD_FILTER_EXE) + " -q -c " + quoted(dir / "fixed.ini") + " -i " +
+                      quoted(dir / "quiet.rawlog") + " -o " + quoted(dir / "out3.rawlog"),
+                  &text),
+              0)
+        << text;
+    EXPECT_NE(text.find("range noise 2.0 cm (configured: sigma_m)"), std::string::npos) << text;
+}
+
+// A CARMEN input: "objects in" counts the same unit as "out" (MRPT objects), the lines they
+// were read from labelled beside.
+TEST(RawlogFilter, ACarmenInputCountsObjectsOnBothSidesAndLabelsTheLines) {
+    TempDir dir;
+    {
+        std::ofstream f(dir / "tiny.clf");
+        f << "# a hand-made log\nPARAM robot_front_laser_max 50\n";
+        for (int k = 0; k < 6; ++k) {
+            f << "FLASER 20";
+            for (int i = 0; i < 20; ++i) f << " " << (3.0 + 0.01 * i);
+            f << " 0 0 0 " << 0.3 * k << " 0 0 " << 100.0 + 0.2 * k << " host 0\n";
+        }
+    }
+    const auto s = kfd::RawlogFilter().run(optionsFor(dir / "tiny.clf", dir / "out.rawlog"));
+    EXPECT_EQ(s.objects_in, 8u);  // lines
+    EXPECT_EQ(s.objects_converted, readAll(dir / "out.rawlog").size() + s.objects_dropped);
+    EXPECT_EQ(s.objects_converted, s.objects_out + s.objects_dropped + s.actions_merged);
+    EXPECT_GT(s.objects_converted, s.objects_in);  // a scan and its odometry per FLASER line
+    std::string text;
+    ASSERT_EQ(run(quoted(KFD_FILTER_EXE) + " -q -i " + quoted(dir / "tiny.clf") + " -o " +
+                      quoted(dir / "out2.rawlog"),
+                  &text),
+              0)
+        << text;
+    const std::string want = "  objects  in " + std::to_string(s.objects_converted) +
+                             " (read from 8 CARMEN lines), out " + std::to_string(s.objects_out) +
+                             ", dropped " + std::to_string(s.objects_dropped);
+    EXPECT_NE(text.find(want), std::string::npos) << want << " in\n" << text;
 }
 
 TEST(RawlogFilter, MissingInputIsAnError) {

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <filesystem>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "kfd/mrpt/config.h"
 #include "kfd/sim/denoise_quality.h"
@@ -205,6 +207,22 @@ TEST(NoisyLog, LabelsMatchTheInjectedBeamsAndScoreBackPerModel) {
     kfd::writeNoisyLog(o);
     EXPECT_EQ(kfd::test::fileBytes(dir / "again.labels.csv"),
               kfd::test::fileBytes(dir / "noisy.labels.csv"));
+    // The progress callback counts the scans read as the copy goes (kfd-inject's progress line).
+    std::vector<std::pair<double, std::size_t>> calls;
+    o.output = dir / "progress.rawlog";
+    o.progress_every = 200;  // log entries: a scan and its odometry each
+    o.on_progress = [&](double f, std::size_t scans) { calls.emplace_back(f, scans); };
+    kfd::writeNoisyLog(o);
+    ASSERT_GE(calls.size(), 3u);
+    EXPECT_GT(calls.front().second, 0u);
+    EXPECT_LT(calls.front().second, s.scans);
+    for (std::size_t i = 1; i < calls.size(); ++i) {  // the last call may repeat the count
+        if (i + 1 < calls.size()) EXPECT_GT(calls[i].second, calls[i - 1].second);
+        EXPECT_GE(calls[i].second, calls[i - 1].second);
+        EXPECT_GE(calls[i].first, calls[i - 1].first);
+    }
+    EXPECT_EQ(calls.back(), std::make_pair(1.0, s.scans));
+    o.on_progress = nullptr;
     o.output = office;
     EXPECT_ANY_THROW(kfd::writeNoisyLog(o));
     EXPECT_TRUE(fs::exists(office));

@@ -5,6 +5,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <utility>
+#include <vector>
 
 #include "kfd/eval/trajectory.h"
 #include "kfd/mrpt/rawlog_source.h"
@@ -30,6 +32,25 @@ kfd::SimulationOptions shortRun(const std::string& out) {
 }
 
 }  // namespace
+
+// kfd-simulate's progress line counts the scans written as it goes, not "0 scans" to the end.
+TEST(Simulator, ProgressCountsTheScansWrittenAsTheRunGoes) {
+    TempDir dir;
+    auto o = shortRun(dir / "sim.rawlog");  // 3 s at 40 Hz: 120 scans
+    o.progress_every = 25;
+    std::vector<std::pair<double, std::size_t>> calls;
+    o.on_progress = [&](double f, std::size_t scans) { calls.emplace_back(f, scans); };
+    const auto s = kfd::Simulator().run(o);
+    ASSERT_GE(calls.size(), 3u);
+    EXPECT_GT(calls.front().second, 0u);
+    EXPECT_LT(calls.front().second, s.scans);         // before the end, already counting
+    for (std::size_t i = 1; i < calls.size(); ++i) {  // the last call may repeat the count
+        if (i + 1 < calls.size()) EXPECT_GT(calls[i].second, calls[i - 1].second);
+        EXPECT_GE(calls[i].second, calls[i - 1].second);
+        EXPECT_GE(calls[i].first, calls[i - 1].first);
+    }
+    EXPECT_EQ(calls.back(), std::make_pair(1.0, s.scans));
+}
 
 TEST(Simulator, SameOptionsAndSeedGiveIdenticalFiles) {
     TempDir dir;

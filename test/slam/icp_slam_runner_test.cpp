@@ -229,6 +229,48 @@ TEST(IcpSlamRunner, EveryModeRunsAndAccountsForEveryScan) {
     }
 }
 
+// kfd-filter reads SENA's 225 scans, icp-slam's steps 224: the one in the first sensory frame
+// (no odometry action before it) is counted apart, and so are the scans before rawlog_offset,
+// so that both apps account for the same scans (issue 23).
+TEST(IcpSlamRunner, ScansOutsideIcpSlamsStepsAreCountedApart) {
+    if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
+    TempDir dir;
+    kfd::RawlogFilterOptions f;
+    f.input = kSena;
+    f.output = dir / "filtered.rawlog";
+    f.pipeline = kfd::kfdDefaults();
+    const auto filtered = kfd::RawlogFilter().run(f);
+    auto o = options(kSena, dir / "all", kfd::PrefilterMode::None);
+    o.write_map = false;
+    const auto all = runAndReport(o);
+    EXPECT_EQ(all.scans_without_step, 1u);
+    EXPECT_EQ(all.scans_before_offset, 0u);
+    EXPECT_EQ(all.scans_in + all.scans_without_step, filtered.scans_in);
+    EXPECT_NE(text(dir / "all/summary.json").find("\"scans_without_step\": 1"), std::string::npos);
+    // rawlog_offset = 20 objects: the scans before it are counted apart too.
+    std::string cfg = text(kConfig);
+    const auto pos = cfg.find("\nrawlog_offset");
+    ASSERT_NE(pos, std::string::npos);
+    cfg.replace(pos + 1, cfg.find('\n', pos + 1) - pos - 1, "rawlog_offset = 20");
+    std::ofstream(dir / "offset.ini") << cfg;
+    o.config_file = dir / "offset.ini";
+    o.output_dir = dir / "offset";
+    const auto later = runAndReport(o);
+    EXPECT_GT(later.scans_before_offset, 0u);
+    EXPECT_EQ(later.scans_in + later.scans_before_offset + later.scans_without_step,
+              filtered.scans_in);
+    // kfd-icp-slam's summary says so under its scan counts.
+    const std::string cmd = "'" + std::string(KFD_ICP_SLAM_EXE) + "' '" + (dir / "offset.ini") +
+                            "' '" + kSena + "' -o '" + (dir / "app") + "' -m none --no-map -q > '" +
+                            (dir / "app.txt") + "' 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << text(dir / "app.txt");
+    const std::string want =
+        "not in: 1 scan in a sensory frame without an odometry action (MRPT's icp-slam reads no "
+        "step from it), " +
+        kfd::plural(later.scans_before_offset, "scan") + " before rawlog_offset";
+    EXPECT_NE(text(dir / "app.txt").find(want), std::string::npos) << text(dir / "app.txt");
+}
+
 TEST(IcpSlamRunner, OdometryModeMatchesATargetDropRate) {
     if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing: " << kSena;
     TempDir dir;

@@ -58,6 +58,7 @@ Denoiser::Result Denoiser::filter(Scan& scan) {
         res.points_removed = unusable + r.points_removed;
         res.temporal = r.temporal;
         res.sigma = r.sigma;
+        res.sigma_measured = r.sigma_measured;
         res.free_points = r.free_points;
         res.stale_references = r.stale_references;
         res.capped = r.capped;

@@ -82,6 +82,7 @@ void EvidenceFilter::initialize(const Params& p) {
 void EvidenceFilter::reset() {
     refs_[0].present = refs_[1].present = false;
     sigma_smoothed_ = -1.0;
+    measured_smoothed_ = -1.0;
     have_pose_ = false;
 }
 
@@ -109,9 +110,11 @@ double EvidenceFilter::estimateSigma(const Scan& scan) {
     if (scratch_.size() < 16) return sigma_smoothed_ > 0.0 ? sigma_smoothed_ : params_.min_sigma_m;
     auto q = scratch_.begin() + static_cast<std::ptrdiff_t>(scratch_.size() / 10);
     std::nth_element(scratch_.begin(), q, scratch_.end());
-    const double sigma =
-        std::max(params_.min_sigma_m, static_cast<double>(*q) / (0.1257 * kResidualScale));
+    const double measured = static_cast<double>(*q) / (0.1257 * kResidualScale);
+    const double sigma = std::max(params_.min_sigma_m, measured);
     sigma_smoothed_ = sigma_smoothed_ < 0.0 ? sigma : 0.8 * sigma_smoothed_ + 0.2 * sigma;
+    measured_smoothed_ =
+        measured_smoothed_ < 0.0 ? measured : 0.8 * measured_smoothed_ + 0.2 * measured;
     return sigma_smoothed_;
 }
 
@@ -436,6 +439,7 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     // 1.-2. Noise, lines and segments.
     const double sigma = estimateSigma(scan);
     res.sigma = sigma;
+    res.sigma_measured = params_.sigma_m > 0.0 ? 0.0 : std::max(0.0, measured_smoothed_);
     segment(scan, sigma, out);
     res.segments = out.count();
 

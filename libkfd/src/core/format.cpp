@@ -21,4 +21,13 @@ std::string format(const char* fmt, ...) {
     return out;
 }
 
+std::string noun(std::size_t n, const std::string& word, const std::string& plural_form) {
+    if (n == 1) return word;
+    return plural_form.empty() ? word + "s" : plural_form;
+}
+
+std::string plural(std::size_t n, const std::string& word, const std::string& plural_form) {
+    return std::to_string(n) + " " + noun(n, word, plural_form);
+}
+
 }  // namespace kfd

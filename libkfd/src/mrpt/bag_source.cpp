@@ -16,6 +16,7 @@
 #include <map>
 
 #include "bag_message.h"
+#include "kfd/core/format.h"
 #include "kfd/core/pose.h"
 
 namespace kfd {
@@ -585,8 +586,7 @@ SourceListing listBag(const std::string& path, const SourceOptions& options) {
         l.streams.push_back({name, info.type, info.count, info.first, info.last});
         total += info.count;
     }
-    l.detail = "ROS 1 bag, " + std::to_string(topics.size()) + " topics, " + std::to_string(total) +
-               " messages";
+    l.detail = "ROS 1 bag, " + plural(topics.size(), "topic") + ", " + plural(total, "message");
     try {
         const BagChoice c = choose(bag, topics, options);
         l.choices = c.notes;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "gz_reader.h"
+#include "kfd/core/format.h"
 #include "kfd/core/scan.h"
 
 namespace kfd {
@@ -193,7 +194,7 @@ struct CarmenSource::Impl {
         const std::size_t after = tok.size() - i - 1;
         if (v > static_cast<double>(after))
             fail(std::string(tok[0]) + " " + what + " " + std::string(tok[i]) +
-                 " is more than the " + std::to_string(after) + " fields after it");
+                 " is more than the " + plural(after, "field") + " after it");
         if (v > kMaxCount)
             fail(std::string(tok[0]) + " " + what + " " + std::string(tok[i]) + " is more than " +
                  std::to_string(static_cast<long>(kMaxCount)));
@@ -202,8 +203,8 @@ struct CarmenSource::Impl {
 
     void expectFields(std::size_t expected, const std::string& what) const {
         if (tok.size() != expected)
-            fail(std::string(tok[0]) + " " + what + " has " + std::to_string(tok.size()) +
-                 " fields, expected " + std::to_string(expected));
+            fail(std::string(tok[0]) + " " + what + " has " + plural(tok.size(), "field") +
+                 ", expected " + std::to_string(expected));
     }
 
     // A laser's mount (its pose on the robot) must be finite: every point depends on it.
@@ -285,7 +286,7 @@ struct CarmenSource::Impl {
     void flaser(const LaserParams& p) {
         if (tok.size() < 2) fail(std::string(tok[0]) + " without a reading count");
         const std::size_t n = count(1, "reading count");
-        expectFields(n + 11, "with " + std::to_string(n) + " readings");
+        expectFields(n + 11, "with " + plural(n, "reading"));
         const std::size_t k = 2 + n;
         const double lx = number(k), ly = number(k + 1), lth = number(k + 2);
         const double ox = number(k + 3), oy = number(k + 4), oth = number(k + 5);
@@ -311,8 +312,8 @@ struct CarmenSource::Impl {
         if (tok.size() < 10 + n) fail(std::string(tok[0]) + " is cut short");
         const std::size_t nrem = count(9 + n, "remission count");
         const std::size_t tail = robot ? 14 : 3;
-        expectFields(10 + n + nrem + tail, "with " + std::to_string(n) + " readings and " +
-                                               std::to_string(nrem) + " remissions");
+        expectFields(10 + n + nrem + tail,
+                     "with " + plural(n, "reading") + " and " + plural(nrem, "remission"));
         const std::size_t k = 10 + n + nrem;
         const double stamp = number(tok.size() - 3);
         auto s = scanOf(9, n, max_range, stamp);
@@ -378,8 +379,7 @@ bool CarmenSource::next(SourceEntry& e) {
                                   "format?): " +
                                   std::to_string(c.bytes_unparsable) + " of its " +
                                   std::to_string(c.bytes_unparsable + d.bytes_parsed) +
-                                  " bytes, in " + std::to_string(c.lines_unparsable) +
-                                  (c.lines_unparsable == 1 ? " line" : " lines") +
+                                  " bytes, in " + plural(c.lines_unparsable, "line") +
                                   ", the first at line " + std::to_string(c.first_unparsable_line),
                               d.path);
         if (d.entries == 0)
@@ -450,8 +450,8 @@ SourceListing listCarmen(const std::string& path) {
         }
     }
     for (const auto& k : order) l.streams.push_back(kinds[k]);
-    l.detail = "CARMEN log, " + std::to_string(lines.number()) + " lines (" +
-               std::to_string(comments) + " comments" +
+    l.detail = "CARMEN log, " + plural(lines.number(), "line") + " (" +
+               plural(comments, "comment") +
                (unparsed ? ", " + std::to_string(unparsed) + " not CARMEN text" : "") + ")";
     return l;
 }

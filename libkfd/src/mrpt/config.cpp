@@ -32,8 +32,9 @@ const StageKey* findKey(const StageRegistry& registry, const std::string& name,
 }
 
 std::string knownKeyList(const StageRegistry& registry) {
-    std::string s;
-    for (const auto& k : configKeys(registry)) s += (s.empty() ? "" : ", ") + k.name;
+    std::string s = "pipeline";  // configKeys()'s order, without its values
+    for (const auto& st : registry.stages())
+        for (const auto& k : st.keys) s += ", " + k.name;
     return s;
 }
 
@@ -155,10 +156,23 @@ std::string scalarText(const mrpt::containers::yaml& node, const std::string& ke
 }  // namespace
 
 std::vector<ConfigKeyInfo> configKeys(const StageRegistry& registry) {
+    const Pipeline::Params plain, kfd = kfdDefaults();
+    auto stageList = [](const Pipeline::Params& p) {
+        std::string s;
+        for (const auto& st : p.stages) s += (s.empty() ? "" : ",") + st;
+        return s;
+    };
+    // A key's value in `p`: the stage's parameters set there, else the stage's defaults.
+    auto value = [](const Pipeline::Params& p, const StageInfo& stage, const StageKey& k) {
+        if (const StageParams* set = p.find(stage.name)) return k.get(set->data());
+        return k.get(stage.defaults()->data());
+    };
     std::vector<ConfigKeyInfo> v;
-    v.push_back({"pipeline", "stages in order, comma separated", registry.names()});
+    v.push_back({"pipeline", "stages in order, comma separated", registry.names(), stageList(plain),
+                 stageList(kfd)});
     for (const auto& s : registry.stages())
-        for (const auto& k : s.keys) v.push_back({k.name, k.help, k.range});
+        for (const auto& k : s.keys)
+            v.push_back({k.name, k.help, k.range, value(plain, s, k), value(kfd, s, k)});
     return v;
 }
 

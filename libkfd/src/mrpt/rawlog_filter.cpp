@@ -16,7 +16,9 @@
 #include "kfd/core/cancel.h"
 #include "kfd/core/output_paths.h"
 
+#include "kfd/core/denoise_stage.h"
 #include "kfd/core/denoiser.h"
+#include "kfd/core/scan_rate.h"
 #include "kfd/mrpt/gz_output.h"
 #include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_csv.h"
@@ -99,9 +101,7 @@ class Run {
     bool have_carry_ = false;
     std::optional<Pose2D> odometry_;  // absolute odometry, for the motion guards
     bool saw_frames_ = false, saw_observations_ = false;
-    // The first sensor's stamps counted for its rate (SensorSummary::rate_hz).
-    std::size_t rate_stamps_ = 0;
-    double first_rate_stamp_ = 0.0;
+    ScanRateMeter rate_;  // the first sensor's stamps (SensorSummary::rate_hz)
 };
 
 void Run::write(const mrpt::serialization::CSerializable& obj) {
@@ -126,16 +126,16 @@ void Run::noteSensor(const CObservation2DRangeScan& scan, const StreamResult& r)
     }
     if (scan.sensorLabel != s.label) return;
     s.odometry = s.odometry || r.record.odometry.has_value();
-    const double t = r.record.stamp;
-    if (std::isfinite(t) && rate_stamps_ < SensorSummary::kMaxRateScans) {
-        if (rate_stamps_ == 0) first_rate_stamp_ = t;
-        ++rate_stamps_;
-        if (rate_stamps_ > 1 && t > first_rate_stamp_)
-            s.rate_hz = static_cast<double>(rate_stamps_ - 1) / (t - first_rate_stamp_);
-    }
+    rate_.add(r.record.stamp);
     if (r.keep)
         if (const auto* d = r.report.find<Denoiser::Result>())
-            if (d->variant == DenoiseVariant::Evidence) s.range_noise_m = d->sigma;
+            if (d->variant == DenoiseVariant::Evidence) {
+                const auto& ev = opts_.pipeline.get<DenoiseStage>().evidence;
+                s.range_noise_m = d->sigma;
+                s.range_noise_measured_m = d->sigma_measured;
+                s.range_noise_floor_m = ev.min_sigma_m;
+                s.range_noise_configured = ev.sigma_m > 0.0;
+            }
 }
 
 bool Run::handleScan(CObservation2DRangeScan& scan) {
@@ -278,6 +278,7 @@ void Run::loop() {
         throwIfCancelled();
         const std::size_t before = sum_.objects_in;
         sum_.objects_in = e.objects_read;
+        e.forEachObject([&](const auto&) { ++sum_.objects_converted; });
         odometry_ = e.odometry;
         handleEntry(e);
         if (before / every != sum_.objects_in / every) reportProgress(source_->bytesRead());
@@ -370,6 +371,9 @@ void Run::finish() {
     static_cast<ScanCounters&>(sum_) = filter_.counters();
     sum_.source = source_->counters();
     sum_.sensors = filter_.sensorCount();
+    const ScanRate rate = rate_.result();
+    sum_.sensor.rate_hz = rate.mean_hz;
+    sum_.sensor.median_interval_s = rate.median_interval_s;
 }
 
 void Run::reportProgress(std::uint64_t bytes_read) {

@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 
+#include "kfd/core/format.h"
 #include "kfd/mrpt/bag_source.h"
 #include "kfd/mrpt/carmen_source.h"
 #include "kfd/mrpt/open_source.h"
@@ -61,7 +62,7 @@ SourceListing listRawlog(const std::string& path) {
         });
     }
     for (const auto& k : order) l.streams.push_back(streams[k]);
-    l.detail = "MRPT rawlog, " + std::to_string(objects) + " objects";
+    l.detail = "MRPT rawlog, " + plural(objects, "object");
     return l;
 }
 

@@ -7,6 +7,7 @@
 
 #include "kfd/core/denoiser.h"
 #include "kfd/core/distance_filter.h"
+#include "kfd/core/format.h"
 #include "kfd/core/keyframe_selector.h"
 #include "kfd/mrpt/default_stages.h"
 #include "kfd/mrpt/scan_check.h"
@@ -171,10 +172,10 @@ std::string noUsableScan(const ScanCounters& c, const SourceCounters& source,
                    std::to_string(c.skipped_by_reason[r]) + ": " +
                    describe(static_cast<ScanSkipReason>(r));
     if (source.scans_bad_angles)
-        why += "; of them " + std::to_string(source.scans_bad_angles) +
-               " LaserScans whose angle fields do not match their beam count";
-    return "no usable scan in " + log + ": all " + std::to_string(c.scans_in) + " scans skipped (" +
-           why + ")";
+        why += "; of them " + plural(source.scans_bad_angles, "LaserScan") +
+               " whose angle fields do not match their beam count";
+    return "no usable scan in " + log + ": " + (c.scans_in == 1 ? "its " : "all ") +
+           plural(c.scans_in, "scan") + " skipped (" + why + ")";
 }
 
 const Clusters* StreamFilter::lastClusters(const std::string& sensor_label) const {

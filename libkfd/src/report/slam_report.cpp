@@ -42,28 +42,28 @@ std::string reportMarkdown(const IcpSlamSummary& sum) {
         sum.scans_in, sum.scans_kept, sum.dropped_pct, sum.points_removed, sum.points_in,
         sum.prefilter_us_per_scan, sum.icp_ms_per_scan, sum.cpu_s_total);
     if (sum.icp_runs)
-        r += format(
-            "- ICP: %zu corrections, %zu rejected (goodness below the minimum), median "
-            "goodness %.2f\n",
-            sum.icp_runs, sum.icp_rejected, sum.icp_goodness_median);
+        r += format("- ICP: %s, %zu rejected (goodness below the minimum), median goodness %.2f\n",
+                    plural(sum.icp_runs, "correction").c_str(), sum.icp_rejected,
+                    sum.icp_goodness_median);
     if (sum.rematches)
         r += format(
             "- re-matches after a rejected correction: %zu (%zu of them after kfd's gap check; "
-            "ICP then accepted the rejected scan in %zu), %zu dropped scans matched again\n",
-            sum.rematches, sum.gap_checks_failed, sum.rematches_recovered, sum.scans_rematched);
+            "ICP then accepted the rejected scan in %zu), %s matched again\n",
+            sum.rematches, sum.gap_checks_failed, sum.rematches_recovered,
+            plural(sum.scans_rematched, "dropped scan").c_str());
     if (!sum.lost_track_stamps.empty()) {
         r += format(
-            "- **%zu suspected lost track%s** (%zu ICP corrections rejected in a row: the "
+            "- **%s** (%zu ICP corrections rejected in a row: the "
             "pose then follows odometry alone and the map is not updated), from t =",
-            sum.lost_track_stamps.size(), sum.lost_track_stamps.size() == 1 ? "" : "s",
+            plural(sum.lost_track_stamps.size(), "suspected lost track").c_str(),
             kLostTrackRejections);
         for (std::size_t i = 0; i < sum.lost_track_stamps.size() && i < 10; ++i)
             r += format("%s %.3f", i ? "," : "", sum.lost_track_stamps[i]);
         r += sum.lost_track_stamps.size() > 10 ? ", ... s\n" : " s\n";
     }
     if (sum.scans_corridor)
-        r += format("- corridor switch: %zu scans degenerate (orange in the figure)\n",
-                    sum.scans_corridor);
+        r += "- corridor switch: " + plural(sum.scans_corridor, "scan") +
+             " degenerate (orange in the figure)\n";
     if (sum.relations)
         r += format(
             "- relations error (%zu used, %zu unmatched): %.4f +- %.4f m, %.3f +- %.3f deg\n",
@@ -218,6 +218,8 @@ std::string toJson(const IcpSlamSummary& s) {
     if (s.target_drop_pct) j["target_drop_pct"] = *s.target_drop_pct;
     j["cpu_s_match"] = s.cpu_s_match;
     j["scans_skipped_start"] = s.scans_skipped_start;
+    j["scans_without_step"] = s.scans_without_step;
+    j["scans_before_offset"] = s.scans_before_offset;
     if (s.source.any()) {  // what a bag or CARMEN source repaired (absent when nothing)
         nlohmann::ordered_json src;
         src["lines_unparsable"] = s.source.lines_unparsable;

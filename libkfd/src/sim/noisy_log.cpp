@@ -2,6 +2,7 @@
 
 #include <mrpt/obs/CObservation2DRangeScan.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <random>
 #include <vector>
@@ -89,8 +90,8 @@ NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
             case SourceEntry::Kind::Native:  // another topic of a bag: not in a rawlog
                 break;
         }
-        if (o.on_progress && ++n % 500 == 0)
-            o.on_progress(static_cast<double>(source->bytesRead()) / total);
+        if (o.on_progress && ++n % std::max<std::size_t>(1, o.progress_every) == 0)
+            o.on_progress(static_cast<double>(source->bytesRead()) / total, sum.scans);
     }
     if (sum.scans == 0) throw SimulationError("no 2D scans in " + o.input);
     f.close();  // the trailer, fsync, checked
@@ -98,7 +99,7 @@ NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
     throwIfCancelled();
     tmp.commit();
     tmp_labels.commit();
-    if (o.on_progress) o.on_progress(1.0);
+    if (o.on_progress) o.on_progress(1.0, sum.scans);
     return sum;
 }
 

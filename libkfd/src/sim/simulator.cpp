@@ -4,6 +4,7 @@
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/poses/CPose2D.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -187,7 +188,8 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
         f.write(odom);
         gt_traj.push_back({t, gt[k]});
         odo_traj.push_back({t, Pose2D{odo.x(), odo.y(), odo.phi()}});
-        if (o.on_progress && k % 200 == 0) o.on_progress(static_cast<double>(k) / gt.size());
+        if (o.on_progress && (k + 1) % std::max<std::size_t>(1, o.progress_every) == 0)
+            o.on_progress(static_cast<double>(k + 1) / gt.size(), k + 1);
     }
     f.close();  // the trailer, fsync, checked
     labels.close();
@@ -200,7 +202,7 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
     tmp_labels.commit();
     sum.scans = gt.size();
     sum.duration_s = static_cast<double>(gt.size()) / sensor.rate_hz;
-    if (o.on_progress) o.on_progress(1.0);
+    if (o.on_progress) o.on_progress(1.0, sum.scans);
     return sum;
 }
 

@@ -582,7 +582,15 @@ void Run::loop() {
     StartSkipper skipper(opts_.skip_scans);
     while (nextEntry(*source_, e)) {
         throwIfCancelled();
-        if (!steps.feed(e, st) || e.objects_read < rawlog_offset_ || skipper.skip(st)) continue;
+        if (!steps.feed(e, st)) {
+            e.forEachScan([&](const auto&) { ++sum_.scans_without_step; });
+            continue;
+        }
+        if (e.objects_read < rawlog_offset_) {
+            sum_.scans_before_offset += scanCount(st);
+            continue;
+        }
+        if (skipper.skip(st)) continue;
         const double builder_s0 = builder_s_;
         logs_->beginStep(st.observation, st.action.get(), st.frame.get());
         step(st, e);

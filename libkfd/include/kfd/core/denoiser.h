@@ -54,7 +54,8 @@ class Denoiser {
         std::size_t merges = 0;          // unions across rings / bridging points / seam
         double r_max = 0.0;              // m, reference: ring radius used
         double theta_threshold = 0.0;    // rad
-        double sigma = 0.0;              // m, evidence: range noise estimated from the scan
+        double sigma = 0.0;              // m, evidence: range noise used (EvidenceFilter)
+        double sigma_measured = 0.0;     // m, evidence: the residuals' estimate before the floor
         std::size_t free_points = 0;     // evidence: returns the previous keyframe saw through
         bool stale_references = false;   // evidence: bound on removal ignored its references
         bool capped = false;             // evidence: removal cut to the bound

@@ -95,6 +95,10 @@ class EvidenceFilter {
         bool temporal = false;           // temporal evidence was used for this scan
         bool refined = false;            // the odometry step was refined against the keyframe
         double sigma = 0.0;              // m: range noise used
+        /// m: the scans' residuals' own estimate, before the floor min_sigma_m (smoothed over
+        /// scans like sigma); 0 when nothing was measured (sigma_m set, or too few residuals
+        /// so far). sigma is the floor when this is below it.
+        double sigma_measured = 0.0;
         std::size_t removal_wanted = 0;  // returns steps 1-4 would have removed
         bool stale_references = false;   // step 5: temporal evidence ignored for this scan
         bool capped = false;             // step 5: spatial removal cut to the bound too
@@ -165,8 +169,9 @@ class EvidenceFilter {
     std::vector<std::uint32_t> order_;                                   // segments by size
     std::vector<std::uint8_t> small_;                                    // per segment: small
     double sigma_smoothed_ = -1.0;
-    Reference refs_[2];  // [0] the newest keyframe
-    Pose2D pose_;        // this scan's refined pose (when have_pose_)
+    double measured_smoothed_ = -1.0;  // the same, of the estimates before the floor
+    Reference refs_[2];                // [0] the newest keyframe
+    Pose2D pose_;                      // this scan's refined pose (when have_pose_)
     bool have_pose_ = false;
 };
 

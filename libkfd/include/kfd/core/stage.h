@@ -22,7 +22,7 @@ namespace kfd {
 class StageReport {
   public:
     /// Room for a stage's diagnostics; larger types are rejected at compile time.
-    static constexpr std::size_t kDiagnosticsBytes = 96;
+    static constexpr std::size_t kDiagnosticsBytes = 112;
 
     const char* name = "";           // the stage's name()
     bool dropped = false;            // this stage dropped the scan (later stages did not run)

@@ -27,14 +27,22 @@ class ConfigError : public Error {
     const std::string& key() const { return field(); }
 };
 
-/// One recognised key: name, meaning (with unit), and the allowed values.
+/// One recognised key: name, meaning (with unit), the allowed values and its two defaults.
 struct ConfigKeyInfo {
     std::string name;
     std::string help;
     std::string range;
+    /// The value a configuration file that leaves the key out gets: the stage's Params default
+    /// (the loaders read a file over Pipeline::Params{}).
+    std::string default_value;
+    /// kfd's default (kfdDefaults(), share/kfd/default.ini): the value without any
+    /// configuration (kfd-filter without -c, kfd-icp-slam without [KFD]).
+    std::string kfd_value;
 };
 /// Every key the loaders accept, in documentation order: "pipeline", then the keys of every
-/// stage of `registry` in registration order (derived from the stages' own key lists).
+/// stage of `registry` in registration order (derived from the stages' own key lists), each
+/// with its values in Pipeline::Params{} and in kfdDefaults() (a stage's values as its key
+/// printers write them, e.g. "0.01", "scan").
 std::vector<ConfigKeyInfo> configKeys(const StageRegistry& registry);
 /// configKeys(defaultStageRegistry()).
 const std::vector<ConfigKeyInfo>& configKeys();

@@ -39,16 +39,22 @@ struct RawlogFilterOptions {
 
 /// What the log's first sensor is, measured from its scans: the parameters the evidence
 /// denoiser derives (resolution from the geometry, range noise from the residuals) and the
-/// scan rate (from the stamps of its first kMaxRateScans scans).
+/// scan rate (from the stamps of all its scans, kfd::ScanRateMeter).
 struct SensorSummary {
-    static constexpr std::size_t kMaxRateScans = 50;
     std::string label;
     std::size_t beams = 0;
     double aperture_deg = 0.0;
     double resolution_deg = 0.0;
-    double rate_hz = 0.0;        // 0 when the stamps do not tell
-    double range_noise_m = 0.0;  // the evidence denoiser's estimate at the last keyframe; 0 = n/a
-    bool odometry = false;       // the log carries odometry (temporal evidence uses it)
+    double rate_hz = 0.0;            // mean over the log: (scans - 1) / span; 0 = not known
+    double median_interval_s = 0.0;  // s, between consecutive scans; 0 = not known
+    /// The evidence denoiser's range noise at the last keyframe (0 = that denoiser did not run):
+    /// the value used, the scans' residuals' own estimate before the floor (0 = nothing
+    /// measured), the floor (min_sigma_m) and whether sigma_m fixed it (nothing measured).
+    double range_noise_m = 0.0;
+    double range_noise_measured_m = 0.0;
+    double range_noise_floor_m = 0.0;
+    bool range_noise_configured = false;
+    bool odometry = false;  // the log carries odometry (temporal evidence uses it)
 };
 
 /// kfd-filter's summary: the door's counters (ScanCounters: scans in, kept, dropped, skipped by
@@ -58,11 +64,13 @@ struct RawlogFilterSummary : ScanCounters {
                          // for a bag or CARMEN input, what was read from it
     LogFormat input_format = LogFormat::Rawlog;
     LogFormat output_format = LogFormat::Rawlog;
-    std::size_t points_marked = 0;    // bag output: removed points written as NaN / +Inf
-    std::size_t objects_in = 0;       // top-level objects read
-    std::size_t objects_out = 0;      // top-level objects written
-    std::size_t objects_dropped = 0;  // sensory frames / observations dropped whole
-    std::size_t actions_merged = 0;   // odometry actions composed into a later kept action
+    std::size_t points_marked = 0;      // bag output: removed points written as NaN / +Inf
+    std::size_t objects_in = 0;         // top-level objects read (a CARMEN log: lines; a bag:
+                                        // messages)
+    std::size_t objects_converted = 0;  // MRPT objects made of them (a rawlog: = objects_in)
+    std::size_t objects_out = 0;        // top-level objects written
+    std::size_t objects_dropped = 0;    // sensory frames / observations dropped whole
+    std::size_t actions_merged = 0;     // odometry actions composed into a later kept action
     std::size_t sensors = 0;
     SensorSummary sensor;       // the first sensor, as measured from its scans
     SourceCounters source;      // what the bag or CARMEN source repaired or left out

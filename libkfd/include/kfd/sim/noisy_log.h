@@ -16,7 +16,10 @@ struct NoisyLogOptions {
     std::string output;  // the noisy rawlog; its labels go to OUTPUT_STEM.labels.csv
     RealNoiseInjector::Params noise;
     unsigned seed = 1;
-    std::function<void(double)> on_progress;  // fraction of the input read
+    /// Called every progress_every log entries and at the end: the fraction of the input read
+    /// and the 2D scans read so far.
+    std::function<void(double fraction, std::size_t scans)> on_progress;
+    std::size_t progress_every = 500;
 };
 
 struct NoisyLogSummary {

@@ -37,7 +37,10 @@ struct SimulationOptions {
     double odo_drift_deg_per_m = 0.5;  // deg of heading bias per metre travelled
     std::uint32_t seed = 1;
     std::string output;  // OUT.rawlog; writes OUT.gt.tum, OUT.odom.tum, OUT.labels.csv beside it
-    std::function<void(double fraction)> on_progress;
+    /// Called every progress_every scans and at the end: the fraction of the route done and the
+    /// scans written so far.
+    std::function<void(double fraction, std::size_t scans)> on_progress;
+    std::size_t progress_every = 200;
 };
 
 struct SimulationSummary {

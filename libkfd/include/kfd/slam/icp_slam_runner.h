@@ -76,7 +76,12 @@ struct IcpSlamSummary : ScanCounters {
     double cpu_s_total = 0.0;             // process CPU time of the run (I/O included)
     double cpu_s_match = 0.0;             // of which the match_drop_of pre-pass
     std::size_t scans_skipped_start = 0;  // the first skip_scans scans, not in scans_in
-    SourceCounters source;                // what the bag or CARMEN source repaired or left out
+    /// Scans MRPT's icp-slam reads no step from, not in scans_in (kfd-filter counts them): in a
+    /// sensory frame without an odometry action before it, or between an action and its frame.
+    std::size_t scans_without_step = 0;
+    /// Scans before [MappingApplication] rawlog_offset (that many file objects), not in scans_in.
+    std::size_t scans_before_offset = 0;
+    SourceCounters source;  // what the bag or CARMEN source repaired or left out
     bool laser_only = false;
     std::optional<double> target_drop_pct;  // what the odometry or decimate mode matched
     double wall_s_total = 0.0;
