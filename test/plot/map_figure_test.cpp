@@ -122,6 +122,9 @@ TEST(MapFigure, AHugeExtentStaysWithinThePixelBudgetAndTheScaleBarStaysRight) {
             EXPECT_TRUE(blue) << s;
         }
     }
+    in.max_side_px = 600;  // a title longer than the budget is cut, never widens the image
+    in.title = std::string(1000, 'x');
+    EXPECT_LE(kfd::renderMapFigure(in).image.getWidth(), 600u);
     in.max_side_px = 50;  // no room for the legend
     EXPECT_THROW(kfd::renderMapFigure(in), kfd::PlotError);
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <tuple>
 
 #include "kfd/core/format.h"
@@ -177,10 +178,15 @@ MapFigure renderMapFigure(const MapFigureInput& in) {
     b.x0 -= margin, b.y0 -= margin, b.x1 += margin, b.y1 += margin;
 
     // The legend band above the map: title, one row per legend entry, the scale bar.
-    int band = kPadPx + kScaleRowPx + (in.title.empty() ? 0 : kTitleRowPx);
+    // A title wider than the budget is cut ("..."): it never widens the image beyond it.
+    std::string title = in.title;
+    const std::size_t title_chars = static_cast<std::size_t>(
+        std::max(4, (std::min(in.max_side_px, 1 << 20) - 2 * kPadPx) / kCharPx));
+    if (title.size() > title_chars) title = title.substr(0, title_chars - 3) + "...";
+    int band = kPadPx + kScaleRowPx + (title.empty() ? 0 : kTitleRowPx);
     int legend_w = 200;  // the scale bar and its label
-    if (!in.title.empty())
-        legend_w = std::max(legend_w, 2 * kPadPx + kCharPx * static_cast<int>(in.title.size()));
+    if (!title.empty())
+        legend_w = std::max(legend_w, 2 * kPadPx + kCharPx * static_cast<int>(title.size()));
     for (const auto& l : layers) {
         if (!l.legend) continue;
         band += kEntryRowPx;
@@ -239,8 +245,8 @@ MapFigure renderMapFigure(const MapFigureInput& in) {
     // Title, legend and scale bar in the band.
     img.selectTextFont("9x15");
     int y = kPadPx;
-    if (!in.title.empty()) {
-        img.textOut(kPadPx, y, in.title, black);
+    if (!title.empty()) {
+        img.textOut(kPadPx, y, title, black);
         y += kTitleRowPx;
     }
     for (const auto& l : layers) {
