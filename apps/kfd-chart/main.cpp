@@ -18,7 +18,10 @@ int main(int argc, char** argv) {
     cli.option("--title", title, "chart title")->type_name("T");
     cli.option("--ylabel", ylabel, "y axis label")->type_name("L");
     cli.flag("--log", log_y, "logarithmic y axis");
-    cli.option("--size", size, "image width and height in pixels (default 1000 500)", 2, 2)
+    cli.option("--size", size,
+               "image width and height in pixels (default 1000 500; 200 to\n10000 each, at most 40 "
+               "million pixels)",
+               2, 2)
         ->option_text("W H");
     cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP
     return cli.run(argc, argv, [&] {

@@ -3,7 +3,6 @@
 // All logic lives in kfd::IcpSlamRunner; this file parses arguments and reports.
 #include <cstdio>
 #include <string>
-#include <utility>
 
 #include "common/cli.h"
 #include "common/source_cli.h"
@@ -112,59 +111,8 @@ int main(int argc, char** argv) {
             }
         }();
         kfd::writeIcpSlamReport(result);
-        const auto& s = result.summary;
-        for (const auto& notice : s.notices)  // an icp-slam key or map kfd did not honour
+        for (const auto& notice : result.summary.notices)  // a key or map kfd did not honour
             std::fprintf(stderr, "kfd-icp-slam: warning: %s\n", notice.c_str());
-        std::printf("kfd-icp-slam summary (mode %s)\n", kfd::toString(s.mode));
-        std::printf("  input      %s\n  output     %s\n", s.rawlog.c_str(), s.output_dir.c_str());
-        std::printf("  scans      in %zu, kept %zu, dropped %.1f %%\n", s.scans_in, s.scans_kept,
-                    s.dropped_pct);
-        std::string not_in;  // the log's other scans (kfd-filter counts them in its "in")
-        auto notIn = [&](std::size_t n, const char* why) {
-            if (n) not_in += (not_in.empty() ? "" : ", ") + kfd::plural(n, "scan") + " " + why;
-        };
-        notIn(s.scans_without_step,
-              "in a sensory frame without an odometry action (MRPT's icp-slam reads no step "
-              "from it)");
-        notIn(s.scans_before_offset, "before rawlog_offset");
-        notIn(s.scans_skipped_start, "skipped at the start (--skip-scans)");
-        if (!not_in.empty()) std::printf("             not in: %s\n", not_in.c_str());
-        std::printf("  points     removed %zu of %zu\n", s.points_removed, s.points_in);
-        std::printf(
-            "  time       pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s, "
-            "wall %.2f s\n",
-            s.prefilter_us_per_scan, s.icp_ms_per_scan, s.cpu_s_total, s.wall_s_total);
-        if (s.icp_runs)
-            std::printf("  ICP        %s, %zu rejected, median goodness %.2f\n",
-                        kfd::plural(s.icp_runs, "correction").c_str(), s.icp_rejected,
-                        s.icp_goodness_median);
-        if (s.rematches)
-            std::printf(
-                "  re-match   %zu after a rejection (%zu by the gap check, %zu then "
-                "accepted), %s matched again\n",
-                s.rematches, s.gap_checks_failed, s.rematches_recovered,
-                kfd::plural(s.scans_rematched, "dropped scan").c_str());
-        if (!s.lost_track_stamps.empty())
-            std::printf(
-                "  WARNING    %s (%zu ICP corrections rejected in a row), "
-                "first at t = %.3f s: see report.md and scans.csv's icp_goodness\n",
-                kfd::plural(s.lost_track_stamps.size(), "suspected lost track").c_str(),
-                kfd::kLostTrackRejections, s.lost_track_stamps.front());
-        if (s.ate_rmse) std::printf("  ATE        RMSE %.4f m\n", *s.ate_rmse);
-        if (s.relations) {
-            const auto& r = *s.relations;
-            std::printf(
-                "  relations  %zu used, %zu unmatched: trans %.4f +- %.4f m, rot %.3f +- "
-                "%.3f deg\n",
-                r.used, r.unmatched, r.trans_mean, r.trans_std, r.rot_mean_deg, r.rot_std_deg);
-            for (const auto& [name, sub] :
-                 {std::pair{"local", &s.relations_local}, std::pair{"long ", &s.relations_long}})
-                if (*sub)
-                    std::printf("    %s    (%s %g s) %zu used: trans %.4f +- %.4f m\n", name,
-                                sub == &s.relations_local ? "<=" : ">", s.split_seconds,
-                                (*sub)->used, (*sub)->trans_mean, (*sub)->trans_std);
-        }
-        if (s.target_drop_pct)
-            std::printf("  matched    drop target %.2f %%\n", *s.target_drop_pct);
+        std::fputs(kfd::summaryText(result.summary).c_str(), stdout);  // as report.md
     });
 }

@@ -53,7 +53,9 @@ int main(int argc, char** argv) {
     kfd::app::addSourceOptions(cli, source_opts, list, laser_only,
                                " (the denoiser's temporal evidence then\naligns the scans "
                                "without it)");
-    cli.option("--size", size, "image width and height")->type_name("PX")->capture_default_str();
+    cli.option("--size", size, "image width and height (16 to 6324)")
+        ->type_name("PX")
+        ->capture_default_str();
     cli.option("--extent", extent, "half the visible height in metres (default: fit the scan)")
         ->type_name("M");
     cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP

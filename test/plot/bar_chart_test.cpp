@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <utility>
 
 #include "kfd/plot/bar_chart.h"
 
@@ -54,6 +55,25 @@ TEST(BarChart, BadShapesAndLogOfZeroAreErrors) {
     EXPECT_THROW(c.render(), kfd::PlotError);
     c.values[0][0] = 0.01;
     EXPECT_NO_THROW(c.render());
+}
+
+TEST(BarChart, TheLegendWrapsWithinTheImageAndTheSizeHasABudget) {
+    auto c = twoByTwo();
+    c.series = {"a long series name one", "a long series name two", "a long series name three"};
+    c.values = {{1.0, 2.0, 3.0}, {4.0, 0.5, 1.5}};
+    c.errors.clear();
+    const auto img = c.render();
+    // Every series' swatch is in the legend rows under the axis (rows 240 on), inside the image.
+    for (std::size_t s = 0; s < c.series.size(); ++s) {
+        bool found = false;
+        for (int row = 300 - 90 + 30; row < 300 && !found; ++row)
+            found = columnOfColour(img, row, kfd::BarChart::seriesColour(s)) >= 0;
+        EXPECT_TRUE(found) << s;
+    }
+    for (const auto& [w, h] : {std::pair{100, 300}, std::pair{20000, 500}, std::pair{9000, 9000}}) {
+        c.width = w, c.height = h;
+        EXPECT_THROW(c.render(), kfd::PlotError) << w << " x " << h;
+    }
 }
 
 TEST(BarChart, ReadsCsvInFirstSeenOrder) {

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <string>
+#include <utility>
 
 #include "kfd/core/denoiser.h"
 #include "kfd/render/cluster_figure.h"
@@ -114,4 +116,17 @@ TEST(ClusterFigure, NoisePointsAreRed) {
                                        1.5 * std::sin(s.geometry.angle(lone)));
     EXPECT_GT(py, 150);  // -y below the centre
     EXPECT_TRUE(colourNear(img, px, py, kfd::ClusterFigure::colourOf(0, true)));
+}
+
+TEST(ClusterFigure, SizesOutsideThePixelBudgetAreRefusedBeforeAnyAllocation) {
+    for (const auto& [w, h] : {std::pair{8, 800}, std::pair{20000, 100}, std::pair{9000, 9000}}) {
+        kfd::ClusterFigureOptions o;
+        o.width = w, o.height = h;
+        try {  // refused for its size, whether or not OSMesa is there
+            kfd::ClusterFigure fig(o);
+            ADD_FAILURE() << w << " x " << h << " accepted";
+        } catch (const kfd::RenderError& e) {
+            EXPECT_NE(std::string(e.what()).find("figure size"), std::string::npos) << e.what();
+        }
+    }
 }

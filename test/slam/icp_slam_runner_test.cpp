@@ -532,7 +532,26 @@ TEST(IcpSlamRunner, GroundTruthTrajectoryGivesAteAndAReport) {
     const std::string report = text(dir / "out/report.md");
     EXPECT_NE(report.find("ATE RMSE"), std::string::npos);
     EXPECT_NE(report.find("map_figure.png"), std::string::npos);
-    EXPECT_TRUE(fs::exists(dir / "out/map_figure.png"));
+    mrpt::img::CImage img;
+    ASSERT_TRUE(img.loadFromFile(dir / "out/map_figure.png"));
+    EXPECT_LE(std::max(img.getWidth(), img.getHeight()), 3000u);  // the figure's budget
+    // The figure's caption names what it drew: ground truth and odometry here, neither on a
+    // laser-only run without ground truth.
+    auto caption = [&](const std::string& out) {
+        const std::string md = text(out + "/report.md");
+        const auto from = md.find("![");
+        return md.substr(from, md.find('\n', from) - from);
+    };
+    const std::string full = caption(dir / "out");
+    for (const char* layer : {"occupancy map", "estimate", "ground truth", "odometry"})
+        EXPECT_NE(full.find(layer), std::string::npos) << layer << " in " << full;
+    o = options(sim.rawlog, dir / "laser", kfd::PrefilterMode::None);
+    o.laser_only = true;
+    runAndReport(o);
+    const std::string laser = caption(dir / "laser");
+    EXPECT_NE(laser.find("estimate"), std::string::npos) << laser;
+    for (const char* layer : {"ground truth", "odometry"})
+        EXPECT_EQ(laser.find(layer), std::string::npos) << layer << " in " << laser;
 }
 
 // API users get the same protection as the app: the output folder appears only on commit, a

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 namespace kfd {
 
@@ -18,6 +19,13 @@ mrpt::img::TColor BarChart::seriesColour(std::size_t s) {
 
 mrpt::img::CImage BarChart::render() const {
     if (values.size() != groups.size()) throw PlotError("bar chart: rows != groups");
+    if (std::min(width, height) < kMinSidePx || std::max(width, height) > kMaxSidePx ||
+        double(width) * height > kMaxPixels)
+        throw PlotError("bar chart: size " + std::to_string(width) + " x " +
+                        std::to_string(height) + " px is outside " + std::to_string(kMinSidePx) +
+                        ".." + std::to_string(kMaxSidePx) +
+                        " px a side or above 40 million "
+                        "pixels");
     double lo = 1e300, hi = -1e300;
     for (std::size_t g = 0; g < groups.size(); ++g) {
         if (values[g].size() != series.size())
@@ -93,12 +101,14 @@ mrpt::img::CImage BarChart::render() const {
             }
         }
     }
-    // Legend under the axis.
-    int lx = left;
+    // Legend under the axis, in rows that fit the image's width.
+    int lx = left, ly = bottom + 30;
     for (std::size_t s = 0; s < series.size(); ++s) {
-        img.filledRectangle(lx, bottom + 30, lx + 12, bottom + 42, seriesColour(s));
-        img.textOut(lx + 16, bottom + 30, series[s], black);
-        lx += 24 + 7 * static_cast<int>(series[s].size());
+        const int w = 24 + 7 * static_cast<int>(series[s].size());
+        if (lx > left && lx + w > width) lx = left, ly += 18;
+        img.filledRectangle(lx, ly, lx + 12, ly + 12, seriesColour(s));
+        img.textOut(lx + 16, ly, series[s], black);
+        lx += w;
     }
     return img;
 }

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
+#include <limits>
+#include <string>
+#include <tuple>
 
 #include "kfd/core/format.h"
 #include "kfd/eval/ate.h"
@@ -11,37 +13,129 @@ namespace kfd {
 namespace {
 
 using mrpt::img::TColor;
+using Grid = mrpt::maps::COccupancyGridMap2D;
 
-void path(mrpt::img::CImage& img, const mrpt::maps::COccupancyGridMap2D& g, const Trajectory& t,
-          const TColor& c, unsigned width) {
+// Poses farther than this from the origin (m) are drawn (clamped, off the image) but do not
+// stretch the figure's bounds: their difference would overflow a double's range.
+constexpr double kFarM = 1.0e15;
+
+bool usable(const Pose2D& p) {
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::abs(p.x) < kFarM &&
+           std::abs(p.y) < kFarM;
+}
+
+// The bounds of what is drawn (m), grown point by point.
+struct Bounds {
+    double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+    bool empty() const { return x1 < x0; }
+    void add(double x, double y) {
+        x0 = std::min(x0, x), x1 = std::max(x1, x);
+        y0 = std::min(y0, y), y1 = std::max(y1, y);
+    }
+};
+
+// A trajectory is drawn when it has a segment between two usable poses.
+bool hasSegment(const Trajectory& t) {
+    for (std::size_t i = 1; i < t.size(); ++i)
+        if (usable(t[i - 1].pose) && usable(t[i].pose)) return true;
+    return false;
+}
+
+void addPath(Bounds& b, const Trajectory& t) {
+    for (const auto& p : t)
+        if (usable(p.pose)) b.add(p.pose.x, p.pose.y);
+}
+
+// The indices into `t` of usable poses among `idx`.
+std::vector<std::size_t> drawable(const std::vector<std::size_t>& idx, const Trajectory& t) {
+    std::vector<std::size_t> out;
+    for (const auto k : idx)
+        if (k < t.size() && usable(t[k].pose)) out.push_back(k);
+    return out;
+}
+
+void path(mrpt::img::CImage& img, const MapFigureFrame& f, const Trajectory& t, const TColor& c,
+          unsigned width) {
     for (std::size_t i = 1; i < t.size(); ++i) {
-        const auto a = mapFigurePixel(g, t[i - 1].pose.x, t[i - 1].pose.y);
-        const auto b = mapFigurePixel(g, t[i].pose.x, t[i].pose.y);
+        if (!usable(t[i - 1].pose) || !usable(t[i].pose)) continue;
+        const auto a = f.pixel(t[i - 1].pose.x, t[i - 1].pose.y);
+        const auto b = f.pixel(t[i].pose.x, t[i].pose.y);
         img.line(a.first, a.second, b.first, b.second, c, width);
     }
 }
 
+// The grid into the map part of `img`: each pixel shows the most occupied known cell it covers
+// (the darkest, as getAsImage draws it: white free, black occupied), unknown grey otherwise.
+void drawGrid(mrpt::img::CImage& img, const Grid& g, const MapFigureFrame& f) {
+    const auto& raw = g.getRawMap();
+    const int nx = static_cast<int>(g.getSizeX()), ny = static_cast<int>(g.getSizeY());
+    const double res = g.getResolution(), gx = g.getXMin(), gy = g.getYMin();
+    const std::uint8_t unknown = Grid::l2p_255(0);
+    // The cell range [first, last) under [a, b) metres, clipped to [0, n).
+    auto cells = [res](double a, double b, double origin, int n) {
+        const double lo = std::floor((a - origin) / res + 1e-9),
+                     hi = std::ceil((b - origin) / res - 1e-9);
+        return std::pair<int, int>{static_cast<int>(std::clamp(lo, 0.0, double(n))),
+                                   static_cast<int>(std::clamp(hi, 0.0, double(n)))};
+    };
+    std::vector<std::pair<int, int>> cols(static_cast<std::size_t>(f.width));
+    for (int c = 0; c < f.width; ++c)
+        cols[c] =
+            cells(f.x_min + c * f.metres_per_pixel, f.x_min + (c + 1) * f.metres_per_pixel, gx, nx);
+    for (int r = 0; r < f.height; ++r) {
+        const auto rows =
+            cells(f.y_max - (r + 1) * f.metres_per_pixel, f.y_max - r * f.metres_per_pixel, gy, ny);
+        for (int c = 0; c < f.width; ++c) {
+            int v = 256;
+            for (int cy = rows.first; cy < rows.second; ++cy)
+                for (int cx = cols[c].first; cx < cols[c].second; ++cx) {
+                    const auto l = raw[static_cast<std::size_t>(cy) * nx + cx];
+                    if (l != 0) v = std::min<int>(v, Grid::l2p_255(l));
+                }
+            const auto grey = static_cast<std::uint8_t>(v > 255 ? unknown : v);
+            auto* p = img.ptr<std::uint8_t>(c, f.top + r);
+            p[0] = p[1] = p[2] = grey;
+        }
+    }
+}
+
+struct Layer {
+    MapFigureLayer text;
+    TColor colour;
+    bool dot = false;  // legend swatch: a dot, not a line
+    bool legend = true;
+};
+
+constexpr int kCharPx = 9, kTitleRowPx = 20, kEntryRowPx = 18, kScaleRowPx = 22, kPadPx = 8;
+
 }  // namespace
 
-std::pair<int, int> mapFigurePixel(const mrpt::maps::COccupancyGridMap2D& g, double x, double y) {
-    // getAsImage(verticalFlip = true) puts the grid's last row (largest y) at the top. A point
-    // far outside the image (a track lost far away, NaN) is clamped well outside it: lines
-    // towards it are clipped by the canvas, and no double is cast beyond an int's range.
-    const double res = g.getResolution();
-    auto cell = [](double v) {
+std::optional<CellBox> knownCellBox(const Grid& g) {
+    const auto& raw = g.getRawMap();
+    const int nx = static_cast<int>(g.getSizeX()), ny = static_cast<int>(g.getSizeY());
+    CellBox b{nx, ny, -1, -1};
+    for (int cy = 0; cy < ny; ++cy)
+        for (int cx = 0; cx < nx; ++cx)
+            if (raw[static_cast<std::size_t>(cy) * nx + cx] != 0) {
+                b.x0 = std::min(b.x0, cx), b.x1 = std::max(b.x1, cx);
+                b.y0 = std::min(b.y0, cy), b.y1 = std::max(b.y1, cy);
+            }
+    if (b.x1 < 0) return std::nullopt;
+    return b;
+}
+
+std::pair<int, int> MapFigureFrame::pixel(double x, double y) const {
+    auto at = [](double v) {
         constexpr double kFar = 1.0e6;  // pixels; images are at most a few thousand wide
         return static_cast<int>(std::isnan(v) ? -kFar : std::clamp(std::floor(v), -kFar, kFar));
     };
-    const int col = cell((x - g.getXMin()) / res);
-    const int row = static_cast<int>(g.getSizeY()) - 1 - cell((y - g.getYMin()) / res);
-    return {col, row};
+    return {at((x - x_min) / metres_per_pixel), top + at((y_max - y) / metres_per_pixel)};
 }
 
-mrpt::img::CImage renderMapFigure(const MapFigureInput& in) {
+MapFigure renderMapFigure(const MapFigureInput& in) {
     if (!in.grid) throw PlotError("map figure: no grid");
     const auto& g = *in.grid;
-    mrpt::img::CImage img;
-    g.getAsImage(img, true, true);  // +y up, RGB
+    const double res = g.getResolution();
 
     Trajectory gt = in.ground_truth, odo = in.odometry;
     if (gt.size() >= 2 && in.estimate.size() >= 2) {  // gt ~ T (+) est: bring gt to the map frame
@@ -55,47 +149,133 @@ mrpt::img::CImage renderMapFigure(const MapFigureInput& in) {
         const Pose2D t = compose(in.estimate.front().pose, inverse(odo.front().pose));
         for (auto& p : odo) p.pose = compose(t, p.pose);
     }
+
+    // The layers drawn and their bounds: nothing else sets the figure's extent.
     const TColor grey(150, 150, 150), green(30, 160, 60), blue(30, 90, 220), navy(10, 20, 90),
         black(0, 0, 0), orange(240, 130, 0);
-    path(img, g, odo, grey, 1);
-    path(img, g, gt, green, 5);  // wide: stays visible under an accurate estimate
-    path(img, g, in.estimate, blue, 2);
-    for (const auto k : in.corridor) {  // under the keyframe dots
-        if (k >= in.estimate.size()) continue;
-        const auto p = mapFigurePixel(g, in.estimate[k].pose.x, in.estimate[k].pose.y);
+    std::vector<Layer> layers;
+    Bounds b;
+    if (const auto cells = knownCellBox(g)) {
+        layers.push_back({{"occupancy map", "white free, black occupied"}, black, false, false});
+        b.add(g.getXMin() + cells->x0 * res, g.getYMin() + cells->y0 * res);
+        b.add(g.getXMin() + (cells->x1 + 1) * res, g.getYMin() + (cells->y1 + 1) * res);
+    }
+    const bool draw_est = hasSegment(in.estimate), draw_gt = hasSegment(gt),
+               draw_odo = hasSegment(odo);
+    const auto keyframes = drawable(in.keyframes, in.estimate);
+    const auto corridor = drawable(in.corridor, in.estimate);
+    if (draw_est) layers.push_back({{"estimate", "blue"}, blue});
+    if (!keyframes.empty()) layers.push_back({{"keyframes", "navy dots"}, navy, true});
+    if (draw_gt) layers.push_back({{"ground truth, aligned to the estimate", "green"}, green});
+    if (draw_odo) layers.push_back({{"odometry from the estimate's start", "grey"}, grey});
+    if (!corridor.empty())
+        layers.push_back({{"scans the corridor switch found degenerate", "orange"}, orange, true});
+    if (draw_est || !keyframes.empty() || !corridor.empty()) addPath(b, in.estimate);
+    if (draw_gt) addPath(b, gt);
+    if (draw_odo) addPath(b, odo);
+    if (b.empty()) b.add(0.5 * (g.getXMin() + g.getXMax()), 0.5 * (g.getYMin() + g.getYMax()));
+    const double margin = std::max(in.margin_m, 0.0) + 0.5 * res;
+    b.x0 -= margin, b.y0 -= margin, b.x1 += margin, b.y1 += margin;
+
+    // The legend band above the map: title, one row per legend entry, the scale bar.
+    // A title wider than the budget is cut ("..."): it never widens the image beyond it.
+    std::string title = in.title;
+    const std::size_t title_chars = static_cast<std::size_t>(
+        std::max(4, (std::min(in.max_side_px, 1 << 20) - 2 * kPadPx) / kCharPx));
+    if (title.size() > title_chars) title = title.substr(0, title_chars - 3) + "...";
+    int band = kPadPx + kScaleRowPx + (title.empty() ? 0 : kTitleRowPx);
+    int legend_w = 200;  // the scale bar and its label
+    if (!title.empty())
+        legend_w = std::max(legend_w, 2 * kPadPx + kCharPx * static_cast<int>(title.size()));
+    for (const auto& l : layers) {
+        if (!l.legend) continue;
+        band += kEntryRowPx;
+        legend_w = std::max(legend_w, 34 + kPadPx + kCharPx * static_cast<int>(l.text.name.size()));
+    }
+    const double side = in.max_side_px;
+    if (legend_w > side || band + 1 > side || double(legend_w) * (band + 1) > in.max_pixels)
+        throw PlotError(
+            format("map figure: a budget of %d px a side and %.0f pixels is too "
+                   "small for the legend (%d x %d px)",
+                   in.max_side_px, in.max_pixels, legend_w, band + 1));
+
+    // The cell size drawn: the grid's, coarser until the whole image fits the budget.
+    const double w_m = b.x1 - b.x0, h_m = b.y1 - b.y0;
+    double mpp = std::max({res, w_m / side, h_m / (side - band)});
+    auto size = [&](double m) {
+        const int w = std::max(1, static_cast<int>(std::ceil(w_m / m - 1e-9)));
+        const int h = std::max(1, static_cast<int>(std::ceil(h_m / m - 1e-9)));
+        return std::pair<int, int>{w, h};
+    };
+    for (int k = 0; k < 10000; ++k) {  // the area shrinks with mpp^2 down to the legend's
+        const auto [w, h] = size(mpp);
+        if (std::max(w, legend_w) <= side && h + band <= side &&
+            double(std::max(w, legend_w)) * (h + band) <= in.max_pixels)
+            break;
+        mpp *= 1.01;
+    }
+    MapFigure fig;
+    auto& f = fig.frame;
+    f.metres_per_pixel = mpp;
+    f.x_min = b.x0, f.y_max = b.y1;
+    if (mpp == res) {  // one cell a pixel: put the pixels on the cells
+        f.x_min = g.getXMin() + std::floor((b.x0 - g.getXMin()) / res) * res;
+        f.y_max = g.getYMin() + std::ceil((b.y1 - g.getYMin()) / res) * res;
+    }
+    std::tie(f.width, f.height) = size(mpp);
+    f.top = band;
+
+    auto& img = fig.image;
+    const int img_w = std::max(f.width, legend_w);
+    img = mrpt::img::CImage(img_w, band + f.height, mrpt::img::CH_RGB);
+    img.filledRectangle(0, 0, img_w - 1, band + f.height - 1, TColor(255, 255, 255));
+    drawGrid(img, g, f);
+    path(img, f, odo, grey, 1);
+    path(img, f, gt, green, 5);  // wide: stays visible under an accurate estimate
+    path(img, f, in.estimate, blue, 2);
+    for (const auto k : corridor) {  // under the keyframe dots
+        const auto p = f.pixel(in.estimate[k].pose.x, in.estimate[k].pose.y);
         img.filledRectangle(p.first - 2, p.second - 2, p.first + 2, p.second + 2, orange);
     }
-    for (const auto k : in.keyframes) {
-        if (k >= in.estimate.size()) continue;
-        const auto p = mapFigurePixel(g, in.estimate[k].pose.x, in.estimate[k].pose.y);
+    for (const auto k : keyframes) {
+        const auto p = f.pixel(in.estimate[k].pose.x, in.estimate[k].pose.y);
         img.filledRectangle(p.first - 1, p.second - 1, p.first + 1, p.second + 1, navy);
     }
 
-    // Legend, title and a 1 m scale bar.
+    // Title, legend and scale bar in the band.
     img.selectTextFont("9x15");
-    int y = 8;
-    if (!in.title.empty()) {
-        img.textOut(8, y, in.title, black);
-        y += 20;
+    int y = kPadPx;
+    if (!title.empty()) {
+        img.textOut(kPadPx, y, title, black);
+        y += kTitleRowPx;
     }
-    auto entry = [&](const TColor& c, const std::string& label) {
-        img.filledRectangle(8, y + 4, 28, y + 8, c);
-        img.textOut(34, y, label, black);
-        y += 18;
-    };
-    entry(blue, "estimate (dots: keyframes)");
-    if (!gt.empty()) entry(green, "ground truth (aligned)");
-    if (!odo.empty()) entry(grey, "odometry");
-    if (!in.corridor.empty()) entry(orange, "corridor switch: degenerate scans");
+    for (const auto& l : layers) {
+        fig.layers.push_back(l.text);
+        if (!l.legend) continue;
+        if (l.dot)
+            img.filledRectangle(16, y + 4, 20, y + 8, l.colour);
+        else
+            img.filledRectangle(8, y + 4, 28, y + 8, l.colour);
+        img.textOut(34, y, l.text.name, black);
+        y += kEntryRowPx;
+    }
     // Scale bar: 1, 2 or 5 times a power of ten metres, at least 20 pixels long.
     double metres = 1.0;
-    for (int k = 0; metres / g.getResolution() < 19.5 && k < 60; ++k)  // 0.05f is > 0.05
-        metres *= (k % 3 == 1) ? 2.5 : 2.0;                            // 1, 2, 5, 10, 20, 50, ...
-    const int bar = static_cast<int>(std::lround(metres / g.getResolution()));
-    const int by = static_cast<int>(img.getHeight()) - 12;
-    img.line(8, by, 8 + bar, by, black, 2);
-    img.textOut(12 + bar, by - 8, format("%g m", metres), black);
-    return img;
+    for (int k = 0; metres / mpp < 19.5 && k < 1000; ++k)  // 0.05f is > 0.05
+        metres *= (k % 3 == 1) ? 2.5 : 2.0;                // 1, 2, 5, 10, 20, 50, ...
+    fig.scale_bar_m = metres;
+    fig.scale_bar_px = static_cast<int>(std::lround(metres / mpp));
+    fig.scale_bar_row = y + 8;
+    img.line(kPadPx, fig.scale_bar_row, kPadPx + fig.scale_bar_px, fig.scale_bar_row, black, 2);
+    img.textOut(12 + kPadPx + fig.scale_bar_px, y, format("%g m", metres), black);
+    return fig;
+}
+
+std::string mapFigureCaption(const std::vector<MapFigureLayer>& layers) {
+    std::string s = "map figure:";
+    for (std::size_t i = 0; i < layers.size(); ++i)
+        s += (i ? ", " : " ") + layers[i].name + " (" + layers[i].colour + ")";
+    return layers.empty() ? s + " nothing drawn" : s;
 }
 
 }  // namespace kfd

@@ -8,6 +8,7 @@
 #include <mrpt/opengl/CSetOfLines.h>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace kfd {
@@ -21,6 +22,10 @@ struct ClusterFigure::Impl {
 ClusterFigure::ClusterFigure(const ClusterFigureOptions& opts)
     : impl_(std::make_unique<Impl>()), opts_(opts) {
     if (opts.width < 16 || opts.height < 16) throw RenderError("figure size too small");
+    if (opts.width > 10000 || opts.height > 10000 || double(opts.width) * opts.height > 40.0e6)
+        throw RenderError("figure size too large: " + std::to_string(opts.width) + " x " +
+                          std::to_string(opts.height) +
+                          " px (at most 10000 a side and 40 million pixels)");
     // OSMesa core-profile context (see ../shared/notes/platform.md), then MRPT's FBO renderer.
     const int attribs[] = {OSMESA_FORMAT,
                            OSMESA_RGBA,

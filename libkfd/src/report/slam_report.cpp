@@ -8,8 +8,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "kfd/baselines/decimate_stage.h"
 #include "kfd/baselines/motion_stage.h"
@@ -33,14 +34,35 @@ void writeText(const StagedOutputFolder& out, const std::string& name, const std
     f.close();
 }
 
-std::string reportMarkdown(const IcpSlamSummary& sum) {
+}  // namespace
+
+namespace {
+
+// The log's scans that are not in scans_in (kfd-filter counts them in its "in"), or "".
+std::string scansNotIn(const IcpSlamSummary& s) {
+    std::string not_in;
+    auto add = [&](std::size_t n, const char* why) {
+        if (n) not_in += (not_in.empty() ? "" : ", ") + plural(n, "scan") + " " + why;
+    };
+    add(s.scans_without_step,
+        "in a sensory frame without an odometry action (MRPT's icp-slam reads no step from it)");
+    add(s.scans_before_offset, "before rawlog_offset");
+    add(s.scans_skipped_start, "skipped at the start (--skip-scans)");
+    return not_in;
+}
+
+}  // namespace
+
+std::string reportMarkdown(const IcpSlamSummary& sum,
+                           const std::vector<MapFigureLayer>& figure_layers) {
     std::string r = "# kfd-icp-slam report\n\n";
     r += "- rawlog: `" + sum.rawlog + "`\n- pre-filter mode: **" + toString(sum.mode) + "**\n";
     r += format(
         "- scans: %zu in, %zu kept (%.1f %% dropped); points removed: %zu of %zu\n"
-        "- time: pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s\n",
+        "- time: pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s, wall %.2f s\n",
         sum.scans_in, sum.scans_kept, sum.dropped_pct, sum.points_removed, sum.points_in,
-        sum.prefilter_us_per_scan, sum.icp_ms_per_scan, sum.cpu_s_total);
+        sum.prefilter_us_per_scan, sum.icp_ms_per_scan, sum.cpu_s_total, sum.wall_s_total);
+    if (const std::string n = scansNotIn(sum); !n.empty()) r += "- not in: " + n + "\n";
     if (sum.icp_runs)
         r += format("- ICP: %s, %zu rejected (goodness below the minimum), median goodness %.2f\n",
                     plural(sum.icp_runs, "correction").c_str(), sum.icp_rejected,
@@ -64,21 +86,33 @@ std::string reportMarkdown(const IcpSlamSummary& sum) {
     if (sum.scans_corridor)
         r += "- corridor switch: " + plural(sum.scans_corridor, "scan") +
              " degenerate (orange in the figure)\n";
-    if (sum.relations)
+    if (sum.ate_rmse) r += format("- ATE RMSE after SE(2) alignment: %.4f m\n", *sum.ate_rmse);
+    if (sum.relations) {
+        const auto& a = *sum.relations;
         r += format(
             "- relations error (%zu used, %zu unmatched): %.4f +- %.4f m, %.3f +- %.3f deg\n",
-            sum.relations->used, sum.relations->unmatched, sum.relations->trans_mean,
-            sum.relations->trans_std, sum.relations->rot_mean_deg, sum.relations->rot_std_deg);
-    if (sum.ate_rmse) {
-        std::ostringstream ate;  // as the stream prints it (6 significant digits)
-        ate << *sum.ate_rmse;
-        r += "- ATE RMSE after SE(2) alignment: " + ate.str() + " m\n";
+            a.used, a.unmatched, a.trans_mean, a.trans_std, a.rot_mean_deg, a.rot_std_deg);
+        for (const auto& [name, sub, n] :
+             {std::tuple{"local", &sum.relations_local, sum.relations_local_count},
+              std::tuple{"long", &sum.relations_long, sum.relations_long_count}}) {
+            r += format("  - %s (%s %g s apart, %zu relations): ", name,
+                        sub == &sum.relations_local ? "<=" : ">", sum.split_seconds, n);
+            if (*sub)
+                r += format("%zu used, %zu unmatched: %.4f +- %.4f m, %.3f +- %.3f deg\n",
+                            (*sub)->used, (*sub)->unmatched, (*sub)->trans_mean, (*sub)->trans_std,
+                            (*sub)->rot_mean_deg, (*sub)->rot_std_deg);
+            else
+                r += n ? "none matched a pose\n" : "none\n";
+        }
     }
-    r += "\n![map, estimate (blue, dots = keyframes), ground truth (green), odometry (grey)]"
-         "(map_figure.png)\n\nAll numbers: `summary.json`; per scan: `scans.csv`; "
-         "trajectory: `trajectory.tum`.\n";
+    if (sum.target_drop_pct) r += format("- matched drop target: %.2f %%\n", *sum.target_drop_pct);
+    const std::string caption = mapFigureCaption(figure_layers);
+    r += "\n![" + caption + "](map_figure.png)\n\n*" + caption +
+         "*\n\nAll numbers: `summary.json`; per scan: `scans.csv`; trajectory: `trajectory.tum`.\n";
     return r;
 }
+
+namespace {
 
 // The map image and figure are drawn in a local frame whose origin is the estimate's first
 // position (rounded to the metre), on a grid whose cell size keeps it within kMaxMapCells:
@@ -121,7 +155,8 @@ Trajectory inFrame(const Trajectory& t, const MapFrame& f) {
     return out;
 }
 
-void writeMap(const IcpSlamResult& res, const StagedOutputFolder& out) {
+// Writes final_map.simplemap, map.png and map_figure.png; returns the figure's layers.
+std::vector<MapFigureLayer> writeMap(const IcpSlamResult& res, const StagedOutputFolder& out) {
     const auto& sum = res.summary;
     // in the log's frame (like trajectory.tum); the map as built is in the builder's frame
     writeSimpleMap(*res.map, res.map_origin, out.path() / "final_map.simplemap",
@@ -134,22 +169,35 @@ void writeMap(const IcpSlamResult& res, const StagedOutputFolder& out) {
         local.changeCoordinatesOrigin(mrpt::poses::CPose3D(dx, dy, 0.0, 0.0, 0.0, 0.0));
     grid.setSize(-10, 10, -10, 10, static_cast<float>(frame.resolution));
     grid.loadFromSimpleMap(local);
-    {  // as COccupancyGridMap2D::saveAsBitmapFile
+    {  // as COccupancyGridMap2D::saveAsBitmapFile (+y up), the known cells and 1 m around them
         mrpt::img::CImage img;
         grid.getAsImage(img);
+        if (const auto box = knownCellBox(grid)) {
+            const int m = static_cast<int>(std::ceil(1.0 / grid.getResolution()));
+            const int nx = static_cast<int>(grid.getSizeX()),
+                      ny = static_cast<int>(grid.getSizeY());
+            const int x0 = std::max(0, box->x0 - m), x1 = std::min(nx - 1, box->x1 + m);
+            const int y0 = std::max(0, box->y0 - m), y1 = std::min(ny - 1, box->y1 + m);
+            mrpt::img::CImage part;
+            img.extract_patch(part, x0, ny - 1 - y1, x1 - x0 + 1, y1 - y0 + 1);
+            img = std::move(part);
+        }
         writePng(img, out.path() / "map.png", out.finalName("map.png"));
     }
     MapFigureInput fig;
     fig.grid = &grid;
     fig.estimate = inFrame(res.trajectory, frame);
     fig.ground_truth = res.ground_truth;  // aligned to the estimate by the figure
-    fig.odometry = res.odometry;          // put on the estimate's start by the figure
+    if (!sum.laser_only)                  // a laser-only run never saw it: not drawn, not named
+        fig.odometry = res.odometry;      // put on the estimate's start by the figure
     fig.keyframes = res.keyframes;
     fig.corridor = res.corridor;
     fig.title = fs::path(sum.rawlog).filename().string() + "  mode " + toString(sum.mode);
     if (frame.origin.x() != 0.0 || frame.origin.y() != 0.0)
         fig.title += format("  (origin at x %.0f, y %.0f m)", frame.origin.x(), frame.origin.y());
-    writePng(renderMapFigure(fig), out.path() / "map_figure.png", out.finalName("map_figure.png"));
+    const MapFigure drawn = renderMapFigure(fig);
+    writePng(drawn.image, out.path() / "map_figure.png", out.finalName("map_figure.png"));
+    return drawn.layers;
 }
 
 // A relations error's fields (used, unmatched, means and deviations) into `o`.
@@ -253,14 +301,58 @@ std::string toJson(const IcpSlamSummary& s) {
     return j.dump(2) + "\n";
 }
 
+std::string summaryText(const IcpSlamSummary& s) {
+    std::string t = format("kfd-icp-slam summary (mode %s)\n", toString(s.mode));
+    t += format("  input      %s\n  output     %s\n", s.rawlog.c_str(), s.output_dir.c_str());
+    t += format("  scans      in %zu, kept %zu, dropped %.1f %%\n", s.scans_in, s.scans_kept,
+                s.dropped_pct);
+    if (const std::string n = scansNotIn(s); !n.empty()) t += "             not in: " + n + "\n";
+    t += format("  points     removed %zu of %zu\n", s.points_removed, s.points_in);
+    t += format(
+        "  time       pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s, wall %.2f s\n",
+        s.prefilter_us_per_scan, s.icp_ms_per_scan, s.cpu_s_total, s.wall_s_total);
+    if (s.icp_runs)
+        t +=
+            format("  ICP        %s, %zu rejected, median goodness %.2f\n",
+                   plural(s.icp_runs, "correction").c_str(), s.icp_rejected, s.icp_goodness_median);
+    if (s.rematches)
+        t += format(
+            "  re-match   %zu after a rejection (%zu by the gap check, %zu then accepted), %s "
+            "matched again\n",
+            s.rematches, s.gap_checks_failed, s.rematches_recovered,
+            plural(s.scans_rematched, "dropped scan").c_str());
+    if (!s.lost_track_stamps.empty())
+        t += format(
+            "  WARNING    %s (%zu ICP corrections rejected in a row), "
+            "first at t = %.3f s: see report.md and scans.csv's icp_goodness\n",
+            plural(s.lost_track_stamps.size(), "suspected lost track").c_str(),
+            kLostTrackRejections, s.lost_track_stamps.front());
+    if (s.ate_rmse) t += format("  ATE        RMSE %.4f m\n", *s.ate_rmse);
+    if (s.relations) {
+        const auto& r = *s.relations;
+        t += format(
+            "  relations  %zu used, %zu unmatched: trans %.4f +- %.4f m, rot %.3f +- %.3f deg\n",
+            r.used, r.unmatched, r.trans_mean, r.trans_std, r.rot_mean_deg, r.rot_std_deg);
+        for (const auto& [name, sub] :
+             {std::pair{"local", &s.relations_local}, std::pair{"long ", &s.relations_long}})
+            if (*sub)
+                t += format("    %s    (%s %g s) %zu used: trans %.4f +- %.4f m\n", name,
+                            sub == &s.relations_local ? "<=" : ">", s.split_seconds, (*sub)->used,
+                            (*sub)->trans_mean, (*sub)->trans_std);
+    }
+    if (s.target_drop_pct) t += format("  matched    drop target %.2f %%\n", *s.target_drop_pct);
+    return t;
+}
+
 void writeIcpSlamReport(const IcpSlamResult& result) {
     if (!result.output) throw SlamError("no staged output folder in the result");
     if (result.output->committed()) throw SlamError("the output was already committed");
     const StagedOutputFolder& out = *result.output;
-    if (result.map) writeMap(result, out);
+    std::vector<MapFigureLayer> layers;
+    if (result.map) layers = writeMap(result, out);
     throwIfCancelled();
     writeText(out, "summary.json", toJson(result.summary));
-    if (result.map) writeText(out, "report.md", reportMarkdown(result.summary));
+    if (result.map) writeText(out, "report.md", reportMarkdown(result.summary, layers));
     throwIfCancelled();
     result.output->commit();
 }

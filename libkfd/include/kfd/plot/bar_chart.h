@@ -24,9 +24,14 @@ struct BarChart {
     std::vector<std::vector<double>> values;  // [group][series]; NaN = no bar
     std::vector<std::vector<double>> errors;  // same shape, optional (+- error bar)
     bool log_y = false;
-    int width = 1000, height = 500;
+    int width = 1000, height = 500;  // px: kMinSidePx to kMaxSidePx, at most kMaxPixels
 
-    /// Throws PlotError when the shapes do not match or a log axis has a value <= 0.
+    static constexpr int kMinSidePx = 200, kMaxSidePx = 10000;
+    static constexpr double kMaxPixels = 40.0e6;
+
+    /// The bars fill the plot area; the legend under it wraps to the image's width. Throws
+    /// PlotError when the shapes do not match, a log axis has a value <= 0 or the size is outside
+    /// the budget.
     mrpt::img::CImage render() const;
     /// The colour of series s (R, G, B), shared by bars and legend.
     static mrpt::img::TColor seriesColour(std::size_t s);

@@ -22,7 +22,7 @@ class RenderError : public Error {
 };
 
 struct ClusterFigureOptions {
-    int width = 800, height = 800;  // px
+    int width = 800, height = 800;  // px: 16 to 10 000 a side, at most 40 million pixels
     double half_extent_m = 0.0;     // half the visible height (m); 0 = fit the scan
     double ring_r_max = 0.0;        // draw t faint equal-area ring boundaries up to this (m)
     std::size_t rings = 5;          // t

@@ -3,7 +3,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
+#include "kfd/plot/map_figure.h"
 #include "kfd/slam/icp_slam_runner.h"
 
 namespace kfd {
@@ -14,9 +16,22 @@ namespace kfd {
 /// motion_distance_m, motion_angle_deg, then notices, ate_rmse_m and relations when present).
 std::string toJson(const IcpSlamSummary& s);
 
+/// The summary kfd-icp-slam prints on the console: scans, points, time, ICP's verdicts,
+/// re-matches, lost tracks, ATE, the relations error (all, local and long) and the matched drop
+/// target, one line each.
+std::string summaryText(const IcpSlamSummary& s);
+
+/// report.md's text: every number summaryText() prints, with its unit (the local and long
+/// relations error with their counts, used and unmatched), and the map figure with a caption
+/// naming exactly `figure_layers` (what renderMapFigure drew; mapFigureCaption).
+std::string reportMarkdown(const IcpSlamSummary& s,
+                           const std::vector<MapFigureLayer>& figure_layers);
+
 /// Writes into result.summary.output_dir: summary.json and, when the result holds the built
-/// map (IcpSlamOptions::write_map), final_map.simplemap, map.png (occupancy grid, 5 cm),
-/// map_figure.png (grid + estimate, keyframes, odometry and ground truth) and report.md.
+/// map (IcpSlamOptions::write_map), final_map.simplemap, map.png (the occupancy grid's known
+/// cells, one cell a pixel, 5 cm unless the map is very large), map_figure.png
+/// (renderMapFigure: grid + estimate, keyframes, odometry and ground truth, cropped to what it
+/// draws, within its pixel budget) and report.md.
 /// Writes into the result's staging folder, then moves everything into output_dir
 /// (IcpSlamResult::output->commit(), which checks every file first). Every file goes through
 /// kfd's checked writers (OutputFile, GzOutputStream, writePng): throws WriteError ("cannot write
