@@ -679,6 +679,41 @@ TEST(BagSource, EachChunkIsDecompressedOnceBesideSeveralHighRateTopics) {
     }
 }
 
+// The chunks' contents are checked when the source first reads them (each chunk decompressed
+// once): an index entry whose offset names no message record of its chunk, its lengths all
+// fitting, is still refused, naming the chunk's byte (the listing checks it up front).
+TEST(BagSource, AnIndexEntryThatPointsBetweenMessagesIsRefusedWhenItsChunkIsRead) {
+    TempDir d;
+    std::string bytes =
+        kfd::test::fileBytes(smallBag(d, "ok.bag", 30, rosbag::compression::Uncompressed));
+    // The first index data record: header fields conn, count, op, ver (rosbag writes them in
+    // this order), then its data length and 12-byte entries (time, offset).
+    const auto op = bytes.find(std::string("op=\x04", 4));
+    ASSERT_NE(op, std::string::npos);
+    const std::size_t header = op - 4 - (4 + 10) - (4 + 9);
+    auto u32 = [&](std::size_t at) {
+        std::uint32_t v = 0;
+        for (int i = 0; i < 4; ++i) v |= std::uint32_t(std::uint8_t(bytes[at + i])) << (8 * i);
+        return v;
+    };
+    ASSERT_EQ(u32(header - 4), 47u);  // 4 fields: 4 + 9, 4 + 10, 4 + 4, 4 + 8 bytes
+    const std::size_t entry = header + 47 + 4;
+    bytes[entry + 8] = static_cast<char>(bytes[entry + 8] + 1);  // offset + 1
+    const std::string p = d / "between.bag";
+    std::ofstream(p, std::ios::binary) << bytes;
+    const std::string e = readError(p);
+    EXPECT_EQ(e.rfind(p + ": byte ", 0), 0u) << e;
+    EXPECT_NE(e.find("an index entry points to no message of its chunk"), std::string::npos) << e;
+    try {
+        (void)kfd::listBag(p);
+        ADD_FAILURE() << "listed";
+    } catch (const kfd::BagError& l) {
+        EXPECT_NE(std::string(l.what()).find("an index entry points to no message of its chunk"),
+                  std::string::npos)
+            << l.what();
+    }
+}
+
 // --- the filtered bag ---------------------------------------------------------------------
 
 struct Msg {
