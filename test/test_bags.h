@@ -3,13 +3,20 @@
 
 #include <nav_msgs/Odometry.h>
 #include <rosbag/bag.h>
+#include <sensor_msgs/Imu.h>
 #include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/MultiEchoLaserScan.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
+#include <iterator>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace kfd {
@@ -53,6 +60,23 @@ inline geometry_msgs::Quaternion yawQuaternion(double yaw) {
     q.z = std::sin(yaw / 2);
     q.w = std::cos(yaw / 2);
     return q;
+}
+
+/// The ranges a robot at (x, y, yaw) sees in a 6 m x 4 m room centred on the origin, beams over
+/// [-fov/2, fov/2].
+inline std::vector<float> room(double x, double y, double yaw, std::size_t n, double fov = 3.0) {
+    std::vector<float> r(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const double a = yaw - fov / 2 + fov * static_cast<double>(i) / static_cast<double>(n - 1);
+        const double c = std::cos(a), s = std::sin(a);
+        double d = 1e9;
+        if (c > 1e-9) d = std::min(d, (3.0 - x) / c);
+        if (c < -1e-9) d = std::min(d, (-3.0 - x) / c);
+        if (s > 1e-9) d = std::min(d, (2.0 - y) / s);
+        if (s < -1e-9) d = std::min(d, (-2.0 - y) / s);
+        r[i] = static_cast<float>(d);
+    }
+    return r;
 }
 
 /// Writes a bag message by message (bag time = header stamp unless given).
@@ -105,8 +129,9 @@ class BagBuilder {
         m.pose.pose.orientation = yawQuaternion(yaw);
         bag_.write(topic, ros::Time(t), m);
     }
-    void tf(const std::string& topic, double t, const std::string& parent, const std::string& child,
-            double x, double y, double yaw) {
+    /// One transform parent -> child stamped t.
+    static tf2_msgs::TFMessage tfMsg(double t, const std::string& parent, const std::string& child,
+                                     double x, double y, double yaw) {
         tf2_msgs::TFMessage m;
         geometry_msgs::TransformStamped ts;
         ts.header.stamp = ros::Time(t);
@@ -116,13 +141,103 @@ class BagBuilder {
         ts.transform.translation.y = y;
         ts.transform.rotation = yawQuaternion(yaw);
         m.transforms.push_back(ts);
-        bag_.write(topic, ros::Time(t), m);
+        return m;
+    }
+    void tf(const std::string& topic, double t, const std::string& parent, const std::string& child,
+            double x, double y, double yaw) {
+        bag_.write(topic, ros::Time(t), tfMsg(t, parent, child, x, y, yaw));
     }
 
   private:
     rosbag::Bag bag_;
     bool open_ = true;
 };
+
+/// A bag like a fast scanner's (issue 23's measurements; its tests): /scan at 35 Hz (1079 beams)
+/// beside multi-echo scans, an IMU at 200 Hz, odometry and /tf at 50 Hz, over `seconds`; several
+/// chunks. Stamps are distinct across topics. `by_topic`: written one topic after the other (the
+/// chunks' times overlap: reading in time order goes back and forth between them), else in time
+/// order.
+inline void writeFastScannerBag(const std::string& path, rosbag::compression::CompressionType c,
+                                bool by_topic, double seconds) {
+    rosbag::Bag bag(path, rosbag::bagmode::Write);
+    bag.setCompression(c);
+    struct Stamped {
+        double t;
+        int topic;
+    };
+    std::vector<Stamped> all;
+    auto every = [&](int topic, double hz, double phase) {
+        for (double t = 1.0 + phase; t < 1.0 + seconds; t += 1.0 / hz) all.push_back({t, topic});
+    };
+    every(0, 35, 0.0003);   // /scan
+    every(1, 35, 0.0007);   // /echoes
+    every(2, 200, 0.0011);  // /imu
+    every(3, 50, 0.0013);   // /odom and /tf
+    if (by_topic)
+        std::stable_sort(all.begin(), all.end(),
+                         [](const Stamped& a, const Stamped& b) { return a.topic < b.topic; });
+    else
+        std::stable_sort(all.begin(), all.end(),
+                         [](const Stamped& a, const Stamped& b) { return a.t < b.t; });
+    auto tfs = [](double t, const std::string& parent, const std::string& child, double x) {
+        return BagBuilder::tfMsg(t, parent, child, x, 0, 0);
+    };
+    bag.write("/tf_static", ros::Time(1.0), tfs(1.0, "base_link", "laser", 0.1));
+    for (const auto& s : all) {
+        const double x = 0.3 * (s.t - 1.0);  // 0.3 m/s along x
+        if (s.topic == 0) {
+            bag.write("/scan", ros::Time(s.t),
+                      BagBuilder::scanMsg(s.t, room(x + 0.1, 0, 0, 1079), "laser"));
+        } else if (s.topic == 1) {
+            sensor_msgs::MultiEchoLaserScan m;
+            m.header.stamp = ros::Time(s.t);
+            m.header.frame_id = "laser";
+            m.ranges.resize(1079);
+            const auto r = room(x + 0.1, 0, 0, 1079);
+            for (std::size_t i = 0; i < r.size(); ++i)
+                m.ranges[i].echoes = {r[i], r[i] + 0.01f * static_cast<float>(i % 7), 0.0f};
+            bag.write("/echoes", ros::Time(s.t), m);
+        } else if (s.topic == 2) {
+            sensor_msgs::Imu m;
+            m.header.stamp = ros::Time(s.t);
+            m.header.frame_id = "imu";
+            m.linear_acceleration.x = 0.01 * std::sin(100 * s.t);
+            m.orientation.w = 1;
+            bag.write("/imu", ros::Time(s.t), m);
+        } else {
+            nav_msgs::Odometry m;
+            m.header.stamp = ros::Time(s.t);
+            m.header.frame_id = "odom";
+            m.child_frame_id = "base_link";
+            m.pose.pose.position.x = x;
+            m.pose.pose.orientation.w = 1;
+            bag.write("/odom", ros::Time(s.t), m);
+            bag.write("/tf", ros::Time(s.t + 0.0001), tfs(s.t, "odom", "base_link", x));
+        }
+    }
+    bag.close();
+}
+
+/// The chunk compressions of rosbag_storage with their names in a bag ("none", "bz2", "lz4").
+inline const std::vector<std::pair<rosbag::compression::CompressionType, std::string>>&
+bagCompressions() {
+    static const std::vector<std::pair<rosbag::compression::CompressionType, std::string>> all = {
+        {rosbag::compression::Uncompressed, "none"},
+        {rosbag::compression::BZ2, "bz2"},
+        {rosbag::compression::LZ4, "lz4"}};
+    return all;
+}
+
+/// The compressions named by the chunk records of the bag at `path` ("none", "bz2", "lz4").
+inline std::set<std::string> chunkCompressions(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    std::set<std::string> found;
+    for (const std::string c : {"none", "bz2", "lz4"})
+        if (bytes.find("compression=" + c) != std::string::npos) found.insert(c);
+    return found;
+}
 
 }  // namespace test
 }  // namespace kfd

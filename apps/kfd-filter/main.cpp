@@ -199,7 +199,7 @@ int main(int argc, char** argv) {
     bool print_config = false, list_keys = false;
     std::vector<double> window;
     bool list = false;
-    std::string compression = "lz4", removed_as = "nan";
+    std::string compression = "input", removed_as = "nan";
     cli.option("-i,--input", opts.input,
                "input log: rawlog (either MRPT layout, plain or gzip),\n"
                "ROS 1 bag, or CARMEN log (.clf/.log, plain or gzip)")
@@ -213,9 +213,10 @@ int main(int argc, char** argv) {
         ->type_name("MARK")
         ->check(CLI::IsMember({"nan", "inf"}))
         ->capture_default_str();
-    cli.option("--bag-compression", compression, "bag output: none, lz4 or bz2")
+    cli.option("--bag-compression", compression,
+               "bag output's chunks: input (the input bag's), none, lz4 or bz2")
         ->type_name("C")
-        ->check(CLI::IsMember({"none", "lz4", "bz2"}))
+        ->check(CLI::IsMember({"input", "none", "lz4", "bz2"}))
         ->capture_default_str();
     cli.option("-c,--config", config,
                ".ini ([KFD] section) or .yaml configuration;\n"
@@ -252,9 +253,7 @@ int main(int argc, char** argv) {
             return kfd::app::printListing(opts.input, opts.source);
         }
         opts.bag.removed = kfd::parseRemovedMark(removed_as);
-        opts.bag.compression = compression == "none"  ? kfd::BagWriterOptions::Compression::None
-                               : compression == "bz2" ? kfd::BagWriterOptions::Compression::Bz2
-                                                      : kfd::BagWriterOptions::Compression::Lz4;
+        opts.bag.compression = kfd::parseBagCompression(compression);
         opts.pipeline = config.empty() ? kfd::kfdDefaults() : kfd::loadConfigFile(config);
         if (print_config) {
             std::fputs(kfd::toIni(opts.pipeline).c_str(), stdout);

@@ -934,6 +934,59 @@ TEST(BadInputLogs, TruncatedOrCorruptBagsAreRefused) {
     expectLogRefused(d, text, {}, "not a ROS bag");
 }
 
+// Issue 23: a chunk's contents are checked when kfd first reads it (each chunk is decompressed
+// once), so a chunk that does not decompress is found while the outputs are being written: the
+// same refusal, and nothing is left behind.
+TEST(BadInputLogs, AChunkThatDoesNotDecompressIsRefusedWhenRead) {
+    Dir d;
+    const std::string p = d / "good.bag";
+    {
+        kfd::test::BagBuilder b(p, rosbag::compression::BZ2);
+        for (int i = 0; i < 400; ++i) {
+            b.odom("/odom", 1 + 0.1 * i, 0.01 * i, 0, 0);
+            b.scan("/scan", kfd::test::BagBuilder::scanMsg(1 + 0.1 * i + 0.05,
+                                                           kfd::test::room(0.01 * i, 0, 0, 361)));
+        }
+    }
+    std::string bytes = fileBytes(p);
+    fs::remove(p);
+    // The middle of the last chunk's bz2 stream.
+    const auto last = bytes.rfind("compression=bz2");
+    ASSERT_NE(last, std::string::npos);
+    const auto bz = bytes.find("BZh", last);
+    ASSERT_NE(bz, std::string::npos);
+    for (std::size_t i = bz + 2000; i < bz + 2064; ++i) bytes[i] ^= 0x5a;
+    const auto bad = d.write("bad.bag", bytes);
+    expectLogRefused(d, bad, {}, "chunk does not decompress");
+}
+
+// Issue 23: the filtered bag's chunks are compressed like the input's unless --bag-compression
+// names a compression.
+TEST(BadInputLogs, AFilteredBagIsCompressedLikeItsInput) {
+    Dir d;
+    const auto& kinds = kfd::test::bagCompressions();
+    for (const auto& [c, name] : kinds) {
+        SCOPED_TRACE(name);
+        const std::string in = d / ("in-" + name + ".bag");
+        {
+            kfd::test::BagBuilder b(in, c);
+            for (int i = 0; i < 40; ++i) {
+                b.odom("/odom", 1 + 0.2 * i, 0.05 * i, 0, 0);
+                b.scan("/scan", kfd::test::BagBuilder::scanMsg(
+                                    1 + 0.2 * i + 0.1, kfd::test::room(0.05 * i, 0, 0, 181)));
+            }
+        }
+        const std::string out = d / ("out-" + name + ".bag");
+        Result r = run(KFD_FILTER_EXE, {"-q", "-i", in, "-o", out}, d.path);
+        ASSERT_EQ(r.status, 0) << r.err;
+        EXPECT_EQ(kfd::test::chunkCompressions(out), std::set<std::string>{name});
+        const std::string told = name == "lz4" ? "bz2" : "lz4";
+        r = run(KFD_FILTER_EXE, {"-q", "-i", in, "-o", out, "--bag-compression", told}, d.path);
+        ASSERT_EQ(r.status, 0) << r.err;
+        EXPECT_EQ(kfd::test::chunkCompressions(out), std::set<std::string>{told});
+    }
+}
+
 TEST(BadInputLogs, MissingTopicsAndUnsupportedTypesAreRefused) {
     Dir d;
     const auto bag = writeBag(d, "in.bag");

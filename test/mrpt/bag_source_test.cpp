@@ -7,11 +7,13 @@
 #include <rosbag/view.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <set>
 
 #include "kfd/mrpt/bag_source.h"
 #include "kfd/mrpt/bag_writer.h"
@@ -52,22 +54,7 @@ std::vector<Scan2D::Ptr> scansOf(const std::vector<SourceEntry>& v) {
     return s;
 }
 
-// The ranges a robot at (x, y, yaw) sees in a 6 m x 4 m room centred on the origin, beams over
-// [-fov/2, fov/2].
-std::vector<float> room(double x, double y, double yaw, std::size_t n, double fov = 3.0) {
-    std::vector<float> r(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        const double a = yaw - fov / 2 + fov * static_cast<double>(i) / static_cast<double>(n - 1);
-        const double c = std::cos(a), s = std::sin(a);
-        double d = 1e9;
-        if (c > 1e-9) d = std::min(d, (3.0 - x) / c);
-        if (c < -1e-9) d = std::min(d, (-3.0 - x) / c);
-        if (s > 1e-9) d = std::min(d, (2.0 - y) / s);
-        if (s < -1e-9) d = std::min(d, (-2.0 - y) / s);
-        r[i] = static_cast<float>(d);
-    }
-    return r;
-}
+using kfd::test::room;
 
 TEST(BagSource, ScansGetInterpolatedOdometryTheStaticMountAndTheValidityRule) {
     TempDir d;
@@ -668,6 +655,81 @@ TEST(BagSource, AChunkSizeFieldIsCheckedNotAllocated) {
     EXPECT_LT(peakMiB(), 512);
 }
 
+// --- reading chunks once -------------------------------------------------------------------
+
+// Issue 23: a bag of several high-rate topics read through decompressed each chunk 2.4 times
+// (kfd's structure check once, rosbag_storage again each time the messages held for the
+// odometry after a scan were copied from a chunk it had left). Now each chunk is loaded once,
+// also when the chunks' times overlap (read in time order, back and forth between them).
+TEST(BagSource, EachChunkIsDecompressedOnceBesideSeveralHighRateTopics) {
+    TempDir d;
+    for (auto c : {rosbag::compression::BZ2, rosbag::compression::LZ4}) {
+        std::vector<std::vector<SourceEntry>> read;
+        for (const bool by_topic : {false, true}) {
+            SCOPED_TRACE(std::to_string(int(c)) + (by_topic ? " by topic" : " in time order"));
+            const std::string p =
+                d / ("fast" + std::to_string(int(c)) + std::to_string(by_topic) + ".bag");
+            kfd::test::writeFastScannerBag(p, c, by_topic, 6.0);
+            kfd::BagSource src(p);
+            std::vector<SourceEntry> v;
+            SourceEntry e;
+            while (src.next(e)) v.push_back(e);
+            EXPECT_GE(src.chunks(), 4u);
+            EXPECT_EQ(src.chunksLoaded(), src.chunks());
+            EXPECT_EQ(src.compression(), c == rosbag::compression::BZ2 ? "bz2" : "lz4");
+            read.push_back(std::move(v));
+        }
+        // The same messages written in another order read the same (rosbag::View's order).
+        ASSERT_EQ(read[0].size(), read[1].size());
+        const auto a = scansOf(read[0]), b = scansOf(read[1]);
+        ASSERT_GT(a.size(), 150u);  // 6 s at 35 Hz
+        ASSERT_EQ(a.size(), b.size());
+        for (std::size_t i = 0; i < read[0].size(); ++i) {
+            ASSERT_EQ(read[0][i].kind, read[1][i].kind) << i;
+            ASSERT_EQ(read[0][i].odometry.has_value(), read[1][i].odometry.has_value()) << i;
+            if (read[0][i].odometry) {
+                EXPECT_EQ(read[0][i].odometry->x, read[1][i].odometry->x);
+            }
+        }
+        for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i]->timestamp, b[i]->timestamp);
+    }
+}
+
+// The chunks' contents are checked when the source first reads them (each chunk decompressed
+// once): an index entry whose offset names no message record of its chunk, its lengths all
+// fitting, is still refused, naming the chunk's byte (the listing checks it up front).
+TEST(BagSource, AnIndexEntryThatPointsBetweenMessagesIsRefusedWhenItsChunkIsRead) {
+    TempDir d;
+    std::string bytes =
+        kfd::test::fileBytes(smallBag(d, "ok.bag", 30, rosbag::compression::Uncompressed));
+    // The first index data record: header fields conn, count, op, ver (rosbag writes them in
+    // this order), then its data length and 12-byte entries (time, offset).
+    const auto op = bytes.find(std::string("op=\x04", 4));
+    ASSERT_NE(op, std::string::npos);
+    const std::size_t header = op - 4 - (4 + 10) - (4 + 9);
+    auto u32 = [&](std::size_t at) {
+        std::uint32_t v = 0;
+        for (int i = 0; i < 4; ++i) v |= std::uint32_t(std::uint8_t(bytes[at + i])) << (8 * i);
+        return v;
+    };
+    ASSERT_EQ(u32(header - 4), 47u);  // 4 fields: 4 + 9, 4 + 10, 4 + 4, 4 + 8 bytes
+    const std::size_t entry = header + 47 + 4;
+    bytes[entry + 8] = static_cast<char>(bytes[entry + 8] + 1);  // offset + 1
+    const std::string p = d / "between.bag";
+    std::ofstream(p, std::ios::binary) << bytes;
+    const std::string e = readError(p);
+    EXPECT_EQ(e.rfind(p + ": byte ", 0), 0u) << e;
+    EXPECT_NE(e.find("an index entry points to no message of its chunk"), std::string::npos) << e;
+    try {
+        (void)kfd::listBag(p);
+        ADD_FAILURE() << "listed";
+    } catch (const kfd::BagError& l) {
+        EXPECT_NE(std::string(l.what()).find("an index entry points to no message of its chunk"),
+                  std::string::npos)
+            << l.what();
+    }
+}
+
 // --- the filtered bag ---------------------------------------------------------------------
 
 struct Msg {
@@ -792,6 +854,32 @@ TEST(BagOutput, DroppedScansLeaveEveryOtherMessageIsCopiedRemovedPointsAreMarked
     r.output = d / "x.bag";
     EXPECT_THROW(kfd::RawlogFilter().run(r), kfd::RawlogError);
     EXPECT_FALSE(fs::exists(d / "x.bag"));
+}
+
+// Issue 23: a filtered bag was written lz4 whatever its input (1.36 MB from a 1.38 MB bz2 bag
+// whose scans were 76 % dropped; bz2: 0.77 MB). Its chunks now take the input's compression,
+// unless BagWriterOptions (kfd-filter --bag-compression) names one.
+TEST(BagOutput, IsCompressedLikeItsInputUnlessToldOtherwise) {
+    TempDir d;
+    const auto& kinds = kfd::test::bagCompressions();
+    for (const auto& [c, name] : kinds) {
+        SCOPED_TRACE(name);
+        kfd::RawlogFilterOptions o;
+        o.input = smallBag(d, "in-" + name + ".bag", 200, c);
+        o.pipeline = kfd::kfdDefaults();
+        o.output = d / ("out-" + name + ".bag");
+        kfd::RawlogFilter().run(o);
+        EXPECT_EQ(kfd::test::chunkCompressions(o.output), std::set<std::string>{name});
+        EXPECT_EQ(kfd::BagSource(o.output).compression(), name);
+        for (const auto& [told, told_name] : kinds) {
+            o.output = d / ("out-" + name + "-" + told_name + ".bag");
+            o.bag.compression = kfd::parseBagCompression(told_name);
+            kfd::RawlogFilter().run(o);
+            EXPECT_EQ(kfd::test::chunkCompressions(o.output), std::set<std::string>{told_name});
+        }
+    }
+    EXPECT_EQ(kfd::parseBagCompression("input"), kfd::BagWriterOptions::Compression::AsInput);
+    EXPECT_THROW(kfd::parseBagCompression("zip"), kfd::Error);
 }
 
 // --- real bags against their rawlogs --------------------------------------------------------

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bag_file.h"
 #include "kfd/mrpt/bag_source.h"
 
 namespace kfd {
@@ -143,18 +144,26 @@ Inflated inflateLz4(std::vector<unsigned char>& in, std::uint64_t size,
     return r == Inflated::Ok ? buf.finish(used, size) : r;
 }
 
-class Checker {
-  public:
-    explicit Checker(const std::string& path) : path_(path) {}
+}  // namespace
 
-    void run() {
-        std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path_.c_str(), "rb"),
-                                                          &std::fclose);
-        if (!f) fail(0, "cannot open the file");
-        file_ = f.get();
+const ChunkMessage* Chunk::find(std::uint32_t offset) const {
+    const auto it =
+        std::lower_bound(messages.begin(), messages.end(), offset,
+                         [](const ChunkMessage& m, std::uint32_t o) { return m.offset < o; });
+    return it != messages.end() && it->offset == offset ? &*it : nullptr;
+}
+
+struct BagFile::Impl {
+    explicit Impl(const std::string& path)
+        : path_(path), file_(std::fopen(path.c_str(), "rb"), &std::fclose) {
+        if (!file_) fail(0, "cannot open the file");
         std::error_code ec;
         size_ = std::filesystem::file_size(path_, ec);
         if (ec) fail(0, "cannot tell the file's size");
+    }
+
+    void run(bool chunks) {
+        decompress_ = chunks;
         unsigned char magic[13];
         if (!readAt(0, magic, 13) || std::memcmp(magic, "#ROSBAG V2.0\n", 13) != 0)
             fail(0, "not a ROS bag 2.0 (no '#ROSBAG V2.0' line)");
@@ -164,7 +173,8 @@ class Checker {
             const std::uint64_t at = pos;
             Header h;
             std::vector<unsigned char> data;
-            pos = record(pos, h, data);
+            std::uint64_t dlen = 0;
+            pos = record(pos, h, data, dlen);
             const std::uint8_t op = opOf(h, at);
             if (!seen_header) {
                 if (op != kBagHeader) fail(at, "the first record is not the bag header");
@@ -181,7 +191,7 @@ class Checker {
             }
             switch (op) {
                 case kChunk:
-                    chunk(h, data, at);
+                    chunk(h, data, dlen, at);
                     break;
                 case kIndexData:
                     indexData(h, data, at);
@@ -207,15 +217,38 @@ class Checker {
                             std::to_string(chunks_.size()) + " chunks (truncated?)");
     }
 
-  private:
-    [[noreturn]] void fail(std::uint64_t at, const std::string& what) const {
-        throw BagError(path_ + ": byte " + std::to_string(at) + ": " + what, path_);
+    void readChunk(std::uint64_t pos, Chunk& out) {
+        Header h;
+        std::vector<unsigned char> data;
+        std::uint64_t dlen = 0;
+        const bool was = decompress_;
+        decompress_ = true;  // record() reads the chunk's data
+        record(pos, h, data, dlen);
+        decompress_ = was;
+        if (opOf(h, pos) != kChunk) fail(pos, "the index points to a record that is not a chunk");
+        inflate(h, data, pos, out);
+        ++loaded_;
     }
 
+    [[noreturn]] void fail(std::uint64_t at, const std::string& what) const {
+        throw BagFileError(path_ + ": byte " + std::to_string(at) + ": " + what, path_);
+    }
+
+    std::size_t chunks() const { return chunks_.size(); }
+    std::string compression() const {
+        std::string best = "none";
+        std::size_t most = 0;
+        for (const auto& [c, n] : compressions_)
+            if (n > most) best = c, most = n;
+        return best;
+    }
+    std::size_t loaded() const { return loaded_; }
+
+  private:
     bool readAt(std::uint64_t at, void* buf, std::size_t n) {
         if (at + n > size_) return false;
-        if (std::fseek(file_, static_cast<long>(at), SEEK_SET) != 0) return false;
-        return std::fread(buf, 1, n, file_) == n;
+        if (std::fseek(file_.get(), static_cast<long>(at), SEEK_SET) != 0) return false;
+        return std::fread(buf, 1, n, file_.get()) == n;
     }
 
     // Parses the header fields of `bytes` (len bytes).
@@ -236,8 +269,10 @@ class Checker {
         return h;
     }
 
-    // Reads the record at `pos` (header parsed, data read); returns the position after it.
-    std::uint64_t record(std::uint64_t pos, Header& h, std::vector<unsigned char>& data) {
+    // Reads the record at `pos` (header parsed, data read when this check reads it, its length
+    // in `dlen`); returns the position after it.
+    std::uint64_t record(std::uint64_t pos, Header& h, std::vector<unsigned char>& data,
+                         std::uint64_t& dlen) {
         unsigned char len[4];
         if (!readAt(pos, len, 4)) fail(pos, "a record is cut short (truncated file?)");
         const std::uint64_t hlen = u32(len);
@@ -247,7 +282,7 @@ class Checker {
         if (!readAt(pos + 4, hb.data(), hlen) || !readAt(pos + 4 + hlen, len, 4))
             fail(pos, "read error");
         h = parseHeader(hb.data(), hlen, pos);
-        std::uint64_t dlen = u32(len);
+        dlen = u32(len);
         const std::uint64_t dpos = pos + 8 + hlen;
         const std::uint8_t op = opOf(h, pos);
         // Index data: rosbag_storage reads its count entries of 12 bytes and goes on from
@@ -259,7 +294,8 @@ class Checker {
         }
         if (dlen > size_ - dpos)
             fail(pos, "a record's data runs past the end of the file (truncated?)");
-        if (op == kChunk || op == kIndexData || op == kConnection) {  // the data this check reads
+        // The data this check reads (a chunk's only when it decompresses it).
+        if ((op == kChunk && decompress_) || op == kIndexData || op == kConnection) {
             data.resize(dlen);
             if (dlen && !readAt(dpos, data.data(), dlen)) fail(pos, "read error");
         }
@@ -292,27 +328,34 @@ class Checker {
         return u64(reinterpret_cast<const unsigned char*>(it->second.data()));
     }
 
-    void chunk(const Header& h, std::vector<unsigned char>& data, std::uint64_t at) {
+    // A chunk's compression and announced size (what a chunk record's header must say).
+    std::pair<std::string, std::uint64_t> chunkHeader(const Header& h, std::uint64_t at) const {
         const auto c = h.fields.find("compression");
         if (c == h.fields.end()) fail(at, "a chunk without 'compression'");
         const std::uint64_t size = u32field(h, "size", at);
         if (size > kMaxChunk) fail(at, "a chunk of more than 2 GiB");
-        std::vector<unsigned char> plain;
-        if (c->second == "none") {
+        if (c->second != "none" && c->second != "bz2" && c->second != "lz4")
+            fail(at, "a chunk with unknown compression '" + c->second + "'");
+        return {c->second, size};
+    }
+
+    // Decompresses the chunk record at `at` (header h, data) into `out` and checks its records:
+    // connections and messages, each within the chunk.
+    void inflate(const Header& h, std::vector<unsigned char>& data, std::uint64_t at, Chunk& out) {
+        const auto [compression, size] = chunkHeader(h, at);
+        std::vector<unsigned char>& plain = out.plain;
+        out.messages.clear();
+        if (compression == "none") {
             if (data.size() != size) fail(at, "a chunk's size field does not match its data");
             plain.swap(data);
-        } else if (c->second == "bz2" || c->second == "lz4") {
-            const Inflated r =
-                c->second == "bz2" ? inflateBz2(data, size, plain) : inflateLz4(data, size, plain);
+        } else {
+            const Inflated r = compression == "bz2" ? inflateBz2(data, size, plain)
+                                                    : inflateLz4(data, size, plain);
             if (r == Inflated::Corrupt)
-                fail(at, "a " + c->second + " chunk does not decompress (corrupt)");
+                fail(at, "a " + compression + " chunk does not decompress (corrupt)");
             if (r == Inflated::OtherSize)
                 fail(at, "a chunk decompresses to another size than announced");
-        } else {
-            fail(at, "a chunk with unknown compression '" + c->second + "'");
         }
-        // The records inside: connections and messages, each within the chunk.
-        std::set<std::uint32_t> starts;
         std::uint64_t p = 0;
         while (p < plain.size()) {
             if (plain.size() - p < 4) fail(at, "a record inside a chunk is cut short (corrupt)");
@@ -328,17 +371,34 @@ class Checker {
                 fail(at, "a chunk holds a record of op " + std::to_string(op));
             (void)u32field(rh, "conn", at);
             if (op == kConnection) connectionHeader(plain.data() + p + 8 + hlen, dlen, at);
-            if (op == kMessageData) starts.insert(static_cast<std::uint32_t>(p));
+            if (op == kMessageData)
+                out.messages.push_back(ChunkMessage{static_cast<std::uint32_t>(p),
+                                                    static_cast<std::uint32_t>(p + 8 + hlen),
+                                                    static_cast<std::uint32_t>(dlen)});
             p += 8 + hlen + dlen;
         }
+    }
+
+    void chunk(const Header& h, std::vector<unsigned char>& data, std::uint64_t dlen,
+               std::uint64_t at) {
+        const auto [compression, size] = chunkHeader(h, at);
+        ++compressions_[compression];
+        last_starts_.clear();
+        if (decompress_) {
+            Chunk c;
+            inflate(h, data, at, c);
+            for (const ChunkMessage& m : c.messages) last_starts_.insert(m.offset);
+        } else if (compression == "none" && dlen != size) {
+            fail(at, "a chunk's size field does not match its data");
+        }
         chunks_.push_back(at);
-        last_starts_ = std::move(starts);
     }
 
     void indexData(const Header& h, const std::vector<unsigned char>& data, std::uint64_t at) {
         if (chunks_.empty()) fail(at, "index data before any chunk");
         const std::uint64_t count = u32field(h, "count", at);
         if (data.size() != count * 12) fail(at, "index data of the wrong length");
+        if (!decompress_) return;  // the entries' offsets: checked when the chunk is read
         for (std::uint64_t i = 0; i < count; ++i)
             if (!last_starts_.count(u32(data.data() + 12 * i + 8)))
                 fail(at, "an index entry points to no message of its chunk (corrupt)");
@@ -353,15 +413,24 @@ class Checker {
     }
 
     std::string path_;
-    std::FILE* file_ = nullptr;
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file_;
+    bool decompress_ = true;
     std::uint64_t size_ = 0, index_pos_ = 0, chunk_count_ = 0;
     std::vector<std::uint64_t> chunks_;
+    std::map<std::string, std::size_t> compressions_;  // chunks by compression
     std::set<std::uint32_t> last_starts_;
-    std::size_t infos_ = 0;
+    std::size_t infos_ = 0, loaded_ = 0;
 };
 
-}  // namespace
+BagFile::BagFile(const std::string& path) : impl_(std::make_unique<Impl>(path)) {}
+BagFile::~BagFile() = default;
+void BagFile::check(bool chunks) { impl_->run(chunks); }
+void BagFile::readChunk(std::uint64_t pos, Chunk& out) { impl_->readChunk(pos, out); }
+void BagFile::fail(std::uint64_t at, const std::string& what) const { impl_->fail(at, what); }
+std::size_t BagFile::chunks() const { return impl_->chunks(); }
+std::string BagFile::compression() const { return impl_->compression(); }
+std::size_t BagFile::chunksLoaded() const { return impl_->loaded(); }
 
-void checkBagStructure(const std::string& path) { Checker(path).run(); }
+void checkBagStructure(const std::string& path) { BagFile(path).check(true); }
 
 }  // namespace kfd

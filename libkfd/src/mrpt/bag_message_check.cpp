@@ -124,12 +124,4 @@ void checkMessageBytes(MessageLayout layout, const unsigned char* data, std::siz
     }
 }
 
-void checkMessageBytes(MessageLayout layout, const rosbag::MessageInstance& m) {
-    thread_local std::vector<unsigned char> buffer;  // reused: no allocation per message
-    buffer.resize(m.size());  // bounded: checkBagStructure put the message inside its chunk
-    ros::serialization::OStream out(buffer.data(), static_cast<std::uint32_t>(buffer.size()));
-    m.write(out);
-    checkMessageBytes(layout, buffer.data(), buffer.size());
-}
-
 }  // namespace kfd

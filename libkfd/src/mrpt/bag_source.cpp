@@ -15,7 +15,9 @@
 #include <limits>
 #include <map>
 
+#include "bag_file.h"
 #include "bag_message.h"
+#include "bag_reader.h"
 #include "kfd/core/format.h"
 #include "kfd/core/pose.h"
 
@@ -31,6 +33,8 @@ constexpr const char* kOdometry = "nav_msgs/Odometry";
 constexpr const char* kTfMessage = "tf2_msgs/TFMessage";
 constexpr double kLookaheadSeconds = 10.0;  // bag time searched for the odometry after a scan
 constexpr std::size_t kLookaheadMessages = 100000;
+// The bytes of the messages held meanwhile (they are copies: their chunks are not kept).
+constexpr std::uint64_t kLookaheadBytes = 256ull << 20;
 constexpr std::size_t kHistory = 4096;  // odometry samples kept for late scans
 constexpr std::size_t kTfProbe = 500;   // /tf messages searched for the odom frame
 // A scan up to this long before the first odometry sample or after the last one takes that
@@ -134,30 +138,31 @@ std::string pickTopic(const std::map<std::string, TopicInfo>& topics, const std:
 // corrupt message a BagError naming its topic and time. For the choices made when a bag is
 // opened (BagSource::Impl::readOne names the message by its number).
 template <class T>
-boost::shared_ptr<T> instantiate(const rosbag::MessageInstance& m) {
+boost::shared_ptr<T> instantiate(const NativeMessage& m) {
     try {
         return instantiateChecked<T>(m);
     } catch (const BagError& e) {
         char buf[64];
-        std::snprintf(buf, sizeof(buf), " at t = %.6f s", m.getTime().toSec());
-        throw BagError("the message on " + m.getTopic() + buf + ": " + e.what());
+        std::snprintf(buf, sizeof(buf), " at t = %.6f s", m.time.toSec());
+        throw BagError("the message on " + m.topic() + buf + ": " + e.what());
     }
 }
 
 // The first message of `topic` as a T, or null (none, or not a T).
 template <class T>
-boost::shared_ptr<T> firstMessage(rosbag::Bag& bag, const std::string& topic) {
-    rosbag::View v(bag, rosbag::TopicQuery(topic));
-    for (const rosbag::MessageInstance& m : v) return instantiate<T>(m);
+boost::shared_ptr<T> firstMessage(BagReader& bag, const std::string& topic) {
+    auto v = bag.cursor(topic);
+    NativeMessage m;
+    if (v.next(m)) return instantiate<T>(m);
     return nullptr;
 }
 
 // The first transform in /tf whose parent is `odom_frame` (its child is the base frame).
-std::string baseFrameFromTf(rosbag::Bag& bag, const std::string& tf_topic,
+std::string baseFrameFromTf(BagReader& bag, const std::string& tf_topic,
                             const std::string& odom_frame) {
-    rosbag::View v(bag, rosbag::TopicQuery(tf_topic));
+    auto v = bag.cursor(tf_topic);
     std::size_t n = 0;
-    for (const rosbag::MessageInstance& m : v) {
+    for (NativeMessage m; v.next(m);) {
         if (++n > kTfProbe) break;
         if (const auto tf = instantiate<tf2_msgs::TFMessage>(m))
             for (const auto& t : tf->transforms)
@@ -193,15 +198,15 @@ std::string badTransform(const geometry_msgs::Transform& t) {
     return {};
 }
 
-void chooseMount(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topics, BagChoice& c) {
+void chooseMount(BagReader& bag, const std::map<std::string, TopicInfo>& topics, BagChoice& c) {
     if (const auto s = firstMessage<sensor_msgs::LaserScan>(bag, c.scan_topic))
         c.laser_frame = stripSlash(s->header.frame_id);
     std::map<std::string, Edge> edges;  // child -> parent
     for (const char* topic : {"/tf_static", "tf_static"}) {
         const auto it = topics.find(topic);
         if (it == topics.end() || it->second.type != kTfMessage) continue;
-        rosbag::View v(bag, rosbag::TopicQuery(topic));
-        for (const rosbag::MessageInstance& m : v)
+        auto v = bag.cursor(topic);
+        for (NativeMessage m; v.next(m);)
             if (const auto tf = instantiate<tf2_msgs::TFMessage>(m))
                 for (const auto& t : tf->transforms)
                     edges[stripSlash(t.child_frame_id)] =
@@ -243,7 +248,7 @@ void chooseMount(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topic
     c.notes.push_back(buf);
 }
 
-BagChoice choose(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topics,
+BagChoice choose(BagReader& bag, const std::map<std::string, TopicInfo>& topics,
                  const SourceOptions& o) {
     BagChoice c;
     c.scan_topic = pickTopic(topics, o.scan_topic, kLaserScan, {"/scan", "scan"}, "scans",
@@ -296,19 +301,30 @@ BagChoice choose(rosbag::Bag& bag, const std::map<std::string, TopicInfo>& topic
     return c;
 }
 
-void openBag(rosbag::Bag& bag, const std::string& path) {
-    std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) throw BagError(path + ": no such file", path);
-    checkBagStructure(path);
-    try {
-        bag.open(path, rosbag::bagmode::Read);
-    } catch (const std::exception& e) {
-        throw BagError(path + ": not a readable ROS 1 bag (" + e.what() +
-                           "; a bag cut short while recording has no index: `rosbag reindex` "
-                           "repairs it)",
-                       path);
+// A bag open for reading: its structure checked by kfd (BagFile::check; its chunks' records
+// there when `check_chunks`, else as the reader loads them), its index read by rosbag_storage,
+// its messages read through a BagReader.
+struct OpenBag {
+    std::unique_ptr<BagFile> file;
+    rosbag::Bag bag;
+    std::unique_ptr<BagReader> reader;
+
+    OpenBag(const std::string& path, bool check_chunks) {
+        std::error_code ec;
+        if (!fs::is_regular_file(path, ec)) throw BagError(path + ": no such file", path);
+        file = std::make_unique<BagFile>(path);
+        file->check(check_chunks);
+        try {
+            bag.open(path, rosbag::bagmode::Read);
+        } catch (const std::exception& e) {
+            throw BagError(path + ": not a readable ROS 1 bag (" + e.what() +
+                               "; a bag cut short while recording has no index: `rosbag "
+                               "reindex` repairs it)",
+                           path);
+        }
+        reader = std::make_unique<BagReader>(*file, bag);
     }
-}
+};
 
 }  // namespace
 
@@ -328,30 +344,31 @@ struct BagSource::Impl {
     };
 
     std::string path;
-    rosbag::Bag bag;
+    // Chunks are checked as they are loaded: each is decompressed once, when it is read.
+    OpenBag open;
     std::map<std::string, TopicInfo> topics;
     BagChoice choice;
     std::string label;  // the scans' sensor label: the scan topic without its leading '/'
-    std::unique_ptr<rosbag::View> view;
-    rosbag::View::iterator it;
+    std::optional<BagReader::Cursor> cursor;
     bool at_end = false;
     std::uint64_t size = 0;
     std::size_t total_messages = 0, messages_read = 0, entries = 0;
     std::deque<Item> queue;
+    std::uint64_t queued_bytes = 0;  // the messages' bytes in the queue
     std::deque<Sample> history;
     double last_record = 0.0;
     OdometryTracker tracker;
     SourceCounters counts;
 
-    Impl(const std::string& p, const SourceOptions& o) : path(p) {
-        openBag(bag, path);
+    Impl(const std::string& p, const SourceOptions& o) : path(p), open(p, false) {
         try {
-            topics = topicsOf(bag);
-            choice = choose(bag, topics, o);
+            topics = topicsOf(open.bag);
+            choice = choose(*open.reader, topics, o);
             label = stripSlash(choice.scan_topic);
-            view = std::make_unique<rosbag::View>(bag);
-            total_messages = view->size();
-            it = view->begin();
+            cursor.emplace(open.reader->cursor({}, true));
+            total_messages = cursor->size();
+        } catch (const BagFileError&) {
+            throw;
         } catch (const BagError& e) {
             throw BagError(path + ": " + e.what(), path);
         } catch (const std::exception& e) {
@@ -363,14 +380,11 @@ struct BagSource::Impl {
         if (ec) size = 0;
     }
 
-    std::string where(const rosbag::MessageInstance* m) const {
-        std::string s = path + ": message " + std::to_string(messages_read + 1);
-        if (m) {
-            char buf[64];
-            std::snprintf(buf, sizeof(buf), " at t = %.6f s", m->getTime().toSec());
-            s += " (" + m->getTopic() + buf + ")";
-        }
-        return s;
+    std::string where(const NativeMessage& m) const {
+        char buf[64];
+        std::snprintf(buf, sizeof(buf), " at t = %.6f s", m.time.toSec());
+        return path + ": message " + std::to_string(messages_read + 1) + " (" + m.topic() + buf +
+               ")";
     }
 
     static Pose2D interpolate(const Sample& a, const Sample& b, double t) {
@@ -456,19 +470,28 @@ struct BagSource::Impl {
     // Reads one message into the queue; false at the end of the bag.
     bool readOne() {
         if (at_end) return false;
-        std::optional<rosbag::MessageInstance> m;
+        auto native = std::make_shared<NativeMessage>();
+        // A chunk that cannot be read: BagError "PATH: byte N: ..." (the chunk's record).
         try {
-            if (it == view->end()) {
+            if (!cursor->next(*native)) {
                 at_end = true;
                 return false;
             }
-            m.emplace(*it);
+        } catch (const BagFileError&) {
+            throw;
+        } catch (const std::exception& e) {
+            throw BagError(path + ": message " + std::to_string(messages_read + 1) +
+                               ": corrupt or truncated bag (" + e.what() + ")",
+                           path);
+        }
+        const NativeMessage& m = *native;
+        try {
             Item item;
-            item.native = std::make_shared<NativeMessage>(*m);
-            item.record = m->getTime().toSec();
-            const std::string& topic = m->getTopic();
+            item.native = native;
+            item.record = m.time.toSec();
+            const std::string& topic = m.topic();
             if (topic == choice.scan_topic) {
-                const auto ls = instantiateChecked<sensor_msgs::LaserScan>(*m);
+                const auto ls = instantiateChecked<sensor_msgs::LaserScan>(m);
                 if (!ls) throw BagError("not a " + std::string(kLaserScan));
                 item.stamp = stampOf(ls->header, item.record);
                 item.scan = toScan(*ls, item.stamp);
@@ -478,12 +501,12 @@ struct BagSource::Impl {
                 }
             } else if (choice.odometry == BagChoice::Odometry::Topic &&
                        topic == choice.odom_topic) {
-                if (const auto od = instantiateChecked<nav_msgs::Odometry>(*m))
+                if (const auto od = instantiateChecked<nav_msgs::Odometry>(m))
                     onSample(stampOf(od->header, item.record),
                              Pose2D{od->pose.pose.position.x, od->pose.pose.position.y,
                                     yawOf(od->pose.pose.orientation)});
             } else if (choice.odometry == BagChoice::Odometry::Tf && topic == choice.odom_topic) {
-                if (const auto tf = instantiateChecked<tf2_msgs::TFMessage>(*m))
+                if (const auto tf = instantiateChecked<tf2_msgs::TFMessage>(m))
                     for (const auto& t : tf->transforms)
                         if (stripSlash(t.header.frame_id) == choice.odom_frame &&
                             stripSlash(t.child_frame_id) == choice.base_frame)
@@ -491,20 +514,19 @@ struct BagSource::Impl {
                                      Pose2D{t.transform.translation.x, t.transform.translation.y,
                                             yawOf(t.transform.rotation)});
             }
+            queued_bytes += native->bytes.size();
             queue.push_back(std::move(item));
             last_record = std::max(last_record, queue.back().record);
             ++messages_read;
-            ++it;
         } catch (const BagError& e) {
-            throw BagError(where(m ? &*m : nullptr) + ": " + e.what(), path);
+            throw BagError(where(m) + ": " + e.what(), path);
         } catch (const std::exception& e) {
-            throw BagError(
-                where(m ? &*m : nullptr) + ": corrupt or truncated bag (" + e.what() + ")", path);
+            throw BagError(where(m) + ": corrupt or truncated bag (" + e.what() + ")", path);
         }
         // Bounded lookahead: a scan waits at most kLookaheadSeconds of bag time.
         while (!queue.empty() && !queue.front().resolved &&
                (last_record - queue.front().record > kLookaheadSeconds ||
-                queue.size() > kLookaheadMessages))
+                queue.size() > kLookaheadMessages || queued_bytes > kLookaheadBytes))
             hold(queue.front());
         return true;
     }
@@ -553,6 +575,7 @@ bool BagSource::next(SourceEntry& e) {
         e.odometry = d.tracker.current();
     }
     e.native = std::move(q.native);
+    d.queued_bytes -= e.native ? e.native->bytes.size() : 0;
     d.queue.pop_front();
     return true;
 }
@@ -568,16 +591,18 @@ std::uint64_t BagSource::bytesRead() const {
 std::uint64_t BagSource::bytesTotal() const { return impl_->size; }
 const BagChoice& BagSource::choice() const { return impl_->choice; }
 SourceCounters BagSource::counters() const { return impl_->counts; }
+std::size_t BagSource::chunks() const { return impl_->open.reader->chunks(); }
+std::size_t BagSource::chunksLoaded() const { return impl_->open.reader->chunksLoaded(); }
+std::string BagSource::compression() const { return impl_->open.file->compression(); }
 
 SourceListing listBag(const std::string& path, const SourceOptions& options) {
-    rosbag::Bag bag;
-    openBag(bag, path);
+    OpenBag open(path, true);  // a listing checks every chunk
     SourceListing l;
     l.path = path;
     l.format = LogFormat::Bag;
     std::map<std::string, TopicInfo> topics;
     try {
-        topics = topicsOf(bag);
+        topics = topicsOf(open.bag);
     } catch (const std::exception& e) {
         throw BagError(path + ": cannot read the bag's index (" + e.what() + ")", path);
     }
@@ -588,7 +613,7 @@ SourceListing listBag(const std::string& path, const SourceOptions& options) {
     }
     l.detail = "ROS 1 bag, " + plural(topics.size(), "topic") + ", " + plural(total, "message");
     try {
-        const BagChoice c = choose(bag, topics, options);
+        const BagChoice c = choose(*open.reader, topics, options);
         l.choices = c.notes;
     } catch (const BagError& e) {
         l.choices.push_back(std::string("cannot use as it is: ") + e.what());

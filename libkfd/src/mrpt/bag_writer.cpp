@@ -23,6 +23,15 @@ RemovedMark parseRemovedMark(const std::string& text) {
     throw Error("'" + text + "' is not a removed-point mark (nan or inf)");
 }
 
+BagWriterOptions::Compression parseBagCompression(const std::string& text) {
+    using C = BagWriterOptions::Compression;
+    if (text == "input") return C::AsInput;
+    if (text == "none") return C::None;
+    if (text == "lz4") return C::Lz4;
+    if (text == "bz2") return C::Bz2;
+    throw Error("'" + text + "' is not a bag compression (input, none, lz4 or bz2)");
+}
+
 namespace {
 
 // A rosbag::Bag whose write failed cannot be destroyed: its destructor closes it, closing writes
@@ -75,6 +84,7 @@ BagWriter::BagWriter(const std::string& path, const BagWriterOptions& options,
         [&](rosbag::Bag& bag) {
             bag.open(path, rosbag::bagmode::Write);
             switch (options.compression) {
+                case BagWriterOptions::Compression::AsInput:  // resolved by the caller
                 case BagWriterOptions::Compression::None:
                     bag.setCompression(rosbag::compression::Uncompressed);
                     break;
@@ -97,20 +107,18 @@ BagWriter::~BagWriter() {
         }
 }
 
-void BagWriter::copy(const NativeMessage& message) {
-    const auto& m = message.message;
-    impl_->guarded(
-        [&](rosbag::Bag& bag) { bag.write(m.getTopic(), m.getTime(), m, m.getConnectionHeader()); },
-        "failed writing a message");
+void BagWriter::copy(const NativeMessage& m) {
+    impl_->guarded([&](rosbag::Bag& bag) { bag.write(m.topic(), m.time, m, m.connection->header); },
+                   "failed writing a message");
     ++impl_->written;
 }
 
 std::size_t BagWriter::writeScan(const NativeMessage& original,
                                  const mrpt::obs::CObservation2DRangeScan& cleaned) {
-    const auto& m = original.message;
+    const NativeMessage& m = original;
     auto ls = m.instantiate<sensor_msgs::LaserScan>();  // its bytes checked when read
     if (!ls)
-        throw BagError(impl_->name + ": the message on " + m.getTopic() + " is not a LaserScan",
+        throw BagError(impl_->name + ": the message on " + m.topic() + " is not a LaserScan",
                        impl_->name);
     const float mark = impl_->options.removed == RemovedMark::NaN
                            ? std::numeric_limits<float>::quiet_NaN()
@@ -124,9 +132,7 @@ std::size_t BagWriter::writeScan(const NativeMessage& original,
         }
     }
     impl_->guarded(
-        [&](rosbag::Bag& bag) {
-            bag.write(m.getTopic(), m.getTime(), *ls, m.getConnectionHeader());
-        },
+        [&](rosbag::Bag& bag) { bag.write(m.topic(), m.time, *ls, m.connection->header); },
         "failed writing a scan");
     ++impl_->written;
     return marked;

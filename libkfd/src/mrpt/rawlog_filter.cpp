@@ -258,7 +258,11 @@ void Run::prepare() {
 void Run::openOutputs() {
     asRawlogError([&] { tmp_.emplace(opts_.output); });
     if (sum_.output_format == LogFormat::Bag) {
-        asRawlogError([&] { bag_.emplace(tmp_->path().string(), opts_.bag, opts_.output); },
+        BagWriterOptions bag = opts_.bag;  // AsInput: the input bag's compression
+        if (bag.compression == BagWriterOptions::Compression::AsInput)
+            if (const auto* in = dynamic_cast<const BagSource*>(source_.get()))
+                bag.compression = parseBagCompression(in->compression());
+        asRawlogError([&] { bag_.emplace(tmp_->path().string(), bag, opts_.output); },
                       opts_.output);
     } else {
         asRawlogError([&] { gz_.emplace(tmp_->path(), opts_.output, opts_.compress_level); });

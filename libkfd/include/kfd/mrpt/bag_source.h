@@ -23,11 +23,14 @@ class BagError : public SourceError {
 /// them, the index entries and the chunk index) and throws BagError naming the file, the byte
 /// offset and what is wrong: not a bag, truncated, no index, a chunk that does not decompress,
 /// a length or an offset outside its record or chunk. rosbag_storage trusts these, so
-/// BagSource and listBag() run this check first. A compressed chunk's output grows with what
-/// its data holds, up to its announced size: a corrupt size field allocates nothing. (The
-/// lengths inside a message are checked when it is read, see BagSource; other corrupt bytes
-/// inside a message's data, e.g. a range value, cannot be told from real data: bags carry no
-/// checksums.)
+/// listBag() runs this check first; BagSource runs it too, but checks each chunk's contents (its
+/// records, the index entries into it) when it first reads the chunk, so that each chunk is
+/// decompressed once (a corrupt chunk is then a BagError from next(), naming its byte, as
+/// here). kfd reads the chunks itself; rosbag_storage only reads the index. A compressed
+/// chunk's output grows with what its data holds, up to its announced size: a corrupt size
+/// field allocates nothing. (The lengths inside a message are checked when it is read, see
+/// BagSource; other corrupt bytes inside a message's data, e.g. a range value, cannot be told
+/// from real data: bags carry no checksums.)
 void checkBagStructure(const std::string& path);
 
 /// What a BagSource reads from its bag (after the automatic choices).
@@ -45,7 +48,10 @@ struct BagChoice {
 
 /// Reads a ROS 1 bag (format 2.0, any chunk compression) message by message in time order,
 /// through the bag's index (a bag whose index is missing, i.e. one cut short while recording,
-/// is refused: `rosbag reindex` repairs it).
+/// is refused: `rosbag reindex` repairs it). The order is rosbag::View's; each chunk is
+/// decompressed once (the chunks of the messages held for a scan's odometry stay in a cache of
+/// at most 64 MiB, freed as soon as the pass has read all their messages), and each message is
+/// copied out of its chunk, so writing it reads nothing again.
 ///
 /// Choices (SourceOptions; a named topic must exist and have the right type, else BagError):
 ///  - scans: the --scan-topic, else the only sensor_msgs/LaserScan topic, else /scan or scan
@@ -60,7 +66,8 @@ struct BagChoice {
 ///    header stamp of another clock, odometry that starts late or stops early) the scan's
 ///    odometry is unknown (no odometry observation before it), counted
 ///    (SourceCounters::scans_without_odometry). The source looks ahead at most 10 s of bag time
-///    (or 100 000 messages) for the message after a scan, then holds the last one (within 1 s).
+///    (or 100 000 messages, or 256 MiB of messages) for the message after a scan, then holds the
+///    last one (within 1 s).
 ///  - stamps: a header stamp of 0 (unset) is replaced by the message's bag record time, for
 ///    scans and odometry alike (counted: SourceCounters::stamps_zero).
 ///  - mount: the chain of /tf_static transforms from the base frame to the scan's frame_id
@@ -107,6 +114,15 @@ class BagSource : public Source {
     const BagChoice& choice() const;
     /// Angle fields that do not match the beam count, stamps of 0, scans without odometry.
     SourceCounters counters() const override;
+    /// The bag's chunks, and how many have been loaded (decompressed, when compressed) so far:
+    /// each once when the bag is read through (the chunks of messages read when the bag is
+    /// opened stay cached for the pass), unless its messages interleave with those of other
+    /// chunks over more than 64 MiB of decompressed chunks.
+    std::size_t chunks() const;
+    std::size_t chunksLoaded() const;
+    /// The compression of the bag's chunks ("none", "bz2" or "lz4"; of most of them when they
+    /// differ): what a bag output takes by default (BagWriterOptions::Compression::AsInput).
+    std::string compression() const;
 
   private:
     struct Impl;

@@ -21,9 +21,15 @@ const char* toString(RemovedMark m);
 RemovedMark parseRemovedMark(const std::string& text);
 
 struct BagWriterOptions {
-    enum class Compression { None, Lz4, Bz2 } compression = Compression::Lz4;
+    /// The chunks' compression. AsInput: the input bag's (BagSource::compression(); what
+    /// RawlogFilter resolves it to; a BagWriter given AsInput writes uncompressed chunks).
+    enum class Compression { AsInput, None, Lz4, Bz2 } compression = Compression::AsInput;
     RemovedMark removed = RemovedMark::NaN;
 };
+
+/// "input", "none", "lz4" or "bz2" (a bag's chunk compression, BagSource::compression()); throws
+/// kfd::Error on anything else.
+BagWriterOptions::Compression parseBagCompression(const std::string& text);
 
 /// Writes a bag (format 2.0) from messages of a BagSource's bag. Errors are BagErrors whose
 /// first words say what failed: "cannot write out.bag: No space left on device (rosbag: ...)".
