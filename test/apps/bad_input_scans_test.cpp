@@ -332,7 +332,7 @@ TEST(BadInputEvaluation, GroundTruthIsToldByContentAndTheWrongOptionIsNamed) {
              "there, 10 with columns 5-7 zero; 10 with columns 4-6 zero, 10 with a unit "
              "quaternion in columns 5-8)"},
         {"a missing file under -g", "-g " + q(dir / "missing"), 1,
-         "kfd-eval: cannot open " + (dir / "missing")},
+         "kfd-eval: ground truth not found: " + (dir / "missing")},
         {"binary garbage under -g", "-g " + q(garbage), 2,
          "kfd-eval: --ground-truth: " + garbage +
              " is neither clearly a TUM trajectory nor a relations file (0 rows: 0 with a later "

@@ -250,9 +250,13 @@ TEST(BadInputOutputPaths, IcpSlamChecksEveryInputBeforeTheRun) {
     EXPECT_EQ(r.status, 1);
     EXPECT_EQ(r.first(), "kfd-icp-slam: ground-truth trajectory not found: " + (d / "missing.tum"));
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
-    r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", d / "out", "-g", d / "missing.relations"}, d.path);
+    r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", d / "out", "-r", d / "missing.relations"}, d.path);
     EXPECT_EQ(r.status, 1);
     EXPECT_EQ(r.first(), "kfd-icp-slam: relations file not found: " + (d / "missing.relations"));
+    // -g takes either format: a missing file is a missing ground truth.
+    r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", d / "out", "-g", d / "missing.relations"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-icp-slam: ground truth not found: " + (d / "missing.relations"));
     const auto bad_gt = d.write("bad.tum", "1 2 three\n");
     r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", d / "out", "--gt", bad_gt}, d.path);
     EXPECT_EQ(r.status, 1);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -33,8 +34,11 @@ std::string GroundTruthGuess::evidence() const {
 }
 
 GroundTruthGuess detectGroundTruthFormat(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+        throw EvalError("ground truth not found: " + path, path);
     std::ifstream f(path);
-    if (!f) throw EvalError("cannot open " + path, path);
+    if (!f) throw EvalError("cannot open the ground truth " + path, path);
     std::vector<std::array<double, 8>> rows;
     std::string line;
     while (rows.size() < GroundTruthGuess::kMaxRows && std::getline(f, line)) {

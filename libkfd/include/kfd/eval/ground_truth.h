@@ -40,8 +40,8 @@ struct GroundTruthGuess {
 /// format's signature (relations: columns 5-7 zero and column 2 a later or a shared stamp;
 /// TUM: columns 4-6 zero or a unit quaternion) and not the other's; a file that shows both is
 /// TUM when 90 % of its rows hold a unit quaternion (a toy trajectory along x with yaw 0),
-/// else Unknown, like a file that shows neither. Throws EvalError when the
-/// file cannot be opened.
+/// else Unknown, like a file that shows neither. Throws EvalError "ground truth not found: PATH"
+/// when `path` is not a regular file, or when it cannot be opened.
 GroundTruthGuess detectGroundTruthFormat(const std::string& path);
 
 }  // namespace kfd
