@@ -986,6 +986,18 @@ TEST(BadInputLogs, AnOutputNameOfNoFormatKfdWritesIsRefused) {
                                  ".log.gz: gzip); its name says none of them")
             << r.err;
     }
+    // kfd-simulate and kfd-inject write rawlogs only.
+    for (const auto& [exe, app] :
+         {std::pair{KFD_SIMULATE_EXE, "kfd-simulate"}, std::pair{KFD_INJECT_EXE, "kfd-inject"}}) {
+        const std::string out = d / "y.clf";
+        const Result r = std::string(app) == "kfd-inject"
+                             ? run(exe, {"-q", "-i", in, "-o", out}, d.path)
+                             : run(exe, {"-q", "-o", out, "-d", "1"}, d.path);
+        EXPECT_EQ(r.status, 1) << app;
+        EXPECT_EQ(r.first(), std::string(app) + ": the output rawlog " + out + ": " + app +
+                                 " writes an MRPT rawlog (.rawlog); its name says none of them")
+            << r.err;
+    }
     EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
     snap.expectUnchanged();
 }

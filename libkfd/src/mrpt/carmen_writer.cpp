@@ -16,10 +16,6 @@
 namespace kfd {
 namespace {
 
-bool endsWith(const std::string& s, const std::string& x) {
-    return s.size() > x.size() && s.compare(s.size() - x.size(), x.size(), x) == 0;
-}
-
 // The shortest text that reads back as the same value (std::to_chars).
 template <class T>
 void appendNumber(std::string& out, T v) {
@@ -41,7 +37,7 @@ struct Laser {
 
 bool isCarmenOutputName(const std::string& path) {
     for (const char* ext : {".clf", ".log", ".clf.gz", ".log.gz"})
-        if (endsWith(path, ext)) return true;
+        if (hasExtension(path, ext)) return true;
     return false;
 }
 

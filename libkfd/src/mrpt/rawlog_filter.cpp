@@ -8,7 +8,6 @@
 #include <mrpt/poses/CPose2D.h>
 #include <mrpt/serialization/CArchive.h>
 
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -57,25 +56,14 @@ decltype(auto) asRawlogError(Fn&& fn, const std::string& field = {}) {
     }
 }
 
-std::string lowerCase(std::string s) {
-    for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
-
-// The output's format by its name; RawlogError naming the formats for any other name.
+// The output's format by its name; a PathError naming the formats for any other name.
 LogFormat outputFormat(const std::string& output) {
-    const std::string o = lowerCase(output);
-    auto ends = [&](const std::string& x) {
-        return o.size() > x.size() && o.compare(o.size() - x.size(), x.size(), x) == 0;
-    };
-    if (ends(".bag")) return LogFormat::Bag;
-    if (isCarmenOutputName(o)) return LogFormat::Carmen;
-    if (ends(".rawlog")) return LogFormat::Rawlog;
-    throw RawlogError("the output " + output +
-                          ": kfd-filter writes .rawlog (an MRPT rawlog), .bag (a ROS 1 bag, for "
-                          "a bag input), .clf or .log (a CARMEN log; .clf.gz, .log.gz: gzip); "
-                          "its name says none of them",
-                      output);
+    if (hasExtension(output, ".bag")) return LogFormat::Bag;
+    if (isCarmenOutputName(output)) return LogFormat::Carmen;
+    checkOutputName({"output", output}, {".rawlog"},
+                    "kfd-filter writes .rawlog (an MRPT rawlog), .bag (a ROS 1 bag, for a bag "
+                    "input), .clf or .log (a CARMEN log; .clf.gz, .log.gz: gzip)");
+    return LogFormat::Rawlog;
 }
 
 // One kfd-filter run, as steps: prepare (paths, formats, source), open the outputs, the loop
@@ -268,7 +256,7 @@ void Run::prepare() {
         throw RawlogError(e.what(), e.field());
     }
     const std::string& o = opts_.output;
-    sum_.output_format = outputFormat(o);
+    sum_.output_format = asRawlogError([&] { return outputFormat(o); });
     sum_.input_format = asRawlogError([&] { return detectFormat(opts_.input); });
     if (sum_.output_format == LogFormat::Bag && sum_.input_format != LogFormat::Bag)
         throw RawlogError("a bag output (" + o + ") needs a ROS bag input; " + opts_.input +
@@ -295,7 +283,7 @@ void Run::openOutputs() {
         asRawlogError([&] { bag_.emplace(tmp_->path().string(), opts_.bag, opts_.output); },
                       opts_.output);
     } else if (sum_.output_format == LogFormat::Carmen) {
-        const bool gzip = lowerCase(opts_.output).rfind(".gz") == opts_.output.size() - 3;
+        const bool gzip = hasExtension(opts_.output, ".gz");
         asRawlogError([&] {
             carmen_.emplace(tmp_->path(), opts_.output, gzip, opts_.compress_level,
                             "kept scans of " + opts_.input + " (kfd-filter)");

@@ -21,7 +21,8 @@ class CarmenWriteError : public Error {
     using Error::Error;
 };
 
-/// True for the names kfd writes as a CARMEN log: .clf, .log, .clf.gz, .log.gz.
+/// True for the names kfd writes as a CARMEN log: .clf, .log, .clf.gz, .log.gz (letter case
+/// aside).
 bool isCarmenOutputName(const std::string& path);
 
 /// Writes a CARMEN log (the format of carmen's logger and of the Freiburg/Radish logs: one
