@@ -6,25 +6,29 @@
 #include <utility>
 
 #include "common/cli.h"
+#include "common/ground_truth_cli.h"
 #include "kfd/core/format.h"
 #include "kfd/eval/ate.h"
 #include "kfd/eval/relations.h"
 
 int main(int argc, char** argv) {
-    kfd::app::Cli cli("kfd-eval", "EST.tum [--relations GT.relations] [--gt GT.tum] [options]",
-                      "Trajectory error of EST.tum (TUM format) against ground truth.",
-                      "Stamps that do not match are counted and reported. Exit 1 on unreadable "
-                      "input, 2 on bad usage.");
-    std::string est_file, rel_file, gt_file;
+    kfd::app::Cli cli(
+        "kfd-eval", "EST.tum [-g GT.relations] [-g GT.tum] [options]",
+        "Trajectory error of EST.tum (TUM format) against ground truth: a relations file\n"
+        "and/or a TUM trajectory, each told by its content.",
+        "Stamps that do not match are counted and reported; a TUM ground truth that matches\n"
+        "fewer than half of the estimate's poses is an error. Exit 1 on unreadable input, 2 on\n"
+        "bad usage (a file given under the option of the other format included).");
+    std::string est_file;
+    kfd::app::GroundTruthArgs gt_args;
     double max_dt = 1e-3, rpe_delta = 1.0;
     cli.option("EST.tum", est_file, "estimated trajectory (TUM)")->required();
-    cli.option("-r,--relations", rel_file,
-               "Kuemmerle et al. 2009 relations metric (mean +- std of the\n"
-               "translation error in m and rotation error in deg, absolute and\nsquared)")
-        ->type_name("FILE");
-    cli.option("-g,--gt", gt_file,
-               "ground-truth TUM trajectory: ATE RMSE after SE(2) alignment, RPE")
-        ->type_name("FILE");
+    kfd::app::addGroundTruthOptions(
+        cli, gt_args,
+        "relations file only: Kuemmerle et al. 2009 relations metric\n"
+        "(mean +- std of the translation error in m and rotation error\n"
+        "in deg, absolute and squared)",
+        "ground-truth TUM trajectory only: ATE RMSE after SE(2)\nalignment, RPE");
     cli.option("--max-dt", max_dt, "stamp matching tolerance (s)")
         ->type_name("S")
         ->capture_default_str();
@@ -38,8 +42,15 @@ int main(int argc, char** argv) {
                kfd::app::toNumber<double>)
         ->type_name("S");
     return cli.run(argc, argv, [&] {
+        std::string rel_file, gt_file;
+        kfd::app::resolveGroundTruth(gt_args, rel_file, gt_file);
         if (rel_file.empty() && gt_file.empty())
-            throw kfd::app::UsageError("give --relations and/or --gt");
+            throw kfd::app::UsageError("give a ground truth: -g FILE (or --relations, --gt)");
+        if (const auto g = kfd::detectGroundTruthFormat(est_file);
+            g.format == kfd::GroundTruthFormat::Relations)
+            throw kfd::app::UsageError("EST.tum: " + est_file + " is " + kfd::toString(g.format) +
+                                       ", not an estimated TUM trajectory (" + g.evidence() +
+                                       "): give it with -g or --relations");
         if (!(max_dt >= 0.0) || !std::isfinite(max_dt))
             throw kfd::app::UsageError("--max-dt: must be finite and >= 0 (got " +
                                        std::to_string(max_dt) + ")");
@@ -51,7 +62,8 @@ int main(int argc, char** argv) {
         std::printf("estimate   %s (%s)\n", est_file.c_str(),
                     kfd::plural(est.size(), "pose").c_str());
         if (split_s && rel_file.empty())
-            throw kfd::app::UsageError("--split-seconds needs --relations");
+            throw kfd::app::UsageError(
+                "--split-seconds needs a relations file (-g or --relations)");
         if (split_s && (!(*split_s >= 0.0) || !std::isfinite(*split_s)))
             throw kfd::app::UsageError("--split-seconds: must be finite and >= 0 (got " +
                                        std::to_string(*split_s) + ")");

@@ -81,7 +81,11 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
                     kfd::plural(s.scans_denoise_stale, "stale reference").c_str(),
                     s.scans_denoise_capped);
     if (s.points_removed_noise) std::printf("\n");
-    if (s.output_format == kfd::LogFormat::Bag)
+    if (s.output_format == kfd::LogFormat::Carmen)
+        std::printf(
+            "  lines    out %zu (FLASER/RLASER for the kept scans, ODOM), scans dropped %zu\n",
+            s.objects_out, s.objects_dropped);
+    else if (s.output_format == kfd::LogFormat::Bag)
         std::printf("  messages in %zu, out %zu, scans dropped %zu; %s written as %s\n",
                     s.objects_in, s.objects_out, s.objects_dropped,
                     kfd::plural(s.points_marked, "removed point").c_str(),
@@ -183,7 +187,7 @@ void printWindowSuggestion(const std::vector<double>& a) {
 
 int main(int argc, char** argv) {
     kfd::app::Cli cli(
-        "kfd-filter", "-i IN.{rawlog,bag,clf,log[.gz]} -o OUT.{rawlog,bag} [options]",
+        "kfd-filter", "-i IN.{rawlog,bag,clf,log[.gz]} -o OUT.{rawlog,bag,clf,log[.gz]} [options]",
         "Drops 2D range scans that carry no new information (keyframe extraction, Hu et al. 2023)\n"
         "and removes noise points from the kept scans (clustering denoise). Every other object is\n"
         "copied unchanged and in order; odometry of dropped frames is composed into the next kept\n"
@@ -191,7 +195,9 @@ int main(int argc, char** argv) {
         "The input's format is told by its content: an MRPT rawlog, a ROS 1 bag (LaserScan with\n"
         "Odometry or /tf; plain, bz2 or lz4) or a CARMEN log (plain or gzip). A bag input can\n"
         "give a bag output (-o X.bag): every other topic copied in order, the dropped scans\n"
-        "left out, removed points written as NaN (or +Inf, --removed-as; REP 117).",
+        "left out, removed points written as NaN (or +Inf, --removed-as; REP 117). Any input\n"
+        "can give a CARMEN log (-o X.clf or X.log, .gz for gzip): FLASER lines for the kept\n"
+        "scans (removed points as 0, no reading), ODOM lines for the odometry.",
         "Exit status: 0 on success, 1 on bad input or configuration (an output that is an input\n"
         "included), 2 on bad usage, 130/143 when interrupted (no output is left).");
     kfd::RawlogFilterOptions opts;
@@ -205,7 +211,8 @@ int main(int argc, char** argv) {
                "ROS 1 bag, or CARMEN log (.clf/.log, plain or gzip)")
         ->type_name("FILE");
     cli.option("-o,--output", opts.output,
-               "output: a rawlog, or for a bag input a bag (X.bag);\n"
+               "output, its format by its name: X.rawlog, X.bag (for a bag\n"
+               "input), X.clf or X.log (CARMEN; X.clf.gz, X.log.gz: gzip);\n"
                "written to a temporary file, then renamed")
         ->type_name("FILE");
     kfd::app::addSourceOptions(cli, opts.source, list, opts.laser_only, " (the output keeps it)");

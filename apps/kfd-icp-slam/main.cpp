@@ -5,6 +5,7 @@
 #include <string>
 
 #include "common/cli.h"
+#include "common/ground_truth_cli.h"
 #include "common/source_cli.h"
 #include "kfd/core/format.h"
 #include "kfd/report/slam_report.h"
@@ -73,11 +74,10 @@ int main(int argc, char** argv) {
                "relations over at most S s are local, the others long")
         ->type_name("S")
         ->capture_default_str();
-    cli.option("-g,--relations", o.relations, "ground-truth .relations: report the relations error")
-        ->type_name("FILE");
-    cli.option("--gt", o.ground_truth_tum,
-               "ground-truth trajectory (TUM): ATE RMSE, drawn in the figure")
-        ->type_name("FILE");
+    kfd::app::GroundTruthArgs gt_args;
+    kfd::app::addGroundTruthOptions(cli, gt_args, "relations file only: report the relations error",
+                                    "ground-truth TUM trajectory only: ATE RMSE, drawn in\n"
+                                    "the figure");
     cli.option("--max-dt", o.relations_max_dt, "stamp matching tolerance (s)")
         ->type_name("S")
         ->capture_default_str();
@@ -98,6 +98,7 @@ int main(int argc, char** argv) {
             return kfd::app::printListing(log, o.source);
         }
         if (o.config_file.empty()) throw kfd::app::UsageError("no configuration (CONFIG.ini)");
+        kfd::app::resolveGroundTruth(gt_args, o.relations, o.ground_truth_tum);
         if (no_map) o.write_map = false;
         if (auto* progress = cli.progress())
             o.on_progress = [progress](const kfd::IcpSlamProgress& p) {

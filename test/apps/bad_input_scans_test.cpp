@@ -290,6 +290,115 @@ TEST(BadInputEvaluation, EveryRowIsAnErrorThatNamesWhatIsWrong) {
     EXPECT_EQ(run(KFD_EVAL_EXE, q(est) + " --gt " + q(gt) + " --relations " + q(rel)).status, 0);
 }
 
+// Issue 23: a relations file and a TUM trajectory both hold 8 numbers a line; each tool tells
+// them by content. -g/--ground-truth takes either, -r/--relations and --gt one format each: a
+// file under the other format's option is bad usage naming what the file is and which option
+// takes it (before, `kfd-eval traj.tum -g x.relations` read the relations as a trajectory and
+// printed an ATE, exit 0).
+TEST(BadInputEvaluation, GroundTruthIsToldByContentAndTheWrongOptionIsNamed) {
+    TempDir dir;
+    const std::string est = dir / "est.tum", gt = dir / "gt.tum", rel = dir / "gt.relations",
+                      part = dir / "part.tum";
+    writeTum(est, 1000.0, 10);  // "t x 0 0 0 0 0 1": 1 m/s along x
+    writeTum(gt, 1000.0, 10);
+    writeTum(part, 1000.0, 4);  // covers 4 of the estimate's 10 poses
+    const std::string garbage = dir / "garbage.bin";
+    std::ofstream(garbage, std::ios::binary) << std::string("\x1f\x8b\x08\0\xff\xfe\n\x01", 8);
+    {
+        std::ofstream f(rel);  // consecutive stamps, t2 = the next row's t1
+        for (int i = 0; i < 9; ++i) f << 1000 + i << " " << 1001 + i << " 1 0.1 0 0 0 0.05\n";
+    }
+    const Result by_content = run(KFD_EVAL_EXE, q(est) + " -g " + q(rel));
+    EXPECT_EQ(by_content.status, 0) << by_content.err;
+    EXPECT_NE(by_content.out.find("relations  " + rel + ": 9 used"), std::string::npos)
+        << by_content.out;
+    EXPECT_EQ(by_content.out.find("ATE"), std::string::npos) << by_content.out;
+    const Result both = run(KFD_EVAL_EXE, q(est) + " -g " + q(gt) + " --ground-truth " + q(rel));
+    EXPECT_EQ(both.status, 0) << both.err;
+    EXPECT_NE(both.out.find("ATE        10 matched, 0 unmatched"), std::string::npos) << both.out;
+    EXPECT_NE(both.out.find("relations  " + rel), std::string::npos) << both.out;
+
+    const std::vector<EvalCase> cases{
+        {"relations under --gt", "--gt " + q(rel), 2,
+         "kfd-eval: --gt: " + rel +
+             " is a relations file (t1 t2 x y z roll pitch yaw), not a TUM trajectory: give it "
+             "with --relations or -g (9 rows: 9 with a later stamp in column 2, 8 with another "
+             "row's stamp there, 9 with columns 5-7 zero; 0 with columns 4-6 zero, 0 with a "
+             "unit quaternion in columns 5-8)"},
+        {"TUM under --relations", "-r " + q(gt), 2,
+         "kfd-eval: --relations: " + gt +
+             " is a TUM trajectory (t x y z qx qy qz qw), not a relations file: give it with "
+             "--gt or -g (10 rows: 0 with a later stamp in column 2, 0 with another row's stamp "
+             "there, 10 with columns 5-7 zero; 10 with columns 4-6 zero, 10 with a unit "
+             "quaternion in columns 5-8)"},
+        {"a missing file under -g", "-g " + q(dir / "missing"), 1,
+         "kfd-eval: ground truth not found: " + (dir / "missing")},
+        {"binary garbage under -g", "-g " + q(garbage), 2,
+         "kfd-eval: --ground-truth: " + garbage +
+             " is neither clearly a TUM trajectory nor a relations file (0 rows: 0 with a later "
+             "stamp in column 2, 0 with another row's stamp there, 0 with columns 5-7 zero; 0 "
+             "with columns 4-6 zero, 0 with a unit quaternion in columns 5-8): give it with "
+             "--relations or --gt"},
+        {"two relations files", "-g " + q(rel) + " -r " + q(rel), 2,
+         "kfd-eval: two relations files: " + rel + " and " + rel},
+        {"ground truth for less than half of the estimate", "-g " + q(part), 1,
+         "kfd-eval: ATE: only 4 of 10 estimated poses have a ground-truth pose within 0.001 s "
+         "(6 unmatched): the ground truth must cover at least half of the trajectory (another "
+         "log's ground truth, or a larger --max-dt?)"},
+    };
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.name);
+        const Result r = run(KFD_EVAL_EXE, q(est) + " " + c.args);
+        EXPECT_EQ(r.status, c.status) << r.err;
+        EXPECT_EQ(r.firstErrLine(), c.first) << r.err;
+    }
+    // The estimate itself must be a trajectory.
+    const Result swapped = run(KFD_EVAL_EXE, q(rel) + " -g " + q(gt));
+    EXPECT_EQ(swapped.status, 2);
+    EXPECT_EQ(swapped.firstErrLine().rfind("kfd-eval: EST.tum: " + rel +
+                                               " is a relations file (t1 t2 x y z roll pitch "
+                                               "yaw), not an estimated TUM trajectory",
+                                           0),
+              0u)
+        << swapped.err;
+}
+
+// kfd-icp-slam takes the same flags: -g is either format (it was the relations file only), a
+// relations file under --gt is refused before the run.
+TEST(BadInputEvaluation, IcpSlamTellsGroundTruthByContent) {
+    TempDir dir;
+    const std::string in = dir / "room.rawlog", rel = dir / "room.relations";
+    kfd::test::writeRoomLog(in, 10);
+    const std::string slam = "-q " + q(kIcpConfig) + " " + q(in) + " --no-map -o ";
+    const Result first = run(KFD_ICP_SLAM_EXE, slam + q(dir / "first"));
+    ASSERT_EQ(first.status, 0) << first.err;
+    const std::string traj = dir / "first/trajectory.tum";
+    {
+        std::ifstream f(traj);
+        std::ofstream r(rel);
+        std::string line, prev;
+        while (std::getline(f, line)) {
+            if (line.empty() || line[0] == '#') continue;
+            const std::string t = line.substr(0, line.find(' '));
+            if (!prev.empty()) r << prev << " " << t << " 0.05 0.001 0 0 0 0.001\n";
+            prev = t;
+        }
+    }
+    const Result r =
+        run(KFD_ICP_SLAM_EXE, slam + q(dir / "second") + " -g " + q(traj) + " -g " + q(rel));
+    EXPECT_EQ(r.status, 0) << r.err;
+    const std::string json = fileBytes(dir / "second/summary.json");
+    EXPECT_NE(json.find("\"ate_rmse_m\""), std::string::npos) << json;
+    EXPECT_NE(json.find("\"relations\""), std::string::npos) << json;
+
+    const Result wrong = run(KFD_ICP_SLAM_EXE, slam + q(dir / "third") + " --gt " + q(rel));
+    EXPECT_EQ(wrong.status, 2) << wrong.err;
+    EXPECT_EQ(wrong.firstErrLine().rfind("kfd-icp-slam: --gt: " + rel + " is a relations file", 0),
+              0u)
+        << wrong.err;
+    EXPECT_FALSE(fs::exists(dir / "third"));
+}
+
 TEST(BadInputEvaluation, IcpSlamWithRelationsThatMatchNothingIsAnError) {
     TempDir dir;
     const std::string in = dir / "room.rawlog", rel = dir / "far.relations";

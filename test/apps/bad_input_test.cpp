@@ -27,6 +27,7 @@
 #include <mrpt/io/CFileGZInputStream.h>
 
 #include "bad_logs.h"
+#include "kfd/mrpt/open_source.h"
 #include "test_bags.h"
 #include "test_files.h"
 
@@ -249,9 +250,13 @@ TEST(BadInputOutputPaths, IcpSlamChecksEveryInputBeforeTheRun) {
     EXPECT_EQ(r.status, 1);
     EXPECT_EQ(r.first(), "kfd-icp-slam: ground-truth trajectory not found: " + (d / "missing.tum"));
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
-    r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", d / "out", "-g", d / "missing.relations"}, d.path);
+    r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", d / "out", "-r", d / "missing.relations"}, d.path);
     EXPECT_EQ(r.status, 1);
     EXPECT_EQ(r.first(), "kfd-icp-slam: relations file not found: " + (d / "missing.relations"));
+    // -g takes either format: a missing file is a missing ground truth.
+    r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", d / "out", "-g", d / "missing.relations"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first(), "kfd-icp-slam: ground truth not found: " + (d / "missing.relations"));
     const auto bad_gt = d.write("bad.tum", "1 2 three\n");
     r = run(KFD_ICP_SLAM_EXE, {cfg, in, "-o", d / "out", "--gt", bad_gt}, d.path);
     EXPECT_EQ(r.status, 1);
@@ -644,6 +649,20 @@ TEST(BadInputFullDisk, FilterBagOutput) {
                       "out.bag: ", {in});
 }
 
+TEST(BadInputFullDisk, FilterCarmenOutput) {
+    Dir d;
+    SmallTmpfs t(d.path / "full");
+    KFD_REQUIRE_TMPFS(t);
+    const auto in = d.copy(kOffice, "in.rawlog");
+    for (const char* name : {"out.clf", "out.clf.gz"})
+        expectFullDiskRow(d, t, KFD_FILTER_EXE, "kfd-filter",
+                          [&](const fs::path& o) {
+                              return std::vector<std::string>{"-q",     "-i",         in, "-o",
+                                                              o / name, "--compress", "0"};
+                          },
+                          std::string(name) + ": ", {in});
+}
+
 TEST(BadInputFullDisk, IcpSlamOutputFolder) {
     Dir d;
     SmallTmpfs t(d.path / "full");
@@ -1024,6 +1043,63 @@ TEST(BadInputLogs, ABagOutputNeedsABagInput) {
               std::string::npos)
         << r.err;
     EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
+    snap.expectUnchanged();
+}
+
+// Issue 23: an output is written in the format its name says, or refused. Before, any name
+// but .bag got an MRPT rawlog (`-o y.clf` and `-o y.txt`: a rawlog, exit 0).
+TEST(BadInputLogs, AnOutputNameOfNoFormatKfdWritesIsRefused) {
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const Snapshot snap({in});
+    for (const std::string name : {"y.txt", "y", "y.clf.txt"}) {
+        const Result r = run(KFD_FILTER_EXE, {"-q", "-i", in, "-o", d / name}, d.path);
+        EXPECT_EQ(r.status, 1) << name;
+        EXPECT_EQ(r.first(), "kfd-filter: the output " + (d / name) +
+                                 ": kfd-filter writes .rawlog (an MRPT rawlog), .bag (a ROS 1 "
+                                 "bag, for a bag input), .clf or .log (a CARMEN log; .clf.gz, "
+                                 ".log.gz: gzip); its name says none of them")
+            << r.err;
+    }
+    // kfd-simulate and kfd-inject write rawlogs only.
+    for (const auto& [exe, app] :
+         {std::pair{KFD_SIMULATE_EXE, "kfd-simulate"}, std::pair{KFD_INJECT_EXE, "kfd-inject"}}) {
+        const std::string out = d / "y.clf";
+        const Result r = std::string(app) == "kfd-inject"
+                             ? run(exe, {"-q", "-i", in, "-o", out}, d.path)
+                             : run(exe, {"-q", "-o", out, "-d", "1"}, d.path);
+        EXPECT_EQ(r.status, 1) << app;
+        EXPECT_EQ(r.first(), std::string(app) + ": the output rawlog " + out + ": " + app +
+                                 " writes an MRPT rawlog (.rawlog); its name says none of them")
+            << r.err;
+    }
+    EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
+    snap.expectUnchanged();
+}
+
+TEST(BadInputLogs, AClfOrLogOutputIsACarmenLog) {
+    Dir d;
+    const auto in = d.copy(kOffice, "in.rawlog");
+    const Snapshot snap({in});
+    for (const std::string name : {"out.clf", "out.log"}) {
+        const Result r = run(KFD_FILTER_EXE, {"-i", in, "-o", d / name}, d.path);
+        ASSERT_EQ(r.status, 0) << r.err;
+        EXPECT_NE(r.out.find("output   " + (d / name) + " (CARMEN log)"), std::string::npos)
+            << r.out;
+        EXPECT_EQ(kfd::detectFormat(d / name), kfd::LogFormat::Carmen);
+        const std::string text = fileBytes(d / name);
+        EXPECT_EQ(text.rfind("# CARMEN log written by kfd\n", 0), 0u);
+        EXPECT_NE(text.find("\nFLASER 1081 "), std::string::npos);
+        EXPECT_NE(text.find("\nODOM "), std::string::npos);
+    }
+    // A log without odometry cannot be a CARMEN log (a FLASER line holds the odometry).
+    const auto raw = d.write("raw.log", "RAWLASER1 0 -1.5 3 0.01 8 0.01 0 3 1 2 3 0 10 h 0\n");
+    const Result r = run(KFD_FILTER_EXE, {"-q", "-i", raw, "-o", d / "nodo.clf"}, d.path);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.first().rfind("kfd-filter: a CARMEN output needs the robot's odometry", 0), 0u)
+        << r.err;
+    EXPECT_EQ(listing(d.path),
+              (std::set<std::string>{"in.rawlog", "out.clf", "out.log", "raw.log"}));
     snap.expectUnchanged();
 }
 

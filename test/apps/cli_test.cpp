@@ -296,7 +296,7 @@ TEST(CliApps, BadUsageExitsTwoAndSaysWhatIsWrong) {
         {"kfd-render", "-i a --index 1", "no output image (-o)"},
         // A missing value, or arguments that contradict each other.
         {"kfd-eval", "est.tum -r", "--relations"},
-        {"kfd-eval", "est.tum", "give --relations and/or --gt"},
+        {"kfd-eval", "est.tum", "give a ground truth: -g FILE (or --relations, --gt)"},
         {"kfd-icp-slam", "x.ini a.rawlog -i b.rawlog", "input log given twice"},
         {"kfd-filter", "-i a.bag -o b.bag --removed-as zero", "--removed-as"},
         {"kfd-filter", "-i a.bag -o b.bag --bag-compression zip", "--bag-compression"},

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 
 #include "kfd/eval/ate.h"
 
@@ -61,6 +62,23 @@ TEST(Ate, UnmatchedStampsAreCounted) {
     EXPECT_EQ(a.matched, 50u);
     EXPECT_EQ(a.unmatched, 1u);
     EXPECT_THROW(kfd::computeAte({{1000.0, {}}}, gt, 1e-3), kfd::EvalError);
+}
+
+TEST(Ate, AGroundTruthMatchingLessThanHalfTheEstimateIsAnErrorWithTheCounts) {
+    const auto gt = squarePath(40);  // stamps 0 .. 3.9 s
+    auto est = gt;
+    for (int i = 0; i < 41; ++i) est.push_back({100.0 + i, {}});  // 40 of 81 match
+    try {
+        kfd::computeAte(est, gt, 1e-3);
+        FAIL() << "no error";
+    } catch (const kfd::EvalError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("only 40 of 81"), std::string::npos) << m;
+        EXPECT_NE(m.find("41 unmatched"), std::string::npos) << m;
+        EXPECT_NE(m.find("0.001 s"), std::string::npos) << m;
+    }
+    est.pop_back();  // 40 of 80: half is enough
+    EXPECT_EQ(kfd::computeAte(est, gt, 1e-3).matched, 40u);
 }
 
 TEST(Rpe, PerfectAndRigidlyMovedEstimatesHaveZeroError) {

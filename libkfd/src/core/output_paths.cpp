@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <random>
@@ -381,6 +382,24 @@ void StagedOutputFolder::commit() {
                         final_.string());
     committed_ = true;
     releaseLock(lock_);
+}
+
+bool hasExtension(const std::string& path, const std::string& extension) {
+    if (path.size() <= extension.size()) return false;
+    for (std::size_t i = 0; i < extension.size(); ++i)
+        if (std::tolower(static_cast<unsigned char>(path[path.size() - extension.size() + i])) !=
+            std::tolower(static_cast<unsigned char>(extension[i])))
+            return false;
+    return true;
+}
+
+void checkOutputName(const NamedPath& output, const std::vector<std::string>& extensions,
+                     const std::string& formats) {
+    for (const auto& x : extensions)
+        if (hasExtension(output.path, x)) return;
+    throw PathError(
+        "the " + output.role + " " + output.path + ": " + formats + "; its name says none of them",
+        output.path);
 }
 
 }  // namespace kfd

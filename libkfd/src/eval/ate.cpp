@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "kfd/core/format.h"
+
 namespace kfd {
 namespace {
 
@@ -33,6 +35,15 @@ AteResult computeAte(const Trajectory& est, const Trajectory& gt, double max_dt)
         throw EvalError("ATE needs at least 2 matched poses (" + std::to_string(a.size()) + " of " +
                         std::to_string(est.size()) + " matched within " + std::to_string(max_dt) +
                         " s)");
+    // A ground truth that covers less than half of the estimate is another log's (or its
+    // stamps are shifted): an RMSE over the few poses that happen to match would mislead.
+    if (2 * res.matched < est.size())
+        throw EvalError("ATE: only " + std::to_string(res.matched) + " of " +
+                        std::to_string(est.size()) +
+                        " estimated poses have a ground-truth pose within " + format("%g", max_dt) +
+                        " s (" + std::to_string(res.unmatched) +
+                        " unmatched): the ground truth must cover at least half of the "
+                        "trajectory (another log's ground truth, or a larger --max-dt?)");
     // Umeyama without scale: R, t minimising sum |b - (R a + t)|^2.
     Eigen::Vector2d ma = Eigen::Vector2d::Zero(), mb = Eigen::Vector2d::Zero();
     for (std::size_t i = 0; i < a.size(); ++i) {

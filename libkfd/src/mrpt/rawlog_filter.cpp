@@ -3,6 +3,7 @@
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose2D.h>
 #include <mrpt/serialization/CArchive.h>
@@ -12,6 +13,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "kfd/core/cancel.h"
 #include "kfd/core/output_paths.h"
@@ -19,6 +22,7 @@
 #include "kfd/core/denoise_stage.h"
 #include "kfd/core/denoiser.h"
 #include "kfd/core/scan_rate.h"
+#include "kfd/mrpt/carmen_writer.h"
 #include "kfd/mrpt/gz_output.h"
 #include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_csv.h"
@@ -49,7 +53,19 @@ decltype(auto) asRawlogError(Fn&& fn, const std::string& field = {}) {
         throw RawlogError(e.what(), e.field());
     } catch (const PathError& e) {
         throw RawlogError(e.what(), e.field());
+    } catch (const CarmenWriteError& e) {
+        throw RawlogError(e.what(), e.field());
     }
+}
+
+// The output's format by its name; a PathError naming the formats for any other name.
+LogFormat outputFormat(const std::string& output) {
+    if (hasExtension(output, ".bag")) return LogFormat::Bag;
+    if (isCarmenOutputName(output)) return LogFormat::Carmen;
+    checkOutputName({"output", output}, {".rawlog"},
+                    "kfd-filter writes .rawlog (an MRPT rawlog), .bag (a ROS 1 bag, for a bag "
+                    "input), .clf or .log (a CARMEN log; .clf.gz, .log.gz: gzip)");
+    return LogFormat::Rawlog;
 }
 
 // One kfd-filter run, as steps: prepare (paths, formats, source), open the outputs, the loop
@@ -81,6 +97,10 @@ class Run {
     void handleObservation(const SourceEntry& e);
     void handleActions(const std::shared_ptr<CActionCollection>& acts);
     void handleFrame(const std::shared_ptr<CSensoryFrame>& sf);
+    // A CARMEN output: kept scans as FLASER/RLASER lines, odometry as ODOM lines.
+    void handleCarmenEntry(const SourceEntry& e);
+    void writeCarmenScan(const CObservation2DRangeScan& scan, const Pose2D& odo);
+    void writeCarmenOdometry(const Pose2D& odo, double stamp, bool always);
     // Processes one scan through the door; returns true when kept.
     bool handleScan(CObservation2DRangeScan& scan);
     void noteSensor(const CObservation2DRangeScan& scan, const StreamResult& r);
@@ -94,8 +114,12 @@ class Run {
     std::unique_ptr<Source> source_;
     std::optional<TempOutputFile> tmp_, tmp_csv_;  // the outputs under temporary names
     ScanCsvWriter csv_;
-    std::optional<GzOutputStream> gz_;            // a rawlog output
-    std::optional<BagWriter> bag_;                // a bag output (instead of gz_)
+    std::optional<GzOutputStream> gz_;       // a rawlog output
+    std::optional<BagWriter> bag_;           // a bag output (instead of gz_)
+    std::optional<CarmenWriter> carmen_;     // a CARMEN output (instead of gz_)
+    std::optional<Pose2D> carmen_odometry_;  // the odometry of the last line written
+    std::vector<CObservation2DRangeScan::Ptr> carmen_pending_;  // kept before any odometry
+    static constexpr std::size_t kCarmenMaxPending = 1000;
     std::shared_ptr<CActionCollection> pending_;  // action waiting for its sensory frame
     CPose2D carry_;                               // odometry of dropped frames, not yet written
     bool have_carry_ = false;
@@ -232,9 +256,7 @@ void Run::prepare() {
         throw RawlogError(e.what(), e.field());
     }
     const std::string& o = opts_.output;
-    sum_.output_format = o.size() > 4 && o.compare(o.size() - 4, 4, ".bag") == 0
-                             ? LogFormat::Bag
-                             : LogFormat::Rawlog;
+    sum_.output_format = asRawlogError([&] { return outputFormat(o); });
     sum_.input_format = asRawlogError([&] { return detectFormat(opts_.input); });
     if (sum_.output_format == LogFormat::Bag && sum_.input_format != LogFormat::Bag)
         throw RawlogError("a bag output (" + o + ") needs a ROS bag input; " + opts_.input +
@@ -264,6 +286,12 @@ void Run::openOutputs() {
                 bag.compression = parseBagCompression(in->compression());
         asRawlogError([&] { bag_.emplace(tmp_->path().string(), bag, opts_.output); },
                       opts_.output);
+    } else if (sum_.output_format == LogFormat::Carmen) {
+        const bool gzip = hasExtension(opts_.output, ".gz");
+        asRawlogError([&] {
+            carmen_.emplace(tmp_->path(), opts_.output, gzip, opts_.compress_level,
+                            "kept scans of " + opts_.input + " (kfd-filter)");
+        });
     } else {
         asRawlogError([&] { gz_.emplace(tmp_->path(), opts_.output, opts_.compress_level); });
     }
@@ -294,6 +322,7 @@ void Run::loop() {
 }
 
 void Run::handleEntry(const SourceEntry& e) {
+    if (carmen_) return handleCarmenEntry(e);
     switch (e.kind) {
         case SourceEntry::Kind::Frame:
             saw_frames_ = true;
@@ -340,7 +369,77 @@ void Run::handleObservation(const SourceEntry& e) {
     }
 }
 
+// A kept scan: its FLASER/RLASER line with the entry's odometry; an odometry reading: an ODOM
+// line; a dropped scan: an ODOM line when the odometry moved since the last line. Kept scans
+// before the log's first odometry wait for it (a scan and its odometry reading often share a
+// stamp, the scan first); a scan whose odometry is not finite gets the last one written.
+void Run::handleCarmenEntry(const SourceEntry& e) {
+    std::optional<Pose2D> odo = e.odometry;
+    if (odo && !finitePose(odo->x, odo->y, odo->phi)) odo.reset();
+    if (odo && !carmen_pending_.empty()) {
+        for (const auto& scan : carmen_pending_) writeCarmenScan(*scan, *odo);
+        carmen_pending_.clear();
+    }
+    auto scanOrOdometry = [&](const mrpt::obs::CObservation::Ptr& obs) {
+        if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(obs)) {
+            if (!handleScan(*scan)) {
+                ++sum_.objects_dropped;
+                return false;
+            }
+            if (odo || carmen_odometry_) {
+                writeCarmenScan(*scan, odo ? *odo : *carmen_odometry_);
+            } else {
+                if (carmen_pending_.size() == kCarmenMaxPending)
+                    throw RawlogError(
+                        "a CARMEN output needs the robot's odometry (a FLASER line holds it): "
+                        "the first " +
+                            std::to_string(kCarmenMaxPending) + " kept scans of " + opts_.input +
+                            " have none (a laser-only log): write a .rawlog" +
+                            (sum_.input_format == LogFormat::Bag ? " or a .bag" : ""),
+                        opts_.output);
+                carmen_pending_.push_back(scan);
+            }
+            return true;
+        }
+        if (odo && std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(obs)) {
+            writeCarmenOdometry(*odo, stampOf(*obs), true);
+            return true;
+        }
+        return false;
+    };
+    bool wrote = false;
+    mrpt::obs::CObservation::Ptr first;
+    if (e.kind == SourceEntry::Kind::Observation) {
+        first = e.observation;
+        wrote = scanOrOdometry(e.observation);
+    } else if (e.kind == SourceEntry::Kind::Frame) {  // the frame's action is in e.odometry
+        for (const auto& obs : *e.frame) {
+            if (!first) first = obs;
+            wrote = scanOrOdometry(obs) || wrote;
+        }
+    }  // an action alone: its motion goes out with the next frame; other objects: left out
+    if (!wrote && odo && first) writeCarmenOdometry(*odo, stampOf(*first), false);
+}
+
+void Run::writeCarmenScan(const CObservation2DRangeScan& scan, const Pose2D& odo) {
+    asRawlogError([&] { carmen_->writeScan(scan, odo); }, opts_.output);
+    carmen_odometry_ = odo;
+}
+
+void Run::writeCarmenOdometry(const Pose2D& odo, double stamp, bool always) {
+    if (!always && carmen_odometry_ && carmen_odometry_->x == odo.x &&
+        carmen_odometry_->y == odo.y && carmen_odometry_->phi == odo.phi)
+        return;
+    asRawlogError([&] { carmen_->writeOdometry(odo, stamp); }, opts_.output);
+    carmen_odometry_ = odo;
+}
+
 void Run::finish() {
+    if (!carmen_pending_.empty())
+        throw RawlogError("a CARMEN output needs the robot's odometry (a FLASER line holds it): " +
+                              opts_.input + " has none (a laser-only log): write a .rawlog" +
+                              (sum_.input_format == LogFormat::Bag ? " or a .bag" : ""),
+                          opts_.output);
     flushPendingAction(true);
     if (have_carry_) {  // the last frames were dropped: keep their motion as a final action
         CActionCollection acts;
@@ -356,6 +455,8 @@ void Run::finish() {
     asRawlogError([&] {
         if (bag_)
             bag_->close();
+        else if (carmen_)
+            carmen_->close();
         else
             gz_->close();
         csv_.close();
@@ -372,6 +473,7 @@ void Run::finish() {
         sum_.layout = saw_frames_ && saw_observations_ ? "mixed"
                       : saw_frames_                    ? "actions+sensory-frames"
                                                        : "observations";
+    if (carmen_) sum_.objects_out = carmen_->linesWritten();
     static_cast<ScanCounters&>(sum_) = filter_.counters();
     sum_.source = source_->counters();
     sum_.sensors = filter_.sensorCount();

@@ -28,6 +28,8 @@ NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
     sum.labels = (out.parent_path() / out.stem()).string() + ".labels.csv";
     checkOutputPaths({{"input rawlog", o.input}},
                      {{"output rawlog", sum.rawlog}, {"labels", sum.labels}});
+    checkOutputName({"output rawlog", sum.rawlog}, {".rawlog"},
+                    "kfd-inject writes an MRPT rawlog (.rawlog)");
     RealNoiseInjector noise;
     try {
         noise.initialize(o.noise);

@@ -104,6 +104,9 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
                       {"ground truth", sum.ground_truth},
                       {"odometry", sum.odometry},
                       {"labels", sum.labels}});
+    if (!sum.rawlog.empty())
+        checkOutputName({"output rawlog", sum.rawlog}, {".rawlog"},
+                        "kfd-simulate writes an MRPT rawlog (.rawlog)");
     World world;
     SensorModel sensor;
     NoiseInjector noise;

@@ -57,6 +57,15 @@ void checkOutputPaths(const std::vector<NamedPath>& inputs, const std::vector<Na
 /// would replace the device node or the FIFO by a regular file. No stdout form exists.
 void checkRegularOutput(const NamedPath& output);
 
+/// True when the name of `path` ends in `extension` (".rawlog", ".clf.gz"), letter case aside.
+bool hasExtension(const std::string& path, const std::string& extension);
+
+/// Throws PathError when the name of `output` ends in none of `extensions` (hasExtension): "the
+/// output rawlog y.txt: " + `formats` + "; its name says none of them", e.g. formats = "kfd-
+/// simulate writes an MRPT rawlog (.rawlog)". An output is written in the format its name says.
+void checkOutputName(const NamedPath& output, const std::vector<std::string>& extensions,
+                     const std::string& formats);
+
 /// The one writer of kfd's output bytes: a file written through its descriptor with every error
 /// checked. write() buffers (64 KiB) and throws WriteError when write(2) fails (ENOSPC, EIO,
 /// EFBIG...); close() flushes, fsyncs, checks that the file holds exactly the bytes written

@@ -17,8 +17,10 @@ struct AteResult {
 /// Matches each estimated pose to the nearest ground-truth stamp (within max_dt), finds the
 /// rigid SE(2) transform that best aligns the estimated positions to the ground truth in the
 /// least-squares sense (closed form, Umeyama 1991 without scale), and reports the translation
-/// errors. Throws EvalError when fewer than 2 poses match or max_dt is negative or not finite
-/// (field "max_dt"). `gt` must be sorted by time.
+/// errors. Throws EvalError when fewer than 2 poses match, when fewer than half of the
+/// estimate's poses match (the message gives matched and unmatched counts and max_dt: such a
+/// ground truth belongs to another log), or when max_dt is negative or not finite (field
+/// "max_dt"). `gt` must be sorted by time.
 AteResult computeAte(const Trajectory& est, const Trajectory& gt, double max_dt);
 
 struct RpeResult {

@@ -23,7 +23,8 @@ struct RawlogProgress {
 
 struct RawlogFilterOptions {
     std::string input;      // any log openSource() reads: rawlog, ROS 1 bag, CARMEN log
-    std::string output;     // .bag: a filtered bag (input must be a bag); else a rawlog.
+    std::string output;     // by its name: .rawlog, .bag (a filtered bag: input must be a
+                            // bag), .clf/.log[.gz] (a CARMEN log); any other name is refused.
                             // Written to a temporary file, renamed on success
     SourceOptions source;   // a bag's topics and frames
     BagWriterOptions bag;   // a bag output's compression and removed-point mark
@@ -83,7 +84,12 @@ struct RawlogFilterSummary : ScanCounters {
 /// odometry in the observations layout, the bag's other topics left out. A bag output (the
 /// output's name ends in .bag; the input must be a bag) copies every message of the input in
 /// order, except the dropped scans; a kept scan keeps every field, its removed points written
-/// as NaN or +Inf (BagWriterOptions::removed, REP 117). Non-keyframe scans are
+/// as NaN or +Inf (BagWriterOptions::removed, REP 117). A CARMEN output (.clf, .log, .clf.gz,
+/// .log.gz; any input) holds the kept scans as FLASER/RLASER lines and the odometry as ODOM
+/// lines, in input order (kfd/mrpt/carmen_writer.h: removed points as 0, "no reading"); every
+/// other object is left out, and a kept scan without odometry is a RawlogError (a FLASER line
+/// carries the odometry). Any other output name (not .rawlog) is a RawlogError listing the
+/// formats, before anything is read or written. Non-keyframe scans are
 /// removed; a sensory frame left empty is dropped and its odometry action is composed into the
 /// next kept action, so the output's odometry still adds up. Every scan goes through the one
 /// door (StreamFilter::process); a scan it skips (beam count outside [2, 65 536], aperture not
