@@ -52,6 +52,16 @@ TEST(GroundTruthFormat, RelationsWithAFewBackwardPairsAreStillRelations) {
     EXPECT_EQ(formatOf(d, text), GroundTruthFormat::Relations);
 }
 
+TEST(GroundTruthFormat, StraightLineRelationsChainedByStampAreRelations) {
+    TempDir d;  // a simulated robot driving straight: y, z, roll, pitch and yaw all 0, so
+                // columns 4-6 are zero as in a planar TUM file; the chained stamps decide
+    std::string text;
+    for (int i = 0; i < 30; ++i)
+        text += std::to_string(100.0 + 0.5 * i) + " " + std::to_string(100.5 + 0.5 * i) +
+                " 0.376 0 0 0 0 0\n";
+    EXPECT_EQ(formatOf(d, text), GroundTruthFormat::Relations);
+}
+
 TEST(GroundTruthFormat, TumFilesKfdWritesAreTum) {
     TempDir d;
     for (const double t0 : {0.0, 1.7e9}) {  // a simulation's stamps from 0 and epoch stamps

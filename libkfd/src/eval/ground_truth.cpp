@@ -71,8 +71,13 @@ GroundTruthGuess detectGroundTruthFormat(const std::string& path) {
     const bool tum = most(g.zero_4_to_6) || most(g.unit_quat);
     if (relations != tum)
         g.format = relations ? GroundTruthFormat::Relations : GroundTruthFormat::Tum;
-    else if (relations && most(g.unit_quat))  // both: a yaw of +-1 rad in 90 % of the relations
-        g.format = GroundTruthFormat::Tum;    // is no benchmark's; unit quaternions are TUM's
+    // Both fit. Column 2 holding other rows' stamps is relations' (a TUM x never equals them;
+    // straight-line relations have y, z, roll, pitch 0 like a planar TUM file). Else a yaw of
+    // +-1 rad in 90 % of the relations is no benchmark's; unit quaternions are TUM's.
+    else if (relations && most(g.shared_stamp))
+        g.format = GroundTruthFormat::Relations;
+    else if (relations && most(g.unit_quat))
+        g.format = GroundTruthFormat::Tum;
     return g;
 }
 
