@@ -71,13 +71,14 @@ GroundTruthGuess detectGroundTruthFormat(const std::string& path) {
     const bool tum = most(g.zero_4_to_6) || most(g.unit_quat);
     if (relations != tum)
         g.format = relations ? GroundTruthFormat::Relations : GroundTruthFormat::Tum;
-    // Both fit. Column 2 holding other rows' stamps is relations' (a TUM x never equals them;
-    // straight-line relations have y, z, roll, pitch 0 like a planar TUM file). Else a yaw of
-    // +-1 rad in 90 % of the relations is no benchmark's; unit quaternions are TUM's.
-    else if (relations && most(g.shared_stamp))
-        g.format = GroundTruthFormat::Relations;
+    // Both fit. Unit quaternions in 90 % of the rows are TUM's (a yaw of +-1 rad in 90 % of the
+    // relations is no benchmark's); else column 2 holding later stamps that are other rows'
+    // stamps is a chain of relations (straight-line relations have y, z, roll, pitch 0 like a
+    // planar TUM file; a hand-made TUM x may equal a stamp, but not always a later one).
     else if (relations && most(g.unit_quat))
         g.format = GroundTruthFormat::Tum;
+    else if (relations && most(g.shared_stamp) && most(g.later_stamp))
+        g.format = GroundTruthFormat::Relations;
     return g;
 }
 
