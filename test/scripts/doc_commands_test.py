@@ -229,7 +229,12 @@ class DocCommands(unittest.TestCase):
         its jobs are emitted (the options and logs are checked) and one small real run on the
         bundled log fills the output folder for the collect and diagnose commands after it."""
         args = argv[2:]
+        if "--help" in args or "-h" in args:
+            return argv
         scratch.last_compare_run = [a for a in args if a != "..."]
+        for opt, tool in (("--exe", "kfd-icp-slam"), ("--sim-exe", "kfd-simulate")):
+            if opt not in args:  # this build's apps (the tree may have no build/apps)
+                args += [opt, os.path.join(APPS, tool)]
         datasets = os.environ.get("KFD_DATASETS_DIR", "")
         logs_at = args.index("--logs") if "--logs" in args else -1
         if logs_at >= 0:
@@ -246,7 +251,8 @@ class DocCommands(unittest.TestCase):
         out = args[args.index("--out") + 1] if "--out" in args else None
         if out and not os.path.exists(os.path.join(scratch.dir, out, "runs")):
             r = scratch.run(argv[:2] + ["--logs", BUNDLED, "--modes", "none", "kfd",
-                                        "--repeats", "2", "--jobs", "2", "-q", "--out", out])
+                                        "--repeats", "2", "--jobs", "2", "-q", "--out", out,
+                                        "--exe", os.path.join(APPS, "kfd-icp-slam")])
             self.assertEqual(r.returncode, 0, f"small kfd-compare run: {r.stderr[-1500:]}")
         return emitted
 

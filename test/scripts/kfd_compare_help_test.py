@@ -9,6 +9,8 @@ import unittest
 
 from kfd_tools import compare
 
+EXE = None
+
 
 def commands():
     ap = compare.build_parser()
@@ -44,8 +46,10 @@ class HelpTest(unittest.TestCase):
     def test_a_dataset_name_without_datasets_says_where_they_are_expected(self):
         with tempfile.TemporaryDirectory() as tmp:
             missing = os.path.join(tmp, "no-datasets")
+            exe = ["--exe", EXE] if EXE else []  # this build's (a tree may have no build/)
             p = subprocess.run([sys.executable, "-m", "kfd_tools.compare", "run", "--logs", "aces",
-                                "--datasets", missing, "--out", os.path.join(tmp, "o"), "-q"],
+                                "--datasets", missing, "--out", os.path.join(tmp, "o"), "-q"]
+                               + exe,
                                capture_output=True, text=True)
             self.assertEqual(p.returncode, 1, p.stderr)
             self.assertIn("the datasets folder " + missing + " does not exist", p.stderr)
@@ -53,4 +57,5 @@ class HelpTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    EXE = sys.argv[1] if len(sys.argv) > 1 else None  # the kfd-icp-slam under test
+    unittest.main(argv=sys.argv[:1])
