@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -47,8 +48,10 @@ class ScanFilterNodeTest : public ::testing::Test {
         core_ = fork();
         if (core_ == 0) {
             setpgid(0, 0);
+            prctl(PR_SET_PDEATHSIG, SIGINT);  // a test killed by its timeout takes roscore along
             const std::string port = std::to_string(port_);
             freopen("/dev/null", "w", stdout);
+            freopen("/dev/null", "w", stderr);
             execlp("roscore", "roscore", "-p", port.c_str(), static_cast<char*>(nullptr));
             _exit(127);
         }

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <thread>
 
 namespace kfd::ros1 {
 
@@ -62,9 +63,15 @@ ScanFilterNode::ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh, const No
     scan_pub_ = nh_.advertise<sensor_msgs::LaserScan>("scan_filtered", q);
     diag_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1);
     stats_pub_ = pnh_.advertise<diagnostic_msgs::DiagnosticStatus>("stats", 1, true);
-    if (config_.odometry == NodeConfig::Odometry::Topic)
-        odom_sub_ = nh_.subscribe("odom", 50, &ScanFilterNode::onOdometry, this,
-                                  ros::TransportHints().tcpNoDelay());
+    if (config_.odometry == NodeConfig::Odometry::Topic) {
+        ros::SubscribeOptions o = ros::SubscribeOptions::create<nav_msgs::Odometry>(
+            "odom", 50, [this](const nav_msgs::Odometry::ConstPtr& m) { onOdometry(m); },
+            ros::VoidPtr(), &odom_queue_);
+        o.transport_hints = ros::TransportHints().tcpNoDelay();
+        odom_sub_ = nh_.subscribe(o);
+        odom_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &odom_queue_);
+        odom_spinner_->start();
+    }
     scan_sub_ =
         nh_.subscribe("scan", q, &ScanFilterNode::onScan, this, ros::TransportHints().tcpNoDelay());
     timer_ = nh_.createWallTimer(ros::WallDuration(1.0),
@@ -73,6 +80,9 @@ ScanFilterNode::ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh, const No
 
 ScanFilterNode::~ScanFilterNode() {
     timer_.stop();
+    if (odom_spinner_) odom_spinner_->stop();
+    odom_sub_.shutdown();
+    scan_sub_.shutdown();
     if (ros::ok()) publishStats();
 }
 
@@ -82,30 +92,48 @@ LiveCounters ScanFilterNode::counters() const {
 }
 
 void ScanFilterNode::onOdometry(const nav_msgs::Odometry::ConstPtr& m) {
-    std::lock_guard<std::mutex> lock(mutex_);
     const double t = m->header.stamp.isZero() ? ros::Time::now().toSec() : m->header.stamp.toSec();
     const Pose2D p{m->pose.pose.position.x, m->pose.pose.position.y,
                    yawOf(m->pose.pose.orientation)};
-    // Time jumped back (a bag looping): the older samples belong to another stream.
-    if (odom_buffer_.size() > 0 && t < odom_buffer_.newest() - config_.reset_jump)
-        odom_buffer_.clear();
-    odom_buffer_.add(t, p);
+    {
+        std::lock_guard<std::mutex> lock(odom_mutex_);
+        // Time jumped back (a bag looping): the older samples belong to another stream.
+        if (odom_buffer_.size() > 0 && t < odom_buffer_.newest() - config_.reset_jump)
+            odom_buffer_.clear();
+        odom_buffer_.add(t, p);
+    }
+    odom_cv_.notify_all();
 }
 
 std::optional<Pose2D> ScanFilterNode::odometryAt(const ros::Time& stamp) {
     switch (config_.odometry) {
         case NodeConfig::Odometry::None:
             return std::nullopt;
-        case NodeConfig::Odometry::Topic:
-            return odom_buffer_.at(stamp.toSec());
-        case NodeConfig::Odometry::Tf:
+        case NodeConfig::Odometry::Topic: {
+            // The sample after the scan usually comes just after it: wait for it at most
+            // ~tf_wait, then the bag source's rule on what there is (kfd-filter's lookahead).
+            const double t = stamp.toSec();
+            std::unique_lock<std::mutex> lock(odom_mutex_);
+            odom_cv_.wait_for(lock, std::chrono::duration<double>(config_.tf_wait), [&] {
+                return odom_buffer_.size() > 0 && odom_buffer_.newest() >= t;
+            });
+            return odom_buffer_.at(t);
+        }
+        case NodeConfig::Odometry::Tf: {
+            // Polled every 0.5 ms of wall time for at most ~tf_wait (tf2's own timed lookup
+            // sleeps in steps of 10 ms: too coarse for a laser at 40 Hz).
+            const auto deadline =
+                std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.tf_wait);
+            while (!tf_->canTransform(config_.odom_frame, config_.base_frame, stamp) &&
+                   std::chrono::steady_clock::now() < deadline && ros::ok())
+                std::this_thread::sleep_for(std::chrono::microseconds(500));
             try {
-                const auto t = tf_->lookupTransform(config_.odom_frame, config_.base_frame, stamp,
-                                                    ros::Duration(config_.tf_wait));
-                return poseOf(t.transform);
+                return poseOf(
+                    tf_->lookupTransform(config_.odom_frame, config_.base_frame, stamp).transform);
             } catch (const tf2::TransformException&) {
                 return std::nullopt;
             }
+        }
     }
     return std::nullopt;
 }
@@ -130,6 +158,7 @@ void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
     const ros::Time now = ros::Time::now();
     const ros::Time stamp = in->header.stamp.isZero() ? now : in->header.stamp;
     if (ros::Time::isSimTime() && filter_.onClock(now.toSec())) {
+        std::lock_guard<std::mutex> odom_lock(odom_mutex_);
         odom_buffer_.clear();
         ROS_WARN("kfd: the ROS clock jumped back to %.3f s (a bag looping?): state reset",
                  now.toSec());
@@ -140,6 +169,7 @@ void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
     const LiveResult r = filter_.process(*out, stamp.toSec(), odom,
                                          config_.odometry != NodeConfig::Odometry::None, mount);
     if (r.reset) {
+        std::lock_guard<std::mutex> odom_lock(odom_mutex_);
         odom_buffer_.clear();
         ROS_WARN("kfd: time jumped back on frame '%s' (scan at %.3f s): state reset",
                  in->header.frame_id.c_str(), stamp.toSec());

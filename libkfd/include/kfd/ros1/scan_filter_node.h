@@ -10,6 +10,10 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <ros/callback_queue.h>
+#include <ros/spinner.h>
+
+#include <condition_variable>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -35,7 +39,8 @@ class ScanFilterNode {
 
     /// One scan (the `scan` subscriber's callback; tests call it directly).
     void onScan(const sensor_msgs::LaserScan::ConstPtr& m);
-    /// One odometry message (`odom`, with ~odom: topic).
+    /// One odometry message (`odom`, with ~odom: topic; served on a thread of its own, so that
+    /// onScan can wait for the sample after a scan).
     void onOdometry(const nav_msgs::Odometry::ConstPtr& m);
 
     /// The ~stats message (keys in docs/USAGE.md).
@@ -59,14 +64,20 @@ class ScanFilterNode {
 
     NodeConfig config_;
     ros::NodeHandle nh_, pnh_;
-    mutable std::mutex mutex_;
+    mutable std::mutex mutex_;  // the filter, the mounts, the latencies
     LiveFilter filter_;
+    std::mutex odom_mutex_;  // the odometry samples (their own thread: see onOdometry)
+    std::condition_variable odom_cv_;
     OdometryBuffer odom_buffer_;
     LatencyStats latency_;
     std::map<std::string, Pose2D> mounts_;  // per laser frame, once found in /tf(_static)
     std::unique_ptr<tf2_ros::Buffer> tf_;
     std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+    // `odom` is served by its own thread, so that a scan can wait for the sample after it (the
+    // queue outlives the subscriber: declared first).
+    ros::CallbackQueue odom_queue_;
     ros::Subscriber scan_sub_, odom_sub_;
+    std::unique_ptr<ros::AsyncSpinner> odom_spinner_;
     ros::Publisher scan_pub_, diag_pub_, stats_pub_;
     ros::WallTimer timer_;
 };
