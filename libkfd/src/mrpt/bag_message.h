@@ -15,6 +15,7 @@
 #include <cstring>
 #include <vector>
 
+#include "kfd/mrpt/laser_scan.h"
 #include "kfd/mrpt/source.h"
 
 namespace kfd {
@@ -51,12 +52,6 @@ struct NativeMessage {
         return p;
     }
 };
-
-/// The one beam validity rule of a LaserScan (the source's and the writer's): finite and
-/// range_min <= r < range_max (r = range_max is "no return", as in MRPT's rawlogs and CARMEN).
-inline bool validRange(const sensor_msgs::LaserScan& m, float r) {
-    return std::isfinite(r) && r >= m.range_min && r < m.range_max;
-}
 
 /// The message types kfd deserializes, by their serialized layout.
 enum class MessageLayout { LaserScan, Odometry, TfMessage };

@@ -20,6 +20,7 @@
 #include "bag_reader.h"
 #include "kfd/core/format.h"
 #include "kfd/core/pose.h"
+#include "kfd/mrpt/laser_scan.h"
 
 namespace kfd {
 namespace {
@@ -48,17 +49,6 @@ std::string stripSlash(const std::string& s) {
 
 double yawOf(const geometry_msgs::Quaternion& q) {
     return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
-}
-
-// True when a LaserScan's angle fields describe its beam count: finite, an increment that is
-// not 0, and (angle_max - angle_min) / angle_increment within one beam of n - 1 (its sign
-// then matches the span's). Fewer than 2 beams: left to the door (no_beams).
-bool anglesMatch(const sensor_msgs::LaserScan& m) {
-    const std::size_t n = m.ranges.size();
-    if (n < 2) return true;
-    const double lo = m.angle_min, hi = m.angle_max, inc = m.angle_increment;
-    if (!std::isfinite(lo) || !std::isfinite(hi) || !std::isfinite(inc) || inc == 0.0) return false;
-    return std::fabs((hi - lo) / inc - static_cast<double>(n - 1)) <= 1.0;
 }
 
 struct TopicInfo {
@@ -434,37 +424,12 @@ struct BagSource::Impl {
         return record;
     }
 
-    // The MRPT scan of a LaserScan stamped `stamp`. Angle fields that do not match the beam
-    // count give an aperture of NaN (the door skips the scan: bad_aperture; counted).
+    // The MRPT scan of a LaserScan stamped `stamp` (kfd/mrpt/laser_scan.h, the node's too);
+    // angle fields that do not match the beam count are counted.
     CObservation2DRangeScan::Ptr toScan(const sensor_msgs::LaserScan& m, double stamp) {
-        auto obs = std::make_shared<CObservation2DRangeScan>();
-        obs->sensorLabel = label;
-        obs->timestamp = mrpt::Clock::fromDouble(stamp);
-        const std::size_t n = m.ranges.size();
-        const bool angles_ok = anglesMatch(m);
-        counts.scans_bad_angles += angles_ok ? 0 : 1;
-        obs->aperture =
-            angles_ok ? static_cast<float>(std::fabs(double(m.angle_max) - double(m.angle_min)))
-                      : std::numeric_limits<float>::quiet_NaN();
-        obs->rightToLeft = !angles_ok || m.angle_increment >= 0.0f;
-        obs->maxRange = m.range_max;
-        const double mid = angles_ok ? 0.5 * (double(m.angle_min) + double(m.angle_max)) : 0.0;
-        obs->sensorPose = mrpt::poses::CPose3D(choice.mount_x, choice.mount_y, 0.0,
-                                               choice.mount_yaw + mid, 0.0, 0.0);
-        obs->resizeScan(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            const float r = m.ranges[i];
-            obs->setScanRange(i, std::isfinite(r) ? r : 0.0f);
-            obs->setScanRangeValidity(i, validRange(m, r));
-        }
-        if (m.intensities.size() == n && n > 0) {
-            obs->setScanHasIntensity(true);
-            for (std::size_t i = 0; i < n; ++i)
-                obs->setScanIntensity(
-                    i, static_cast<int32_t>(
-                           std::lround(std::isfinite(m.intensities[i]) ? m.intensities[i] : 0.f)));
-        }
-        return obs;
+        counts.scans_bad_angles += laserAnglesMatch(m) ? 0 : 1;
+        return laserScanToObservation(m, stamp, label,
+                                      Pose2D{choice.mount_x, choice.mount_y, choice.mount_yaw});
     }
 
     // Reads one message into the queue; false at the end of the bag.

@@ -120,17 +120,7 @@ std::size_t BagWriter::writeScan(const NativeMessage& original,
     if (!ls)
         throw BagError(impl_->name + ": the message on " + m.topic() + " is not a LaserScan",
                        impl_->name);
-    const float mark = impl_->options.removed == RemovedMark::NaN
-                           ? std::numeric_limits<float>::quiet_NaN()
-                           : std::numeric_limits<float>::infinity();
-    std::size_t marked = 0;
-    const std::size_t n = std::min(ls->ranges.size(), cleaned.getScanSize());
-    for (std::size_t i = 0; i < n; ++i) {
-        if (validRange(*ls, ls->ranges[i]) && !cleaned.getScanRangeValidity(i)) {
-            ls->ranges[i] = mark;
-            ++marked;
-        }
-    }
+    const std::size_t marked = markRemovedBeams(*ls, cleaned, impl_->options.removed);
     impl_->guarded(
         [&](rosbag::Bag& bag) { bag.write(m.topic(), m.time, *ls, m.connection->header); },
         "failed writing a scan");

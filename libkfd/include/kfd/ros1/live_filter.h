@@ -1,0 +1,80 @@
+// The live side of the one door: LaserScan messages as a robot or `rosbag play` delivers them,
+// each through kfd::StreamFilter::process, with the rules a live stream needs (time jumping
+// back, scans out of order, several lasers). No ROS communication: ScanFilterNode wires it to
+// topics; tests drive it with hand-made messages.
+#pragma once
+
+#include <sensor_msgs/LaserScan.h>
+
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "kfd/core/pipeline.h"
+#include "kfd/mrpt/bag_writer.h"
+#include "kfd/mrpt/stream_filter.h"
+
+namespace kfd::ros1 {
+
+/// The node's counters (its ~stats and /diagnostics keys).
+struct LiveCounters {
+    std::size_t scans_in = 0;         // every LaserScan received
+    std::size_t scans_kept = 0;       // published on scan_filtered
+    std::size_t points_removed = 0;   // beams marked NaN/+Inf in the published scans
+    std::size_t out_of_order = 0;     // dropped: older than the last scan of its frame
+    std::size_t odom_missing = 0;     // scans filtered laser-only: no odometry at their stamp
+    std::size_t resets = 0;           // state forgotten: time jumped back
+    std::size_t geometry_resets = 0;  // a frame's beam count or angles changed (the door's reset)
+    std::size_t scans_skipped = 0;    // unusable geometry (the door's check): not published
+};
+
+/// What LiveFilter::process decided for one message.
+struct LiveResult {
+    bool publish = false;       // a keyframe: publish the marked message
+    bool reset = false;         // time jumped back: every frame's state was forgotten first
+    bool out_of_order = false;  // dropped without reaching the door
+    std::size_t removed = 0;    // beams marked in the message
+    StreamResult stream;        // the door's result (default when out_of_order)
+};
+
+class LiveFilter {
+  public:
+    struct Params {
+        Pipeline::Params pipeline;               // kfd's configuration
+        RemovedMark removed = RemovedMark::NaN;  // how removed beams are marked (REP 117)
+        /// s: a scan this much (or more) older than the last scan of its frame means time
+        /// jumped back (a bag looping, a simulator restarting): every frame's state is reset
+        /// and the scan goes on as the first of a new stream. A scan older by less is out of
+        /// order and dropped.
+        double reset_jump = 1.0;
+    };
+
+    explicit LiveFilter(const Params& p);
+
+    /// One received scan: `m` is marked in place (removed beams) and is what to publish when
+    /// the result says so. `stamp`: the scan's time (s; its header's, or the receive time
+    /// when that is 0). `odometry`: the robot's pose at that stamp, nothing when unknown
+    /// (`odom_expected`: the node has an odometry source, so unknown counts odom_missing).
+    /// `mount`: the laser in the robot's base frame.
+    LiveResult process(sensor_msgs::LaserScan& m, double stamp,
+                       const std::optional<Pose2D>& odometry, bool odom_expected,
+                       const Pose2D& mount = Pose2D{0.0, 0.0, 0.0});
+
+    /// Forgets every frame's state (the counters stay); what a time jump does.
+    void reset();
+    const LiveCounters& counters() const { return counters_; }
+    const StreamFilter& door() const { return door_; }
+    const Params& params() const { return params_; }
+
+  private:
+    Params params_;
+    StreamFilter door_;
+    std::map<std::string, double> last_stamp_;  // per frame_id
+    LiveCounters counters_;
+};
+
+/// The sensor label of a frame_id: without its leading '/' (as the bag source labels a topic).
+std::string frameLabel(const std::string& frame_id);
+
+}  // namespace kfd::ros1

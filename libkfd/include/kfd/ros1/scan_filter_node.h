@@ -1,0 +1,71 @@
+// kfd on a live robot (ROS 1): LaserScans on `scan` through kfd's one door, keyframes out on
+// `scan_filtered`, diagnostics on /diagnostics and ~stats. kfd_node's main and the
+// kfd/FilterNodelet nodelet both wrap this class (docs/USAGE.md, "kfd_node (ROS 1)").
+#pragma once
+
+#include <diagnostic_msgs/DiagnosticStatus.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "kfd/ros1/latency_stats.h"
+#include "kfd/ros1/live_filter.h"
+#include "kfd/ros1/node_config.h"
+#include "kfd/ros1/odometry_buffer.h"
+
+namespace kfd::ros1 {
+
+class ScanFilterNode {
+  public:
+    /// Reads the private parameters of `pnh` (nodeConfig: kfd::ConfigError naming the key when
+    /// one is unknown or bad; the wrappers refuse to start), then subscribes and advertises on
+    /// `nh` (`scan`, `odom`, `scan_filtered`, /diagnostics) and `pnh` (~stats).
+    ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh);
+    ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeConfig& config);
+    /// Publishes ~stats once more.
+    ~ScanFilterNode();
+
+    /// One scan (the `scan` subscriber's callback; tests call it directly).
+    void onScan(const sensor_msgs::LaserScan::ConstPtr& m);
+    /// One odometry message (`odom`, with ~odom: topic).
+    void onOdometry(const nav_msgs::Odometry::ConstPtr& m);
+
+    /// The ~stats message (keys in docs/USAGE.md).
+    diagnostic_msgs::DiagnosticStatus stats() const;
+    /// Publishes stats() on ~stats and /diagnostics.
+    void publishStats();
+
+    const NodeConfig& config() const { return config_; }
+    LiveCounters counters() const;
+
+    /// The private parameters of `pnh` by name (without '~'); a nested one (~a/b) under its
+    /// top-level name (a map).
+    static std::map<std::string, XmlRpc::XmlRpcValue> privateParams(const ros::NodeHandle& pnh);
+
+  private:
+    std::optional<Pose2D> odometryAt(const ros::Time& stamp);
+    Pose2D mountOf(const std::string& frame_id);
+
+    NodeConfig config_;
+    ros::NodeHandle nh_, pnh_;
+    mutable std::mutex mutex_;
+    LiveFilter filter_;
+    OdometryBuffer odom_buffer_;
+    LatencyStats latency_;
+    std::map<std::string, Pose2D> mounts_;  // per laser frame, once found in /tf(_static)
+    std::unique_ptr<tf2_ros::Buffer> tf_;
+    std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+    ros::Subscriber scan_sub_, odom_sub_;
+    ros::Publisher scan_pub_, diag_pub_, stats_pub_;
+    ros::WallTimer timer_;
+};
+
+}  // namespace kfd::ros1

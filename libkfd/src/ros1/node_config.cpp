@@ -1,0 +1,142 @@
+#include "kfd/ros1/node_config.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "kfd/mrpt/config.h"
+#include "kfd/mrpt/default_stages.h"
+
+namespace kfd::ros1 {
+
+namespace {
+
+using XmlRpc::XmlRpcValue;
+
+const char* typeName(XmlRpcValue::Type t) {
+    switch (t) {
+        case XmlRpcValue::TypeBoolean:
+            return "a bool";
+        case XmlRpcValue::TypeInt:
+            return "an int";
+        case XmlRpcValue::TypeDouble:
+            return "a double";
+        case XmlRpcValue::TypeString:
+            return "a string";
+        case XmlRpcValue::TypeArray:
+            return "a list";
+        case XmlRpcValue::TypeStruct:
+            return "a map";
+        default:
+            return "a value of another type";
+    }
+}
+
+// A scalar parameter as text (a double as %.17g so that no digit is lost).
+std::string scalarText(const std::string& key, XmlRpcValue v) {
+    switch (v.getType()) {
+        case XmlRpcValue::TypeBoolean:
+            return bool(v) ? "true" : "false";
+        case XmlRpcValue::TypeInt:
+            return std::to_string(int(v));
+        case XmlRpcValue::TypeDouble: {
+            std::ostringstream s;
+            s.precision(17);
+            s << double(v);
+            return s.str();
+        }
+        case XmlRpcValue::TypeString:
+            return std::string(v);
+        default:
+            throw ConfigError(
+                key, std::string("is ") + typeName(v.getType()) + ", not a number, bool or string");
+    }
+}
+
+// A kfd key's value: a scalar, or a list of scalars joined with commas (`pipeline`).
+std::string keyText(const std::string& key, XmlRpcValue v) {
+    if (v.getType() != XmlRpcValue::TypeArray) return scalarText(key, v);
+    std::string text;
+    for (int i = 0; i < v.size(); ++i) text += (i ? "," : "") + scalarText(key, v[i]);
+    return text;
+}
+
+std::string stringParam(const std::string& key, XmlRpcValue v) {
+    if (v.getType() != XmlRpcValue::TypeString)
+        throw ConfigError(key, std::string("is ") + typeName(v.getType()) + ", not a string");
+    return std::string(v);
+}
+
+double secondsParam(const std::string& key, XmlRpcValue v, double lo, double hi) {
+    double d = 0.0;
+    if (v.getType() == XmlRpcValue::TypeDouble)
+        d = double(v);
+    else if (v.getType() == XmlRpcValue::TypeInt)
+        d = int(v);
+    else
+        throw ConfigError(key, std::string("is ") + typeName(v.getType()) + ", not a number");
+    if (!std::isfinite(d) || d < lo || d > hi) {
+        std::ostringstream s;
+        s << d << " is outside [" << lo << ", " << hi << "] s";
+        throw ConfigError(key, s.str());
+    }
+    return d;
+}
+
+}  // namespace
+
+bool isNodeParameter(const std::string& name) {
+    for (const char* n : {"config", "odom", "odom_frame", "base_frame", "tf_wait", "removed_as",
+                          "reset_jump", "queue_size"})
+        if (name == n) return true;
+    return false;
+}
+
+NodeConfig nodeConfig(const std::map<std::string, XmlRpc::XmlRpcValue>& params) {
+    NodeConfig c;
+    if (const auto it = params.find("config"); it != params.end())
+        c.config_path = stringParam("config", it->second);
+    c.pipeline = c.config_path.empty() ? kfdDefaults() : loadConfigFile(c.config_path);
+    for (const auto& [key, value] : params) {
+        if (key == "odom") {
+            const std::string s = stringParam(key, value);
+            if (s == "tf")
+                c.odometry = NodeConfig::Odometry::Tf;
+            else if (s == "topic")
+                c.odometry = NodeConfig::Odometry::Topic;
+            else if (s == "none")
+                c.odometry = NodeConfig::Odometry::None;
+            else
+                throw ConfigError(key, "'" + s + "' is not tf, topic or none");
+        } else if (key == "odom_frame") {
+            c.odom_frame = stringParam(key, value);
+        } else if (key == "base_frame") {
+            c.base_frame = stringParam(key, value);
+        } else if (key == "tf_wait") {
+            c.tf_wait = secondsParam(key, value, 0.0, 10.0);
+        } else if (key == "reset_jump") {
+            c.reset_jump = secondsParam(key, value, 0.0, 1e9);
+        } else if (key == "queue_size") {
+            if (value.getType() != XmlRpc::XmlRpcValue::TypeInt)
+                throw ConfigError(key,
+                                  std::string("is ") + typeName(value.getType()) + ", not an int");
+            const int q = int(XmlRpc::XmlRpcValue(value));
+            if (q < 1 || q > 1000)
+                throw ConfigError(key, std::to_string(q) + " is outside [1, 1000]");
+            c.queue_size = q;
+        } else if (key == "removed_as") {
+            try {
+                c.removed = parseRemovedMark(stringParam(key, value));
+            } catch (const ConfigError&) {
+                throw;
+            } catch (const Error& e) {
+                throw ConfigError(key, e.what());
+            }
+        } else if (key != "config") {
+            applyConfigKey(c.pipeline, key, keyText(key, value), defaultStageRegistry());
+        }
+    }
+    validateConfig(c.pipeline, defaultStageRegistry());
+    return c;
+}
+
+}  // namespace kfd::ros1

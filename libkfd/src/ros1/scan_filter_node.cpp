@@ -1,0 +1,185 @@
+#include "kfd/ros1/scan_filter_node.h"
+
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <diagnostic_msgs/KeyValue.h>
+#include <tf2/exceptions.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+namespace kfd::ros1 {
+
+namespace {
+
+double yawOf(const geometry_msgs::Quaternion& q) {
+    return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
+}
+
+Pose2D poseOf(const geometry_msgs::Transform& t) {
+    return Pose2D{t.translation.x, t.translation.y, yawOf(t.rotation)};
+}
+
+diagnostic_msgs::KeyValue kv(const std::string& k, double v) {
+    diagnostic_msgs::KeyValue r;
+    r.key = k;
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), "%.10g", v);
+    r.value = buf;
+    return r;
+}
+
+}  // namespace
+
+std::map<std::string, XmlRpc::XmlRpcValue> ScanFilterNode::privateParams(
+    const ros::NodeHandle& pnh) {
+    std::map<std::string, XmlRpc::XmlRpcValue> out;
+    std::vector<std::string> names;
+    ros::param::getParamNames(names);
+    const std::string ns = pnh.getNamespace() + "/";
+    for (const std::string& name : names) {
+        if (name.compare(0, ns.size(), ns) != 0) continue;
+        std::string key = name.substr(ns.size());
+        key = key.substr(0, key.find('/'));
+        if (key.empty() || out.count(key)) continue;
+        XmlRpc::XmlRpcValue v;
+        if (pnh.getParam(key, v)) out[key] = v;
+    }
+    return out;
+}
+
+ScanFilterNode::ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : ScanFilterNode(nh, pnh, nodeConfig(privateParams(pnh))) {}
+
+ScanFilterNode::ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeConfig& config)
+    : config_(config),
+      nh_(nh),
+      pnh_(pnh),
+      filter_(LiveFilter::Params{config.pipeline, config.removed, config.reset_jump}) {
+    tf_ = std::make_unique<tf2_ros::Buffer>();
+    tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_, nh_, true);
+    const auto q = static_cast<std::uint32_t>(config_.queue_size);
+    scan_pub_ = nh_.advertise<sensor_msgs::LaserScan>("scan_filtered", q);
+    diag_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1);
+    stats_pub_ = pnh_.advertise<diagnostic_msgs::DiagnosticStatus>("stats", 1, true);
+    if (config_.odometry == NodeConfig::Odometry::Topic)
+        odom_sub_ = nh_.subscribe("odom", 50, &ScanFilterNode::onOdometry, this,
+                                  ros::TransportHints().tcpNoDelay());
+    scan_sub_ =
+        nh_.subscribe("scan", q, &ScanFilterNode::onScan, this, ros::TransportHints().tcpNoDelay());
+    timer_ = nh_.createWallTimer(ros::WallDuration(1.0),
+                                 [this](const ros::WallTimerEvent&) { publishStats(); });
+}
+
+ScanFilterNode::~ScanFilterNode() {
+    timer_.stop();
+    if (ros::ok()) publishStats();
+}
+
+LiveCounters ScanFilterNode::counters() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return filter_.counters();
+}
+
+void ScanFilterNode::onOdometry(const nav_msgs::Odometry::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const double t = m->header.stamp.isZero() ? ros::Time::now().toSec() : m->header.stamp.toSec();
+    const Pose2D p{m->pose.pose.position.x, m->pose.pose.position.y,
+                   yawOf(m->pose.pose.orientation)};
+    // Time jumped back (a bag looping): the older samples belong to another stream.
+    if (odom_buffer_.size() > 0 && t < odom_buffer_.newest() - config_.reset_jump)
+        odom_buffer_.clear();
+    odom_buffer_.add(t, p);
+}
+
+std::optional<Pose2D> ScanFilterNode::odometryAt(const ros::Time& stamp) {
+    switch (config_.odometry) {
+        case NodeConfig::Odometry::None:
+            return std::nullopt;
+        case NodeConfig::Odometry::Topic:
+            return odom_buffer_.at(stamp.toSec());
+        case NodeConfig::Odometry::Tf:
+            try {
+                const auto t = tf_->lookupTransform(config_.odom_frame, config_.base_frame, stamp,
+                                                    ros::Duration(config_.tf_wait));
+                return poseOf(t.transform);
+            } catch (const tf2::TransformException&) {
+                return std::nullopt;
+            }
+    }
+    return std::nullopt;
+}
+
+Pose2D ScanFilterNode::mountOf(const std::string& frame_id) {
+    const std::string laser = frameLabel(frame_id);
+    if (const auto it = mounts_.find(laser); it != mounts_.end()) return it->second;
+    if (laser.empty() || laser == frameLabel(config_.base_frame)) return Pose2D{0.0, 0.0, 0.0};
+    try {
+        const auto t = tf_->lookupTransform(config_.base_frame, laser, ros::Time(0));
+        const Pose2D p = poseOf(t.transform);
+        mounts_[laser] = p;
+        return p;
+    } catch (const tf2::TransformException&) {
+        return Pose2D{0.0, 0.0, 0.0};  // identity until /tf_static has the chain
+    }
+}
+
+void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
+    const auto start = std::chrono::steady_clock::now();
+    std::lock_guard<std::mutex> lock(mutex_);
+    const ros::Time stamp = in->header.stamp.isZero() ? ros::Time::now() : in->header.stamp;
+    const std::optional<Pose2D> odom = odometryAt(stamp);
+    const Pose2D mount = mountOf(in->header.frame_id);
+    auto out = boost::make_shared<sensor_msgs::LaserScan>(*in);
+    const LiveResult r = filter_.process(*out, stamp.toSec(), odom,
+                                         config_.odometry != NodeConfig::Odometry::None, mount);
+    if (r.reset) {
+        odom_buffer_.clear();
+        ROS_WARN("kfd: time jumped back on frame '%s' (scan at %.3f s): state reset",
+                 in->header.frame_id.c_str(), stamp.toSec());
+    }
+    if (r.out_of_order)
+        ROS_WARN_THROTTLE(5.0, "kfd: scan of frame '%s' at %.3f s is out of order: dropped",
+                          in->header.frame_id.c_str(), stamp.toSec());
+    if (r.publish) scan_pub_.publish(out);
+    latency_.add(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
+                     .count());
+}
+
+diagnostic_msgs::DiagnosticStatus ScanFilterNode::stats() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const LiveCounters& c = filter_.counters();
+    diagnostic_msgs::DiagnosticStatus s;
+    s.name = ros::this_node::getName() + ": kfd scan filter";
+    s.hardware_id = "kfd";
+    s.level = diagnostic_msgs::DiagnosticStatus::OK;
+    char buf[160];
+    std::snprintf(buf, sizeof(buf), "%zu of %zu scans kept", c.scans_kept, c.scans_in);
+    s.message = buf;
+    const double dropped =
+        c.scans_in ? 100.0 * double(c.scans_in - c.scans_kept) / double(c.scans_in) : 0.0;
+    s.values = {kv("scans_in", double(c.scans_in)),
+                kv("scans_kept", double(c.scans_kept)),
+                kv("dropped_pct", dropped),
+                kv("points_removed", double(c.points_removed)),
+                kv("out_of_order", double(c.out_of_order)),
+                kv("odom_missing", double(c.odom_missing)),
+                kv("resets", double(c.resets)),
+                kv("geometry_resets", double(c.geometry_resets)),
+                kv("scans_skipped", double(c.scans_skipped)),
+                kv("latency_p50_us", latency_.percentile(50.0)),
+                kv("latency_p99_us", latency_.percentile(99.0)),
+                kv("latency_max_us", latency_.max())};
+    return s;
+}
+
+void ScanFilterNode::publishStats() {
+    const auto s = stats();
+    stats_pub_.publish(s);
+    diagnostic_msgs::DiagnosticArray a;
+    a.header.stamp = ros::Time::now();
+    a.status.push_back(s);
+    diag_pub_.publish(a);
+}
+
+}  // namespace kfd::ros1
