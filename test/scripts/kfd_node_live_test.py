@@ -77,6 +77,13 @@ def scans_of(bag_path, topic):
         return [m for _, m, _ in b.read_messages(topics=[topic])]
 
 
+def cpu_seconds(pid):
+    """User + system CPU time of a process so far (s), from /proc/PID/stat."""
+    with open("/proc/%d/stat" % pid) as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def same_floats(a, b):
     """Equal element by element, NaN equal to NaN (and only to NaN)."""
     if len(a) != len(b):
@@ -111,7 +118,6 @@ class KfdNodeLive(unittest.TestCase):
         self.start("roscore", ["roscore", "-p", str(port)])
         self.wait_for(lambda: self.master.getSystemState("/kfd_test")[0] == 1, 30,
                       "roscore on " + self.uri)
-        self.master.setParam("/kfd_test", "/use_sim_time", True)
 
     def start(self, name, argv):
         log = open(os.path.join(self.tmp, name + ".log"), "w")
@@ -150,6 +156,11 @@ class KfdNodeLive(unittest.TestCase):
         out = os.path.join(self.tmp, "live.bag")
         recorder = self.start("record", ["rosbag", "record", "-O", out, "/scan", "/scan_filtered",
                                          "/kfd_node/stats"])
+        # The recorder on wall time (use_sim_time is set after it starts): it writes whatever
+        # comes, without waiting for /clock; the node on the bag's clock.
+        self.wait_for(lambda: len(self.graph()[1].get("/scan_filtered", [])) >= 1, 30,
+                      "rosbag record to subscribe")
+        self.master.setParam("/kfd_test", "/use_sim_time", True)
         node = self.start("kfd_node", [self.node_exe, "__name:=kfd_node"] + list(node_args))
 
         def connected():
@@ -157,12 +168,14 @@ class KfdNodeLive(unittest.TestCase):
             return ("/kfd_node" in subs.get("/scan", []) and
                     "/kfd_node" in pubs.get("/scan_filtered", []) and
                     "/kfd_node" in pubs.get("/kfd_node/stats", []) and
+                    len(subs.get("/scan", [])) >= 2 and  # the node and the recorder
                     len(subs.get("/scan_filtered", [])) >= 1 and
                     len(subs.get("/kfd_node/stats", [])) >= 1)  # the recorder
         self.wait_for(lambda: node.poll() is None and connected(), 30,
                       lambda: "kfd_node and the recorder to register (kfd_node's log: %s; "
                       "graph %s)" % (self.log_of("kfd_node"), self.graph()))
         time.sleep(1.0)  # the recorder connects to the node's publishers
+        cpu0, wall0 = cpu_seconds(node.pid), time.monotonic()
         play = self.start("play", ["rosbag", "play", "--clock", "-q", "-d", "0.5", bag]
                           + list(play_args))
         try:
@@ -170,6 +183,7 @@ class KfdNodeLive(unittest.TestCase):
         except subprocess.TimeoutExpired:
             self.fail("rosbag play did not finish")
         self.assertEqual(play.returncode, 0, self.log_of("play"))
+        self.node_cpu = (cpu_seconds(node.pid) - cpu0, time.monotonic() - wall0)  # the bench's
         time.sleep(2.0)  # the node works off its queue
         self.assertIsNone(node.poll(), "kfd_node died: " + self.log_of("kfd_node"))
         _kill_group(node)  # SIGINT: it publishes ~stats once more at shutdown
