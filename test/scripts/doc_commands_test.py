@@ -31,6 +31,10 @@ NOT_RUN = {
     "xargs ": "runs kfd-compare's emitted jobs (as parallel does)",
     "sh -c ": "a Slurm array task's line (runs one emitted job)",
     "kfd-compare --datasets": "an option of kfd-compare run, quoted in a sentence",
+    "export ROS_PACKAGE_PATH": "ROS 1 node: needs a ROS master (the ros1 tests run the node)",
+    "roslaunch ": "ROS 1 node: needs a ROS master (the ros1 tests run the node)",
+    "build/apps/kfd_node": "ROS 1 node: needs a ROS master (the ros1 tests run the node)",
+    "/usr/lib/nodelet/nodelet": "ROS 1 nodelet: needs a ROS master and a nodelet manager",
 }
 
 TOOLS = ["kfd-filter", "kfd-icp-slam", "kfd-eval", "kfd-simulate", "kfd-inject",

@@ -17,6 +17,15 @@ void LiveFilter::reset() {
     last_stamp_.clear();
 }
 
+bool LiveFilter::onClock(double now) {
+    const bool back = last_clock_ >= 0.0 && now < last_clock_;
+    last_clock_ = now;
+    if (!back) return false;
+    reset();
+    ++counters_.resets;
+    return true;
+}
+
 LiveResult LiveFilter::process(sensor_msgs::LaserScan& m, double stamp,
                                const std::optional<Pose2D>& odometry, bool odom_expected,
                                const Pose2D& mount) {

@@ -127,7 +127,13 @@ Pose2D ScanFilterNode::mountOf(const std::string& frame_id) {
 void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
     const auto start = std::chrono::steady_clock::now();
     std::lock_guard<std::mutex> lock(mutex_);
-    const ros::Time stamp = in->header.stamp.isZero() ? ros::Time::now() : in->header.stamp;
+    const ros::Time now = ros::Time::now();
+    const ros::Time stamp = in->header.stamp.isZero() ? now : in->header.stamp;
+    if (ros::Time::isSimTime() && filter_.onClock(now.toSec())) {
+        odom_buffer_.clear();
+        ROS_WARN("kfd: the ROS clock jumped back to %.3f s (a bag looping?): state reset",
+                 now.toSec());
+    }
     const std::optional<Pose2D> odom = odometryAt(stamp);
     const Pose2D mount = mountOf(in->header.frame_id);
     auto out = boost::make_shared<sensor_msgs::LaserScan>(*in);

@@ -61,6 +61,10 @@ class LiveFilter {
                        const std::optional<Pose2D>& odometry, bool odom_expected,
                        const Pose2D& mount = Pose2D{0.0, 0.0, 0.0});
 
+    /// The ROS clock (s) when a scan arrives, with simulated time (/clock, `rosbag play
+    /// --clock`): a clock that went back (the bag looping or restarting, however short) resets
+    /// every frame's state and counts a reset, before the scan's own rules. True when it did.
+    bool onClock(double now);
     /// Forgets every frame's state (the counters stay); what a time jump does.
     void reset();
     const LiveCounters& counters() const { return counters_; }
@@ -71,6 +75,7 @@ class LiveFilter {
     Params params_;
     StreamFilter door_;
     std::map<std::string, double> last_stamp_;  // per frame_id
+    double last_clock_ = -1.0;                  // onClock's last time (< 0: none yet)
     LiveCounters counters_;
 };
 

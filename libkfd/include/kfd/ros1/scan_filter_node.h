@@ -44,6 +44,9 @@ class ScanFilterNode {
     void publishStats();
 
     const NodeConfig& config() const { return config_; }
+    /// The transforms the node looks up (odom_frame -> base_frame, base_frame -> laser); tests
+    /// set transforms in it directly.
+    tf2_ros::Buffer& tfBuffer() { return *tf_; }
     LiveCounters counters() const;
 
     /// The private parameters of `pnh` by name (without '~'); a nested one (~a/b) under its

@@ -1,0 +1,182 @@
+// kfd::ros1::LiveFilter: the live rules of the node (time jumping back, out-of-order scans,
+// several lasers, a geometry change, missing odometry) and the marking of removed beams. No ROS
+// master: hand-made LaserScan messages straight into the class.
+#include "kfd/ros1/live_filter.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "kfd/mrpt/config.h"
+#include "ros1/laser_scans.h"
+
+namespace {
+
+using kfd::ros1::LiveFilter;
+using kfd::test::roomScan;
+
+LiveFilter::Params defaults() {
+    LiveFilter::Params p;
+    p.pipeline = kfd::kfdDefaults();
+    return p;
+}
+
+TEST(LiveFilter, TimeJumpingBackResetsEveryFrameAndCountsIt) {
+    LiveFilter f(defaults());
+    for (int i = 0; i < 5; ++i) {
+        auto m = roomScan(100.0 + 0.1 * i);
+        EXPECT_FALSE(f.process(m, 100.0 + 0.1 * i, std::nullopt, false).reset);
+    }
+    auto other = roomScan(100.45, "laser2");
+    f.process(other, 100.45, std::nullopt, false);
+    EXPECT_EQ(f.door().sensorCount(), 2u);
+    auto loop = roomScan(10.0);  // the bag started again
+    const auto r = f.process(loop, 10.0, std::nullopt, false);
+    EXPECT_TRUE(r.reset);
+    EXPECT_FALSE(r.out_of_order);
+    EXPECT_TRUE(r.publish);  // the first scan of a new stream is a keyframe
+    EXPECT_EQ(f.counters().resets, 1u);
+    EXPECT_EQ(f.door().sensorCount(), 1u);  // laser2's state went too
+    // laser2's next scan, back in the new time line, is a first scan again, not out of order.
+    auto other2 = roomScan(10.05, "laser2");
+    EXPECT_FALSE(f.process(other2, 10.05, std::nullopt, false).out_of_order);
+    EXPECT_EQ(f.counters().out_of_order, 0u);
+}
+
+TEST(LiveFilter, SimulatedClockGoingBackResetsHoweverShortTheJump) {
+    LiveFilter f(defaults());
+    EXPECT_FALSE(f.onClock(20.0));
+    auto a = roomScan(20.0), b = roomScan(20.1);
+    f.process(a, 20.0, std::nullopt, false);
+    EXPECT_FALSE(f.onClock(20.1));
+    f.process(b, 20.1, std::nullopt, false);
+    EXPECT_TRUE(f.onClock(20.0));  // a 0.1 s bag looping: /clock went back
+    EXPECT_EQ(f.counters().resets, 1u);
+    EXPECT_EQ(f.door().sensorCount(), 0u);
+    auto again = roomScan(20.0);  // its first scan again: not out of order
+    EXPECT_FALSE(f.process(again, 20.0, std::nullopt, false).out_of_order);
+    EXPECT_FALSE(f.onClock(20.0));  // a clock standing still is no jump
+}
+
+TEST(LiveFilter, SlightlyOlderScanIsOutOfOrderAndDropped) {
+    LiveFilter f(defaults());
+    auto a = roomScan(10.0), b = roomScan(10.2), late = roomScan(10.1);
+    f.process(a, 10.0, std::nullopt, false);
+    f.process(b, 10.2, std::nullopt, false);
+    const std::size_t door_in = f.door().counters().scans_in;
+    const auto r = f.process(late, 10.1, std::nullopt, false);
+    EXPECT_TRUE(r.out_of_order);
+    EXPECT_FALSE(r.publish);
+    EXPECT_FALSE(r.reset);
+    EXPECT_EQ(f.counters().out_of_order, 1u);
+    EXPECT_EQ(f.counters().scans_in, 3u);
+    EXPECT_EQ(f.door().counters().scans_in, door_in);  // never reached the door
+    // Just under reset_jump older: still out of order; at reset_jump: a reset.
+    auto under = roomScan(10.2 - 0.999);
+    EXPECT_TRUE(f.process(under, 10.2 - 0.999, std::nullopt, false).out_of_order);
+    auto at = roomScan(10.2 - 1.0);
+    EXPECT_TRUE(f.process(at, 10.2 - 1.0, std::nullopt, false).reset);
+}
+
+TEST(LiveFilter, EqualStampIsNotOutOfOrder) {
+    LiveFilter f(defaults());
+    auto a = roomScan(5.0), b = roomScan(5.0);
+    f.process(a, 5.0, std::nullopt, false);
+    EXPECT_FALSE(f.process(b, 5.0, std::nullopt, false).out_of_order);
+}
+
+TEST(LiveFilter, EachFrameDecidesAlone) {
+    // Two lasers interleaved give each the decisions it gets alone.
+    LiveFilter both(defaults()), front_only(defaults()), back_only(defaults());
+    for (int i = 0; i < 30; ++i) {
+        const double t = 1.0 + 0.1 * i;
+        const double shift = 0.05 * i;
+        auto f1 = roomScan(t, "front", 181, shift), f2 = f1;
+        auto b1 = roomScan(t - 0.5, "back", 361, 0.0), b2 = b1;  // older stamps, other frame
+        const auto rf = both.process(f1, t, std::nullopt, false);
+        const auto rb = both.process(b1, t - 0.5, std::nullopt, false);
+        EXPECT_FALSE(rb.out_of_order) << i;
+        EXPECT_EQ(rf.publish, front_only.process(f2, t, std::nullopt, false).publish) << i;
+        EXPECT_EQ(rb.publish, back_only.process(b2, t - 0.5, std::nullopt, false).publish) << i;
+    }
+    EXPECT_EQ(both.door().sensorCount(), 2u);
+    EXPECT_EQ(both.counters().scans_kept,
+              front_only.counters().scans_kept + back_only.counters().scans_kept);
+    EXPECT_EQ(both.counters().geometry_resets, 0u);
+}
+
+TEST(LiveFilter, GeometryChangeMidStreamStartsThatFrameAgain) {
+    LiveFilter f(defaults());
+    for (int i = 0; i < 5; ++i) {
+        auto m = roomScan(1.0 + 0.1 * i);
+        f.process(m, 1.0 + 0.1 * i, std::nullopt, false);
+    }
+    auto wider = roomScan(1.5, "laser", 361);  // the driver now sends 361 beams
+    const auto r = f.process(wider, 1.5, std::nullopt, false);
+    EXPECT_TRUE(r.stream.geometry_reset);
+    EXPECT_TRUE(r.publish);
+    EXPECT_EQ(wider.ranges.size(), 361u);
+    EXPECT_EQ(f.counters().geometry_resets, 1u);
+    EXPECT_EQ(f.counters().resets, 0u);
+}
+
+TEST(LiveFilter, UnusableGeometryIsCountedNotPublished) {
+    LiveFilter f(defaults());
+    auto m = roomScan(1.0);
+    m.angle_increment = 0.0f;  // angles that do not describe the beams
+    const auto r = f.process(m, 1.0, std::nullopt, false);
+    EXPECT_FALSE(r.publish);
+    EXPECT_NE(r.stream.skipped, kfd::ScanSkipReason::None);
+    EXPECT_EQ(f.counters().scans_skipped, 1u);
+}
+
+TEST(LiveFilter, MissingOdometryIsCountedOnlyWhenExpected) {
+    LiveFilter f(defaults());
+    auto a = roomScan(1.0), b = roomScan(1.1), c = roomScan(1.2);
+    f.process(a, 1.0, std::nullopt, false);  // ~odom none
+    EXPECT_EQ(f.counters().odom_missing, 0u);
+    f.process(b, 1.1, std::nullopt, true);  // /tf late or missing
+    EXPECT_EQ(f.counters().odom_missing, 1u);
+    f.process(c, 1.2, kfd::Pose2D{0.0, 0.0, 0.0}, true);
+    EXPECT_EQ(f.counters().odom_missing, 1u);
+}
+
+// A room scan with a few stray returns in mid-air: the denoiser removes them.
+sensor_msgs::LaserScan noisyScan(double stamp) {
+    auto m = roomScan(stamp);
+    for (std::size_t i : {30u, 90u, 150u}) m.ranges[i] = 0.7f;
+    m.ranges[5] = 40.0f;  // beyond range_max: invalid as received, left as received
+    return m;
+}
+
+void expectMarked(kfd::RemovedMark mark) {
+    auto p = defaults();
+    p.removed = mark;
+    LiveFilter f(p);
+    const auto in = noisyScan(1.0);
+    auto out = in;
+    const auto r = f.process(out, 1.0, std::nullopt, false);
+    ASSERT_TRUE(r.publish);
+    ASSERT_GT(r.removed, 0u);
+    std::size_t marked = 0;
+    for (std::size_t i = 0; i < in.ranges.size(); ++i) {
+        if (out.ranges[i] == in.ranges[i]) continue;
+        ++marked;
+        if (mark == kfd::RemovedMark::NaN)
+            EXPECT_TRUE(std::isnan(out.ranges[i])) << i;
+        else
+            EXPECT_EQ(out.ranges[i], std::numeric_limits<float>::infinity()) << i;
+    }
+    EXPECT_EQ(marked, r.removed);
+    EXPECT_EQ(f.counters().points_removed, r.removed);
+    EXPECT_EQ(out.ranges[5], 40.0f);
+    EXPECT_EQ(out.header, in.header);
+    EXPECT_EQ(out.angle_min, in.angle_min);
+    EXPECT_EQ(out.angle_increment, in.angle_increment);
+    EXPECT_EQ(out.intensities, in.intensities);
+}
+
+TEST(LiveFilter, RemovedBeamsAreNaN) { expectMarked(kfd::RemovedMark::NaN); }
+TEST(LiveFilter, RemovedBeamsArePlusInfWhenAsked) { expectMarked(kfd::RemovedMark::PlusInf); }
+
+}  // namespace

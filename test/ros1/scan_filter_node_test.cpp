@@ -1,0 +1,193 @@
+// kfd::ros1::ScanFilterNode driven directly (onScan/onOdometry with hand-made messages) on a
+// ROS master of its own: a roscore on a free loopback port, started and killed by the fixture.
+#include "kfd/ros1/scan_filter_node.h"
+
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <string>
+#include <thread>
+
+#include "kfd/mrpt/config.h"
+#include "ros1/laser_scans.h"
+
+namespace {
+
+using kfd::ros1::ScanFilterNode;
+using kfd::test::roomScan;
+
+int freePort() {
+    const int s = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = 0;
+    bind(s, reinterpret_cast<sockaddr*>(&a), sizeof(a));
+    socklen_t n = sizeof(a);
+    getsockname(s, reinterpret_cast<sockaddr*>(&a), &n);
+    close(s);
+    return ntohs(a.sin_port);
+}
+
+class ScanFilterNodeTest : public ::testing::Test {
+  protected:
+    static void SetUpTestSuite() {
+        const std::string home = ::testing::TempDir() + "kfd_ros_home_" + std::to_string(getpid());
+        const std::string uri = "http://127.0.0.1:" + std::to_string(port_ = freePort());
+        setenv("ROS_MASTER_URI", uri.c_str(), 1);
+        setenv("ROS_IP", "127.0.0.1", 1);
+        setenv("ROS_HOME", home.c_str(), 1);
+        setenv("ROS_LOG_DIR", (home + "/log").c_str(), 1);
+        core_ = fork();
+        if (core_ == 0) {
+            setpgid(0, 0);
+            const std::string port = std::to_string(port_);
+            freopen("/dev/null", "w", stdout);
+            execlp("roscore", "roscore", "-p", port.c_str(), static_cast<char*>(nullptr));
+            _exit(127);
+        }
+        setpgid(core_, core_);
+        int argc = 0;
+        ros::init(argc, nullptr, "scan_filter_node_test", ros::init_options::NoSigintHandler);
+        for (int i = 0; i < 300 && !ros::master::check(); ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        ASSERT_TRUE(ros::master::check()) << "no roscore on " << uri;
+        ros::start();
+    }
+    static void TearDownTestSuite() {
+        ros::shutdown();
+        if (core_ > 0) {
+            kill(-core_, SIGINT);
+            for (int i = 0; i < 100 && waitpid(core_, nullptr, WNOHANG) == 0; ++i)
+                std::this_thread::sleep_for(std::chrono::milliseconds(100));
+            kill(-core_, SIGKILL);
+            waitpid(core_, nullptr, 0);
+        }
+    }
+    // A node whose private namespace is /NAME, its parameters set first.
+    static std::unique_ptr<ScanFilterNode> node(const std::string& name,
+                                                const std::map<std::string, std::string>& p = {}) {
+        for (const auto& [k, v] : p) ros::param::set("/" + name + "/" + k, v);
+        return std::make_unique<ScanFilterNode>(ros::NodeHandle("/" + name + "_ns"),
+                                                ros::NodeHandle("/" + name));
+    }
+    static std::string refusedKey(const std::string& name) {
+        try {
+            node(name);
+        } catch (const kfd::ConfigError& e) {
+            return e.key();
+        }
+        return "";
+    }
+    static sensor_msgs::LaserScan::ConstPtr scanAt(double t) {
+        return boost::make_shared<sensor_msgs::LaserScan>(roomScan(t));
+    }
+    static inline pid_t core_ = -1;
+    static inline int port_ = 0;
+};
+
+TEST_F(ScanFilterNodeTest, RefusesAnUnknownPrivateParameterNamingIt) {
+    ros::param::set("/bad1/windw", 3);
+    EXPECT_EQ(refusedKey("bad1"), "windw");
+    ros::param::set("/bad2/window", "three");
+    EXPECT_EQ(refusedKey("bad2"), "window");
+    XmlRpc::XmlRpcValue map;
+    map["x"] = 1;
+    ros::param::set("/bad3/bins", map);  // a map where a number goes
+    EXPECT_EQ(refusedKey("bad3"), "bins");
+    ros::param::set("/bad4/odom", true);  // the wrong type for a node parameter
+    EXPECT_EQ(refusedKey("bad4"), "odom");
+}
+
+TEST_F(ScanFilterNodeTest, ReadsItsPrivateParameters) {
+    ros::param::set("/good/window", 3);
+    ros::param::set("/good/odom", std::string("topic"));
+    ros::param::set("/good/removed_as", std::string("inf"));
+    const auto n = node("good");
+    EXPECT_EQ(n->config().odometry, kfd::ros1::NodeConfig::Odometry::Topic);
+    EXPECT_EQ(n->config().removed, kfd::RemovedMark::PlusInf);
+    EXPECT_NE(kfd::toIni(n->config().pipeline).find("window = 3"), std::string::npos);
+}
+
+TEST_F(ScanFilterNodeTest, MissingTfFallsBackToLaserOnlyForThatScan) {
+    ros::param::set("/tfnode/tf_wait", 0.01);
+    auto n = node("tfnode");
+    n->onScan(scanAt(100.0));  // no odom -> base_link at all: a bounded wait, then laser only
+    EXPECT_EQ(n->counters().scans_in, 1u);
+    EXPECT_EQ(n->counters().odom_missing, 1u);
+    EXPECT_EQ(n->counters().scans_kept, 1u);
+    geometry_msgs::TransformStamped t;
+    t.header.frame_id = "odom";
+    t.child_frame_id = "base_link";
+    t.transform.rotation.w = 1.0;
+    for (double s : {100.0, 100.2}) {
+        t.header.stamp.fromSec(s);
+        t.transform.translation.x = s - 100.0;
+        n->tfBuffer().setTransform(t, "test");
+    }
+    n->onScan(scanAt(100.1));  // between two transforms: found
+    EXPECT_EQ(n->counters().odom_missing, 1u);
+    n->onScan(scanAt(105.0));  // /tf stopped long ago: missing again
+    EXPECT_EQ(n->counters().odom_missing, 2u);
+}
+
+TEST_F(ScanFilterNodeTest, OdometryTopicIsInterpolatedAtTheScanStamp) {
+    ros::param::set("/odomnode/odom", std::string("topic"));
+    auto n = node("odomnode");
+    for (double s : {10.0, 10.2}) {
+        auto o = boost::make_shared<nav_msgs::Odometry>();
+        o->header.stamp.fromSec(s);
+        o->pose.pose.orientation.w = 1.0;
+        n->onOdometry(o);
+    }
+    n->onScan(scanAt(10.1));
+    EXPECT_EQ(n->counters().odom_missing, 0u);
+    n->onScan(scanAt(12.0));  // 1.8 s after the last sample: unknown
+    EXPECT_EQ(n->counters().odom_missing, 1u);
+}
+
+TEST_F(ScanFilterNodeTest, PublishesKeptScansAndStats) {
+    ros::param::set("/pubnode/odom", std::string("none"));
+    auto n = node("pubnode");
+    ros::NodeHandle nh("/pubnode_ns");
+    int received = 0;
+    auto sub = nh.subscribe<sensor_msgs::LaserScan>(
+        "scan_filtered", 10, [&](const sensor_msgs::LaserScan::ConstPtr&) { ++received; });
+    for (int i = 0; i < 100 && sub.getNumPublishers() == 0; ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    n->onScan(scanAt(1.0));
+    for (int i = 0; i < 200 && received == 0; ++i) {
+        ros::spinOnce();
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    EXPECT_EQ(received, 1);
+    const auto s = n->stats();
+    std::map<std::string, std::string> kv;
+    for (const auto& v : s.values) kv[v.key] = v.value;
+    for (const char* k :
+         {"scans_in", "scans_kept", "dropped_pct", "points_removed", "out_of_order", "odom_missing",
+          "resets", "latency_p50_us", "latency_p99_us", "latency_max_us"})
+        EXPECT_EQ(kv.count(k), 1u) << k;
+    EXPECT_EQ(kv["scans_in"], "1");
+    EXPECT_EQ(kv["scans_kept"], "1");
+    EXPECT_EQ(kv["odom_missing"], "0");  // ~odom none: nothing expected
+}
+
+TEST_F(ScanFilterNodeTest, ABagLoopingResetsWithAWarning) {
+    ros::param::set("/loopnode/odom", std::string("none"));
+    auto n = node("loopnode");
+    // A 1.5 s bag played with --loop: its stamps go back 1.5 s (>= ~reset_jump) each time.
+    for (int loop = 0; loop < 3; ++loop)
+        for (int i = 0; i < 16; ++i) n->onScan(scanAt(50.0 + 0.1 * i));
+    EXPECT_EQ(n->counters().resets, 2u);
+    EXPECT_EQ(n->counters().scans_in, 48u);
+    EXPECT_EQ(n->counters().out_of_order, 0u);
+}
+
+}  // namespace
