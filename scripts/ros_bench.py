@@ -48,7 +48,8 @@ def main():
         bag = os.path.join(datasets, name, name + ".orig.bag")
         if os.path.isfile(bag):
             cases.append(("%s, first %s s at 10x" % (name, seconds), bag,
-                          ["-r", "10"], live.FREIBURG, seconds))
+                          ["-r", "10"], live.INTEL if name == "intel" else live.FREIBURG,
+                          seconds))
         else:
             print("skipped %s: %s missing" % (name, bag), file=sys.stderr)
     print("| bag | scans played | seen by node (lost) | kept | latency p50 / p99 / max (us) "

@@ -22,7 +22,8 @@ import unittest
 import xmlrpc.client
 
 APPS = DATASETS = FAST_BAG_EXE = None
-FREIBURG = ["_tf_wait:=0.2"]  # see KfdNodeLive.dataset
+FREIBURG = ["_tf_wait:=0.3"]  # see KfdNodeLive.dataset
+INTEL = ["_tf_wait:=0.7", "_queue_size:=50"]
 _GROUPS = set()  # process groups started and not yet reaped
 
 
@@ -276,8 +277,9 @@ class KfdNodeLive(unittest.TestCase):
                   stats.get("latency_p50_us"), stats.get("latency_p99_us")), flush=True)
         return kept, stats
 
-    # FREIBURG: the Freiburg logs' odometry comes at 7-10 Hz, up to 150 ms after a scan (bag
-    # time): the node must wait that long for odom -> base_link at the scan's stamp.
+    # FREIBURG: the Freiburg logs' odometry comes at 7-10 Hz, up to 210 ms after a scan (bag
+    # time): the node must wait that long for odom -> base_link at the scan's
+    # stamp. INTEL: intel's comes up to 640 ms after a scan (55 of its first 305 scans > 200 ms).
     def dataset(self, rel):
         path = os.path.join(DATASETS or "", rel)
         if not DATASETS or not os.path.isfile(path):
@@ -295,7 +297,7 @@ class KfdNodeLive(unittest.TestCase):
         self.check(self.dataset("aces/aces.orig.bag"), seconds=60, rate=4, node_args=FREIBURG)
 
     def test_intel_prefix_matches_kfd_filter(self):
-        self.check(self.dataset("intel/intel.orig.bag"), seconds=60, rate=4, node_args=FREIBURG)
+        self.check(self.dataset("intel/intel.orig.bag"), seconds=60, rate=4, node_args=INTEL)
 
     def test_fr079_prefix_matches_kfd_filter(self):
         self.check(self.dataset("fr079/fr079.orig.bag"), seconds=60, rate=4, node_args=FREIBURG)
