@@ -25,6 +25,7 @@ APPS = DATASETS = FAST_BAG_EXE = None
 FREIBURG = ["_tf_wait:=0.3"]  # see KfdNodeLive.dataset
 INTEL = ["_tf_wait:=0.7", "_queue_size:=50"]
 _GROUPS = set()  # process groups started and not yet reaped
+_TAGS = set()  # the tests' temp dirs: every ROS process of a test names its own
 
 
 def _kill_group(proc, first=signal.SIGINT, wait=10.0):
@@ -57,7 +58,27 @@ def _kill_group(proc, first=signal.SIGINT, wait=10.0):
     _GROUPS.discard(proc.pid)
 
 
+def _kill_tagged(tag):
+    """Kills every process whose command line names `tag` (a test's own temp dir): roscore
+    starts rosmaster and rosout in sessions of their own (their __log:= is under ROS_LOG_DIR)."""
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit() or int(pid) == os.getpid():
+            continue
+        try:
+            with open("/proc/%s/cmdline" % pid, "rb") as f:
+                cmd = f.read()
+        except OSError:
+            continue
+        if tag.encode() in cmd:
+            try:
+                os.kill(int(pid), signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+
+
 def _kill_all():
+    for tag in list(_TAGS):
+        _kill_tagged(tag)
     for pgid in list(_GROUPS):
         try:
             os.killpg(pgid, signal.SIGKILL)
@@ -123,6 +144,9 @@ class KfdNodeLive(unittest.TestCase):
             self.skipTest("kfd_node not built: " + self.node_exe)
         self.tmp = tempfile.mkdtemp(prefix="kfd_node_live_")
         self.addCleanup(shutil.rmtree, self.tmp, ignore_errors=True)
+        _TAGS.add(self.tmp)
+        self.addCleanup(_TAGS.discard, self.tmp)
+        self.addCleanup(_kill_tagged, self.tmp)  # runs after the groups are stopped
         port = free_port()
         self.uri = "http://127.0.0.1:%d" % port
         self.env = dict(os.environ)
