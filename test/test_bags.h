@@ -153,13 +153,21 @@ class BagBuilder {
     bool open_ = true;
 };
 
-/// A bag like a fast scanner's (issue 23's measurements; its tests): /scan at 35 Hz (1079 beams)
-/// beside multi-echo scans, an IMU at 200 Hz, odometry and /tf at 50 Hz, over `seconds`; several
-/// chunks. Stamps are distinct across topics. `by_topic`: written one topic after the other (the
-/// chunks' times overlap: reading in time order goes back and forth between them), else in time
-/// order.
+/// The scanner of writeFastScannerBag: its rate, beam count and field of view.
+struct FastScanner {
+    double scan_hz = 35;       // /scan and /echoes rate (Hz)
+    std::size_t beams = 1079;  // beams per scan
+    double fov = 3.0;          // field of view (rad), centred on the robot's heading
+    double noise = 0;          // range noise (m): uniform in [-noise, noise], the same every run
+};
+
+/// A bag like a fast scanner's (issue 23's measurements; its tests): /scan at 35 Hz (1079 beams;
+/// `scanner` changes them) beside multi-echo scans, an IMU at 200 Hz, odometry and /tf at 50 Hz,
+/// over `seconds`; several chunks. Stamps are distinct across topics. `by_topic`: written one
+/// topic after the other (the chunks' times overlap: reading in time order goes back and forth
+/// between them), else in time order.
 inline void writeFastScannerBag(const std::string& path, rosbag::compression::CompressionType c,
-                                bool by_topic, double seconds) {
+                                bool by_topic, double seconds, const FastScanner& scanner = {}) {
     rosbag::Bag bag(path, rosbag::bagmode::Write);
     bag.setCompression(c);
     struct Stamped {
@@ -170,10 +178,10 @@ inline void writeFastScannerBag(const std::string& path, rosbag::compression::Co
     auto every = [&](int topic, double hz, double phase) {
         for (double t = 1.0 + phase; t < 1.0 + seconds; t += 1.0 / hz) all.push_back({t, topic});
     };
-    every(0, 35, 0.0003);   // /scan
-    every(1, 35, 0.0007);   // /echoes
-    every(2, 200, 0.0011);  // /imu
-    every(3, 50, 0.0013);   // /odom and /tf
+    every(0, scanner.scan_hz, 0.0003);  // /scan
+    every(1, scanner.scan_hz, 0.0007);  // /echoes
+    every(2, 200, 0.0011);              // /imu
+    every(3, 50, 0.0013);               // /odom and /tf
     if (by_topic)
         std::stable_sort(all.begin(), all.end(),
                          [](const Stamped& a, const Stamped& b) { return a.topic < b.topic; });
@@ -183,18 +191,30 @@ inline void writeFastScannerBag(const std::string& path, rosbag::compression::Co
     auto tfs = [](double t, const std::string& parent, const std::string& child, double x) {
         return BagBuilder::tfMsg(t, parent, child, x, 0, 0);
     };
+    const auto n = scanner.beams;
+    const auto half = static_cast<float>(scanner.fov / 2);
+    std::uint32_t lcg = 12345;
+    auto noisy = [&](std::vector<float> r) {
+        if (scanner.noise > 0)
+            for (auto& v : r) {
+                lcg = lcg * 1664525u + 1013904223u;
+                v += static_cast<float>(scanner.noise * (2.0 * (lcg >> 8) / 16777216.0 - 1.0));
+            }
+        return r;
+    };
     bag.write("/tf_static", ros::Time(1.0), tfs(1.0, "base_link", "laser", 0.1));
     for (const auto& s : all) {
         const double x = 0.3 * (s.t - 1.0);  // 0.3 m/s along x
         if (s.topic == 0) {
             bag.write("/scan", ros::Time(s.t),
-                      BagBuilder::scanMsg(s.t, room(x + 0.1, 0, 0, 1079), "laser"));
+                      BagBuilder::scanMsg(s.t, noisy(room(x + 0.1, 0, 0, n, scanner.fov)), "laser",
+                                          -half, half));
         } else if (s.topic == 1) {
             sensor_msgs::MultiEchoLaserScan m;
             m.header.stamp = ros::Time(s.t);
             m.header.frame_id = "laser";
-            m.ranges.resize(1079);
-            const auto r = room(x + 0.1, 0, 0, 1079);
+            m.ranges.resize(n);
+            const auto r = room(x + 0.1, 0, 0, n, scanner.fov);
             for (std::size_t i = 0; i < r.size(); ++i)
                 m.ranges[i].echoes = {r[i], r[i] + 0.01f * static_cast<float>(i % 7), 0.0f};
             bag.write("/echoes", ros::Time(s.t), m);
