@@ -105,6 +105,32 @@ void ScanFilterNode::onOdometry(const nav_msgs::Odometry::ConstPtr& m) {
     odom_cv_.notify_all();
 }
 
+// The bag source's rule at the ends of the odometry (kfd-filter -i X.bag): a scan up to
+// hold_seconds before the first transform or after the last one takes that transform; further
+// away, or in a gap inside the buffer's span, its odometry is unknown.
+std::optional<Pose2D> ScanFilterNode::tfAtTheEdges(const ros::Time& stamp) {
+    const double hold = odom_buffer_.params().hold_seconds;
+    try {
+        const auto latest =
+            tf_->lookupTransform(config_.odom_frame, config_.base_frame, ros::Time(0));
+        if (latest.header.stamp < stamp)
+            return (stamp - latest.header.stamp).toSec() <= hold
+                       ? std::optional<Pose2D>(poseOf(latest.transform))
+                       : std::nullopt;
+        // Before the first transform: tf2 has no query for the oldest one, so the earliest
+        // stamp within hold_seconds it can transform at is found by bisection (to 1 us).
+        ros::Time lo = stamp, hi = std::min(stamp + ros::Duration(hold), latest.header.stamp);
+        if (!tf_->canTransform(config_.odom_frame, config_.base_frame, hi)) return std::nullopt;
+        while ((hi - lo).toSec() > 1e-6) {
+            const ros::Time mid = lo + ros::Duration((hi - lo).toSec() / 2);
+            (tf_->canTransform(config_.odom_frame, config_.base_frame, mid) ? hi : lo) = mid;
+        }
+        return poseOf(tf_->lookupTransform(config_.odom_frame, config_.base_frame, hi).transform);
+    } catch (const tf2::TransformException&) {
+        return std::nullopt;
+    }
+}
+
 std::optional<Pose2D> ScanFilterNode::odometryAt(const ros::Time& stamp) {
     switch (config_.odometry) {
         case NodeConfig::Odometry::None:
@@ -131,7 +157,7 @@ std::optional<Pose2D> ScanFilterNode::odometryAt(const ros::Time& stamp) {
                 return poseOf(
                     tf_->lookupTransform(config_.odom_frame, config_.base_frame, stamp).transform);
             } catch (const tf2::TransformException&) {
-                return std::nullopt;
+                return tfAtTheEdges(stamp);
             }
         }
     }

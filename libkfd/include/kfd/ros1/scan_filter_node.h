@@ -59,6 +59,7 @@ class ScanFilterNode {
     static std::map<std::string, XmlRpc::XmlRpcValue> privateParams(const ros::NodeHandle& pnh);
 
   private:
+    std::optional<Pose2D> tfAtTheEdges(const ros::Time& stamp);
     std::optional<Pose2D> odometryAt(const ros::Time& stamp);
     Pose2D mountOf(const std::string& frame_id);
 
