@@ -217,7 +217,9 @@ TEST(NoisyLog, LabelsMatchTheInjectedBeamsAndScoreBackPerModel) {
     EXPECT_GT(calls.front().second, 0u);
     EXPECT_LT(calls.front().second, s.scans);
     for (std::size_t i = 1; i < calls.size(); ++i) {  // the last call may repeat the count
-        if (i + 1 < calls.size()) EXPECT_GT(calls[i].second, calls[i - 1].second);
+        if (i + 1 < calls.size()) {
+            EXPECT_GT(calls[i].second, calls[i - 1].second);
+        }
         EXPECT_GE(calls[i].second, calls[i - 1].second);
         EXPECT_GE(calls[i].first, calls[i - 1].first);
     }
