@@ -12,24 +12,15 @@ find_path(KfdRos1_INCLUDE_DIR rosbag/bag.h)
 find_path(KfdRos1_SENSOR_MSGS_DIR sensor_msgs/LaserScan.h)
 find_path(KfdRos1_NAV_MSGS_DIR nav_msgs/Odometry.h)
 find_path(KfdRos1_TF2_MSGS_DIR tf2_msgs/TFMessage.h)
-set(_kfd_ros1_nested)
-foreach(_pair "pluginlib:pluginlib/class_loader.hpp"
-              "class_loader:class_loader/multi_library_class_loader.hpp"
-              "rcpputils:rcpputils/shared_library.hpp" "rcutils:rcutils/types.h"
-              "ament_index_cpp:ament_index_cpp/get_package_prefix.hpp")
-  string(REPLACE ":" ";" _pair "${_pair}")
-  list(GET _pair 0 _pkg)
-  list(GET _pair 1 _file)
-  find_path(KfdRos1_${_pkg}_DIR ${_file} PATH_SUFFIXES ${_pkg})
-  if(KfdRos1_${_pkg}_DIR)
-    list(APPEND _kfd_ros1_nested ${KfdRos1_${_pkg}_DIR})
-  endif()
-endforeach()
+include(${CMAKE_CURRENT_LIST_DIR}/KfdRosFind.cmake)
+set(_kfd_ros1_nested)  # optional: the headers rosbag/bag.h includes through pluginlib
+kfd_ros_find_nested(KfdRos1 _kfd_ros1_nested "pluginlib:pluginlib/class_loader.hpp"
+  "class_loader:class_loader/multi_library_class_loader.hpp"
+  "rcpputils:rcpputils/shared_library.hpp" "rcutils:rcutils/types.h"
+  "ament_index_cpp:ament_index_cpp/get_package_prefix.hpp")
 set(_kfd_ros1_libs)
-foreach(_lib rosbag_storage roslz4 rostime cpp_common roscpp_serialization console_bridge bz2)
-  find_library(KfdRos1_${_lib}_LIBRARY ${_lib})
-  list(APPEND _kfd_ros1_libs KfdRos1_${_lib}_LIBRARY)
-endforeach()
+kfd_ros_find_libs(KfdRos1 _kfd_ros1_libs
+  rosbag_storage roslz4 rostime cpp_common roscpp_serialization console_bridge bz2)
 find_package(Boost QUIET COMPONENTS filesystem)
 
 include(FindPackageHandleStandardArgs)
@@ -41,11 +32,9 @@ find_package_handle_standard_args(KfdRos1
 
 if(KfdRos1_FOUND AND NOT TARGET KfdRos1::rosbag)
   add_library(KfdRos1::rosbag INTERFACE IMPORTED)
-  set(_kfd_ros1_link)
-  foreach(_v ${_kfd_ros1_libs})
-    list(APPEND _kfd_ros1_link ${${_v}})
-  endforeach()
+  kfd_ros_values(_kfd_ros1_link ${_kfd_ros1_libs})
+  kfd_ros_values(_kfd_ros1_nested_dirs ${_kfd_ros1_nested})
   set_target_properties(KfdRos1::rosbag PROPERTIES
-    INTERFACE_INCLUDE_DIRECTORIES "${KfdRos1_INCLUDE_DIR};${KfdRos1_SENSOR_MSGS_DIR};${KfdRos1_NAV_MSGS_DIR};${KfdRos1_TF2_MSGS_DIR};${_kfd_ros1_nested}"
+    INTERFACE_INCLUDE_DIRECTORIES "${KfdRos1_INCLUDE_DIR};${KfdRos1_SENSOR_MSGS_DIR};${KfdRos1_NAV_MSGS_DIR};${KfdRos1_TF2_MSGS_DIR};${_kfd_ros1_nested_dirs}"
     INTERFACE_LINK_LIBRARIES "${_kfd_ros1_link};Boost::filesystem")
 endif()

@@ -16,21 +16,14 @@ find_path(KfdRosNode_DIAGNOSTIC_MSGS_DIR diagnostic_msgs/DiagnosticArray.h)
 find_path(KfdRosNode_STD_MSGS_DIR std_msgs/Header.h)
 # The nodelet's plugin macros: pluginlib and class_loader (ROS 2 era in Debian 12, with rcpputils
 # and rcutils), whose headers live one level down (/usr/include/<pkg>/<pkg>/...).
+include(${CMAKE_CURRENT_LIST_DIR}/KfdRosFind.cmake)
 set(_kfd_node_nested)
-foreach(_pair "pluginlib:pluginlib/class_list_macros.hpp"
-              "class_loader:class_loader/class_loader.hpp"
-              "rcpputils:rcpputils/shared_library.hpp" "rcutils:rcutils/types.h")
-  string(REPLACE ":" ";" _pair "${_pair}")
-  list(GET _pair 0 _pkg)
-  list(GET _pair 1 _file)
-  find_path(KfdRosNode_${_pkg}_DIR ${_file} PATH_SUFFIXES ${_pkg})
-  list(APPEND _kfd_node_nested KfdRosNode_${_pkg}_DIR)
-endforeach()
+kfd_ros_find_nested(KfdRosNode _kfd_node_nested "pluginlib:pluginlib/class_list_macros.hpp"
+  "class_loader:class_loader/class_loader.hpp" "rcpputils:rcpputils/shared_library.hpp"
+  "rcutils:rcutils/types.h")
 set(_kfd_node_libs)
-foreach(_lib tf2_ros tf2 message_filters actionlib nodeletlib bondcpp class_loader rcpputils rcutils)
-  find_library(KfdRosNode_${_lib}_LIBRARY ${_lib})
-  list(APPEND _kfd_node_libs KfdRosNode_${_lib}_LIBRARY)
-endforeach()
+kfd_ros_find_libs(KfdRosNode _kfd_node_libs
+  tf2_ros tf2 message_filters actionlib nodeletlib bondcpp class_loader rcpputils rcutils)
 
 include(FindPackageHandleStandardArgs)
 find_package_handle_standard_args(KfdRosNode
@@ -42,15 +35,10 @@ find_package_handle_standard_args(KfdRosNode
 
 if(KfdRosNode_FOUND AND NOT TARGET KfdRosNode::ros)
   add_library(KfdRosNode::ros INTERFACE IMPORTED)
-  set(_kfd_node_link)
+  kfd_ros_values(_kfd_node_nested_dirs ${_kfd_node_nested})
+  kfd_ros_values(_kfd_node_link ${_kfd_node_libs})
   set(_kfd_node_inc ${roscpp_INCLUDE_DIRS} ${KfdRosNode_TF2_ROS_DIR} ${KfdRosNode_NODELET_DIR}
-                    ${KfdRosNode_DIAGNOSTIC_MSGS_DIR})
-  foreach(_v ${_kfd_node_nested})
-    list(APPEND _kfd_node_inc ${${_v}})
-  endforeach()
-  foreach(_v ${_kfd_node_libs})
-    list(APPEND _kfd_node_link ${${_v}})
-  endforeach()
+                    ${KfdRosNode_DIAGNOSTIC_MSGS_DIR} ${_kfd_node_nested_dirs})
   set_target_properties(KfdRosNode::ros PROPERTIES
     INTERFACE_INCLUDE_DIRECTORIES "${_kfd_node_inc}"
     INTERFACE_LINK_LIBRARIES "${_kfd_node_link};${roscpp_LIBRARIES}")

@@ -140,6 +140,37 @@ TEST_F(ScanFilterNodeTest, MissingTfFallsBackToLaserOnlyForThatScan) {
     EXPECT_EQ(n->counters().odom_missing, 2u);
 }
 
+TEST_F(ScanFilterNodeTest, TheWaitForTfCountsInTheLatencyButNotInTheWork) {
+    ros::param::set("/waitnode/tf_wait", 0.2);
+    auto n = node("waitnode");
+    for (int i = 0; i < 3; ++i) n->onScan(scanAt(200.0 + 0.1 * i));  // /tf never comes
+    std::map<std::string, double> kv;
+    for (const auto& v : n->stats().values) kv[v.key] = std::stod(v.value);
+    EXPECT_GE(kv["latency_p50_us"], 200000.0);  // each scan waited ~tf_wait in full
+    EXPECT_LT(kv["work_p50_us"], kv["latency_p50_us"] - 150000.0);
+    EXPECT_GT(kv["work_max_us"], 0.0);
+    EXPECT_LE(kv["work_max_us"], kv["latency_max_us"]);
+}
+
+TEST_F(ScanFilterNodeTest, AScanBeforeTheFirstTransformDoesNotWaitForIt) {
+    ros::param::set("/earlynode/tf_wait", 2.0);
+    auto n = node("earlynode");
+    geometry_msgs::TransformStamped t;
+    t.header.frame_id = "odom";
+    t.child_frame_id = "base_link";
+    t.transform.rotation.w = 1.0;
+    t.header.stamp.fromSec(300.0);
+    n->tfBuffer().setTransform(t, "test");
+    // 5 s before the first transform: no transform will ever come for it, so the scan is decided
+    // at once (laser only) instead of holding the scans behind it for ~tf_wait = 2 s.
+    const auto start = std::chrono::steady_clock::now();
+    n->onScan(scanAt(295.0));
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
+    EXPECT_EQ(n->counters().odom_missing, 1u);
+    n->onScan(scanAt(299.5));  // within the edge rule's 1 s: takes the first transform
+    EXPECT_EQ(n->counters().odom_missing, 1u);
+}
+
 TEST_F(ScanFilterNodeTest, OdometryTopicIsInterpolatedAtTheScanStamp) {
     ros::param::set("/odomnode/odom", std::string("topic"));
     auto n = node("odomnode");
@@ -173,9 +204,9 @@ TEST_F(ScanFilterNodeTest, PublishesKeptScansAndStats) {
     const auto s = n->stats();
     std::map<std::string, std::string> kv;
     for (const auto& v : s.values) kv[v.key] = v.value;
-    for (const char* k :
-         {"scans_in", "scans_kept", "dropped_pct", "points_removed", "out_of_order", "odom_missing",
-          "resets", "latency_p50_us", "latency_p99_us", "latency_max_us"})
+    for (const char* k : {"scans_in", "scans_kept", "dropped_pct", "points_removed", "out_of_order",
+                          "odom_missing", "resets", "latency_p50_us", "latency_p99_us",
+                          "latency_max_us", "work_p50_us", "work_p99_us", "work_max_us"})
         EXPECT_EQ(kv.count(k), 1u) << k;
     EXPECT_EQ(kv["scans_in"], "1");
     EXPECT_EQ(kv["scans_kept"], "1");

@@ -105,6 +105,15 @@ void ScanFilterNode::onOdometry(const nav_msgs::Odometry::ConstPtr& m) {
     odom_cv_.notify_all();
 }
 
+bool ScanFilterNode::newestTfAfter(const ros::Time& stamp) const {
+    try {
+        return tf_->lookupTransform(config_.odom_frame, config_.base_frame, ros::Time(0))
+                   .header.stamp > stamp;
+    } catch (const tf2::TransformException&) {
+        return false;
+    }
+}
+
 // The bag source's rule at the ends of the odometry (kfd-filter -i X.bag): a scan up to
 // hold_seconds before the first transform or after the last one takes that transform; further
 // away, or in a gap inside the buffer's span, its odometry is unknown.
@@ -147,11 +156,14 @@ std::optional<Pose2D> ScanFilterNode::odometryAt(const ros::Time& stamp) {
         }
         case NodeConfig::Odometry::Tf: {
             // Polled every 0.5 ms of wall time for at most ~tf_wait (tf2's own timed lookup
-            // sleeps in steps of 10 ms: too coarse for a laser at 40 Hz).
+            // sleeps in steps of 10 ms: too coarse for a laser at 40 Hz). Once a transform
+            // newer than the scan is in, waiting cannot help (the scan is before the first one
+            // or in a gap): the edge rule decides at once, and the scans behind it keep flowing.
             const auto deadline =
                 std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.tf_wait);
             while (!tf_->canTransform(config_.odom_frame, config_.base_frame, stamp) &&
-                   std::chrono::steady_clock::now() < deadline && ros::ok())
+                   !newestTfAfter(stamp) && std::chrono::steady_clock::now() < deadline &&
+                   ros::ok())
                 std::this_thread::sleep_for(std::chrono::microseconds(500));
             try {
                 return poseOf(
@@ -190,6 +202,7 @@ void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
                  now.toSec());
     }
     const std::optional<Pose2D> odom = odometryAt(stamp);
+    const auto ready = std::chrono::steady_clock::now();  // the wait for odometry is over
     const Pose2D mount = mountOf(in->header.frame_id);
     auto out = boost::make_shared<sensor_msgs::LaserScan>(*in);
     const LiveResult r = filter_.process(*out, stamp.toSec(), odom,
@@ -204,8 +217,9 @@ void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
         ROS_WARN_THROTTLE(5.0, "kfd: scan of frame '%s' at %.3f s is out of order: dropped",
                           in->header.frame_id.c_str(), stamp.toSec());
     if (r.publish) scan_pub_.publish(out);
-    latency_.add(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
-                     .count());
+    const auto end = std::chrono::steady_clock::now();
+    latency_.add(std::chrono::duration<double, std::micro>(end - start).count());
+    work_.add(std::chrono::duration<double, std::micro>(end - ready).count());
 }
 
 diagnostic_msgs::DiagnosticStatus ScanFilterNode::stats() const {
@@ -231,7 +245,10 @@ diagnostic_msgs::DiagnosticStatus ScanFilterNode::stats() const {
                 kv("scans_skipped", double(c.scans_skipped)),
                 kv("latency_p50_us", latency_.percentile(50.0)),
                 kv("latency_p99_us", latency_.percentile(99.0)),
-                kv("latency_max_us", latency_.max())};
+                kv("latency_max_us", latency_.max()),
+                kv("work_p50_us", work_.percentile(50.0)),
+                kv("work_p99_us", work_.percentile(99.0)),
+                kv("work_max_us", work_.max())};
     return s;
 }
 

@@ -60,6 +60,7 @@ class ScanFilterNode {
 
   private:
     std::optional<Pose2D> tfAtTheEdges(const ros::Time& stamp);
+    bool newestTfAfter(const ros::Time& stamp) const;  // odom -> base known after stamp
     std::optional<Pose2D> odometryAt(const ros::Time& stamp);
     Pose2D mountOf(const std::string& frame_id);
 
@@ -70,7 +71,8 @@ class ScanFilterNode {
     std::mutex odom_mutex_;  // the odometry samples (their own thread: see onOdometry)
     std::condition_variable odom_cv_;
     OdometryBuffer odom_buffer_;
-    LatencyStats latency_;
+    LatencyStats latency_;  // callback entry to publish return
+    LatencyStats work_;     // odometry in hand (or given up on) to publish return: kfd's own
     std::map<std::string, Pose2D> mounts_;  // per laser frame, once found in /tf(_static)
     std::unique_ptr<tf2_ros::Buffer> tf_;
     std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
