@@ -32,7 +32,7 @@ TEST(NodeConfig, NoParametersGiveKfdDefaults) {
     EXPECT_EQ(c.odometry, NodeConfig::Odometry::Tf);
     EXPECT_EQ(c.odom_frame, "odom");
     EXPECT_EQ(c.base_frame, "base_link");
-    EXPECT_DOUBLE_EQ(c.tf_wait, 0.05);
+    EXPECT_DOUBLE_EQ(c.tf_wait, 1.0);
     EXPECT_EQ(c.removed, kfd::RemovedMark::NaN);
 }
 

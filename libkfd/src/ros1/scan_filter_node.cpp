@@ -4,6 +4,7 @@
 #include <diagnostic_msgs/KeyValue.h>
 #include <tf2/exceptions.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -105,13 +106,40 @@ void ScanFilterNode::onOdometry(const nav_msgs::Odometry::ConstPtr& m) {
     odom_cv_.notify_all();
 }
 
-bool ScanFilterNode::newestTfAfter(const ros::Time& stamp) const {
+std::optional<ros::Time> ScanFilterNode::newestTf() const {
     try {
         return tf_->lookupTransform(config_.odom_frame, config_.base_frame, ros::Time(0))
-                   .header.stamp > stamp;
+            .header.stamp;
     } catch (const tf2::TransformException&) {
-        return false;
+        return std::nullopt;
     }
+}
+
+bool ScanFilterNode::newestTfAfter(const ros::Time& stamp) const {
+    const std::optional<ros::Time> t = newestTf();
+    return t && *t > stamp;
+}
+
+double ScanFilterNode::waitBound() const {
+    if (intervals_.empty()) return config_.tf_wait;
+    std::vector<double> v = intervals_;
+    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+    return std::min(config_.tf_wait, double(config_.queue_size - 1) * v[v.size() / 2]);
+}
+
+template <class Ready>
+bool ScanFilterNode::waitFor(const ros::Time& stamp, Ready ready) {
+    const double bound = waitBound();
+    const ros::Time deadline = stamp + ros::Duration(bound);
+    const auto wall_deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(2.0 * bound);
+    while (!ready()) {
+        if (ros::Time::now() >= deadline || std::chrono::steady_clock::now() >= wall_deadline ||
+            !ros::ok())
+            return false;
+        std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+    return true;
 }
 
 // The bag source's rule at the ends of the odometry (kfd-filter -i X.bag): a scan up to
@@ -148,23 +176,33 @@ std::optional<Pose2D> ScanFilterNode::odometryAt(const ros::Time& stamp) {
             // The sample after the scan usually comes just after it: wait for it at most
             // ~tf_wait, then the bag source's rule on what there is (kfd-filter's lookahead).
             const double t = stamp.toSec();
-            std::unique_lock<std::mutex> lock(odom_mutex_);
-            odom_cv_.wait_for(lock, std::chrono::duration<double>(config_.tf_wait), [&] {
-                return odom_buffer_.size() > 0 && odom_buffer_.newest() >= t;
+            waitFor(stamp, [&] {
+                std::unique_lock<std::mutex> lock(odom_mutex_);
+                return odom_cv_.wait_for(lock, std::chrono::microseconds(500), [&] {
+                    return odom_buffer_.size() > 0 && odom_buffer_.newest() >= t;
+                });
             });
+            std::lock_guard<std::mutex> lock(odom_mutex_);
             return odom_buffer_.at(t);
         }
         case NodeConfig::Odometry::Tf: {
-            // Polled every 0.5 ms of wall time for at most ~tf_wait (tf2's own timed lookup
-            // sleeps in steps of 10 ms: too coarse for a laser at 40 Hz). Once a transform
-            // newer than the scan is in, waiting cannot help (the scan is before the first one
-            // or in a gap): the edge rule decides at once, and the scans behind it keep flowing.
-            const auto deadline =
-                std::chrono::steady_clock::now() + std::chrono::duration<double>(config_.tf_wait);
-            while (!tf_->canTransform(config_.odom_frame, config_.base_frame, stamp) &&
-                   !newestTfAfter(stamp) && std::chrono::steady_clock::now() < deadline &&
-                   ros::ok())
-                std::this_thread::sleep_for(std::chrono::microseconds(500));
+            // Polled every 0.5 ms (tf2's own timed lookup sleeps in steps of 10 ms: too coarse
+            // for a laser at 40 Hz). Once a transform newer than the scan is in, waiting cannot
+            // help (the scan is before the first one or in a gap): the edge rule decides at
+            // once. While /tf is down (the last wait timed out, nothing newer since) scans do
+            // not wait, so the scans behind them keep flowing.
+            const std::optional<ros::Time> newest = newestTf();
+            if (tf_timed_out_at_ && (!newest || *newest <= *tf_timed_out_at_)) {
+                if (!tf_->canTransform(config_.odom_frame, config_.base_frame, stamp))
+                    return tfAtTheEdges(stamp);
+            } else {
+                tf_timed_out_at_.reset();
+                const bool ready = waitFor(stamp, [&] {
+                    return tf_->canTransform(config_.odom_frame, config_.base_frame, stamp) ||
+                           newestTfAfter(stamp);
+                });
+                if (!ready) tf_timed_out_at_ = newestTf().value_or(ros::Time(0));
+            }
             try {
                 return poseOf(
                     tf_->lookupTransform(config_.odom_frame, config_.base_frame, stamp).transform);
@@ -195,9 +233,18 @@ void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
     std::lock_guard<std::mutex> lock(mutex_);
     const ros::Time now = ros::Time::now();
     const ros::Time stamp = in->header.stamp.isZero() ? now : in->header.stamp;
+    if (last_scan_stamp_ && stamp != *last_scan_stamp_) {  // the queue's pace, every laser
+        const double dt = std::abs((stamp - *last_scan_stamp_).toSec());
+        if (intervals_.size() < 32)
+            intervals_.push_back(dt);
+        else
+            intervals_[next_interval_++ % intervals_.size()] = dt;
+    }
+    last_scan_stamp_ = stamp;
     if (ros::Time::isSimTime() && filter_.onClock(now.toSec())) {
         std::lock_guard<std::mutex> odom_lock(odom_mutex_);
         odom_buffer_.clear();
+        tf_timed_out_at_.reset();
         ROS_WARN("kfd: the ROS clock jumped back to %.3f s (a bag looping?): state reset",
                  now.toSec());
     }
@@ -210,6 +257,7 @@ void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
     if (r.reset) {
         std::lock_guard<std::mutex> odom_lock(odom_mutex_);
         odom_buffer_.clear();
+        tf_timed_out_at_.reset();
         ROS_WARN("kfd: time jumped back on frame '%s' (scan at %.3f s): state reset",
                  in->header.frame_id.c_str(), stamp.toSec());
     }

@@ -20,7 +20,10 @@ struct NodeConfig {
     Odometry odometry = Odometry::Tf;      // ~odom: tf | topic | none
     std::string odom_frame = "odom";       // ~odom_frame
     std::string base_frame = "base_link";  // ~base_frame
-    double tf_wait = 0.05;  // ~tf_wait, s: the bounded wait for odom_frame -> base_frame
+    // ~tf_wait, s of ROS time after the scan's stamp: the longest a scan waits for its odometry
+    // (odom_frame -> base_frame, or the odometry sample after it); 1 s, the bag source's hold.
+    // The node also never waits longer than its queue can absorb (ScanFilterNode::waitBound).
+    double tf_wait = 1.0;
     RemovedMark removed = RemovedMark::NaN;  // ~removed_as: nan | inf
     double reset_jump = 1.0;                 // ~reset_jump, s (LiveFilter::Params::reset_jump)
     int queue_size = 10;  // ~queue_size: the scan subscriber's and publisher's queues

@@ -19,6 +19,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "kfd/ros1/latency_stats.h"
 #include "kfd/ros1/live_filter.h"
@@ -61,6 +62,15 @@ class ScanFilterNode {
   private:
     std::optional<Pose2D> tfAtTheEdges(const ros::Time& stamp);
     bool newestTfAfter(const ros::Time& stamp) const;  // odom -> base known after stamp
+    std::optional<ros::Time> newestTf() const;         // the newest odom -> base stamp
+    /// How long (ROS time, s) a scan may wait for its odometry: ~tf_wait, but at most what the
+    /// scan queue absorbs meanwhile, (queue_size - 1) x the median interval between scans.
+    double waitBound() const;
+    /// Waits (polling every 0.5 ms) until `ready`, the ROS clock passes stamp + waitBound(), or
+    /// twice that in wall time has passed (the clock may stop: a bag paused or ended).
+    /// Returns whether `ready` came true.
+    template <class Ready>
+    bool waitFor(const ros::Time& stamp, Ready ready);
     std::optional<Pose2D> odometryAt(const ros::Time& stamp);
     Pose2D mountOf(const std::string& frame_id);
 
@@ -73,6 +83,12 @@ class ScanFilterNode {
     OdometryBuffer odom_buffer_;
     LatencyStats latency_;  // callback entry to publish return
     LatencyStats work_;     // odometry in hand (or given up on) to publish return: kfd's own
+    std::vector<double> intervals_;  // the last scan intervals (|stamp difference|), s
+    std::size_t next_interval_ = 0;  // ring position in intervals_
+    std::optional<ros::Time> last_scan_stamp_;
+    // /tf down: the newest transform when a scan's wait last timed out. Until a newer one comes,
+    // scans do not wait (laser only at once, counted), so the queue keeps flowing.
+    std::optional<ros::Time> tf_timed_out_at_;
     std::map<std::string, Pose2D> mounts_;  // per laser frame, once found in /tf(_static)
     std::unique_ptr<tf2_ros::Buffer> tf_;
     std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
