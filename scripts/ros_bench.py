@@ -57,7 +57,7 @@ def main():
         bag = os.path.join(datasets, name, name + ".orig.bag")
         if os.path.isfile(bag):
             cases.append(("%s, first %s s at 10x" % (name, seconds), bag,
-                          ["-r", "10"], live.INTEL if name == "intel" else live.FREIBURG,
+                          ["-r", "10"], [],
                           seconds))
             if name == "aces":
                 cases.append(("aces, the same with `_tf_wait:=0` (newest transform)", bag,

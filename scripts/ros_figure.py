@@ -32,7 +32,7 @@ def run_node(bag, seconds, rate):
     tc.setUp()
     try:
         prefix = tc.prefix(bag, seconds)
-        kept, stats, played, _ = tc.run_live(prefix, live.FREIBURG, ["-r", str(rate)])
+        kept, stats, played, _ = tc.run_live(prefix, [], ["-r", str(rate)])
         return kept, stats, played
     finally:
         tc.doCleanups()

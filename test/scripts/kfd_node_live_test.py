@@ -22,8 +22,6 @@ import unittest
 import xmlrpc.client
 
 APPS = DATASETS = FAST_BAG_EXE = None
-FREIBURG = ["_tf_wait:=0.3"]  # see KfdNodeLive.dataset
-INTEL = ["_tf_wait:=0.7", "_queue_size:=50"]
 _GROUPS = set()  # process groups started and not yet reaped
 _TAGS = set()  # the tests' temp dirs: every ROS process of a test names its own
 
@@ -310,9 +308,9 @@ class KfdNodeLive(unittest.TestCase):
                   stats.get("latency_p50_us"), stats.get("latency_p99_us")), flush=True)
         return kept, stats
 
-    # FREIBURG: the Freiburg logs' odometry comes at 7-10 Hz, up to 210 ms after a scan (bag
-    # time): the node must wait that long for odom -> base_link at the scan's
-    # stamp. INTEL: intel's comes up to 640 ms after a scan (55 of its first 305 scans > 200 ms).
+    # The real bags run on the node's defaults: its wait for odometry (~tf_wait, 1 s of ROS time)
+    # covers the Freiburg logs' odometry, which comes up to 210 ms of bag time after a scan
+    # (intel: 640 ms; 55 of its first 305 scans over 200 ms).
     def dataset(self, rel):
         path = os.path.join(DATASETS or "", rel)
         if not DATASETS or not os.path.isfile(path):
@@ -327,13 +325,13 @@ class KfdNodeLive(unittest.TestCase):
         self.check(bag)
 
     def test_aces_prefix_matches_kfd_filter(self):
-        self.check(self.dataset("aces/aces.orig.bag"), seconds=60, rate=4, node_args=FREIBURG)
+        self.check(self.dataset("aces/aces.orig.bag"), seconds=60, rate=4)
 
     def test_intel_prefix_matches_kfd_filter(self):
-        self.check(self.dataset("intel/intel.orig.bag"), seconds=60, rate=4, node_args=INTEL)
+        self.check(self.dataset("intel/intel.orig.bag"), seconds=60, rate=4)
 
     def test_fr079_prefix_matches_kfd_filter(self):
-        self.check(self.dataset("fr079/fr079.orig.bag"), seconds=60, rate=4, node_args=FREIBURG)
+        self.check(self.dataset("fr079/fr079.orig.bag"), seconds=60, rate=4)
 
     def test_ccny_laser_only_bag_matches_kfd_filter(self):
         self.check(self.dataset("ccny-urg/demo.bag"), rate=4, odom="none")
