@@ -7,7 +7,7 @@ writes, the filter's output recorded by `rosbag record` outside the launch: the 
 be kfd-filter's, all of them (the launch keeps running after the bag: nothing is cut off), field
 for field. And a bad key through the launch stops it, naming the key (the node, or the nodelet's
 loader, is required and exits non-zero).
-Usage: kfd_launch_test.py BUILD_APPS_DIR ROS_PACKAGE_DIR FAST_BAG_EXE NODELET_EXE
+Usage: kfd_launch_test.py BUILD_APPS_DIR ROS_PACKAGE_DIR FAST_BAG_EXE NODELET_EXE [TEST...]
 (ROS_PACKAGE_DIR: build/ros, which holds the package kfd_ros the build lays out.)"""
 import os
 import re
@@ -123,7 +123,10 @@ class KfdLaunch(live.RosCase):
         pubs = self.graph()[0]
         self.assertEqual(pubs.get(scan_filtered), [filter_node], pubs)
         self.assertEqual(pubs.get("/kfd/stats"), [filter_node], pubs)
-        self.wait_idle(self.pid_of(filter_node))
+        try:
+            self.wait_idle(self.pid_of(filter_node))
+        except OSError:  # /proc/PID/stat: the filter's process has gone
+            self.fail("the filter exited: " + self.log_of("roslaunch"))
         self.assertIsNone(launched.poll(), "the launch stopped: " + self.log_of("roslaunch"))
         seconds = time.monotonic() - start
         _kill_group(launched)  # SIGINT: roslaunch stops its nodes
@@ -205,4 +208,4 @@ if __name__ == "__main__":
     ROS_PKGS = os.path.abspath(sys.argv[2])
     FAST_BAG_EXE = os.path.abspath(sys.argv[3]) if len(sys.argv) > 3 and sys.argv[3] else ""
     NODELET_EXE = os.path.abspath(sys.argv[4]) if len(sys.argv) > 4 and sys.argv[4] else ""
-    unittest.main(argv=sys.argv[:1], verbosity=2)  # skips with their reason
+    unittest.main(argv=sys.argv[:1] + sys.argv[5:], verbosity=2)  # skips with their reason
