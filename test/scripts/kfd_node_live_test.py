@@ -128,7 +128,11 @@ def diff(a, b):
     return "%d ranges differ (beam, node, kfd-filter): %s" % (len(d), d[:6])
 
 
-class KfdNodeLive(unittest.TestCase):
+class RosCase(unittest.TestCase):
+    """The harness (kfd_launch_test.py uses it too): per test a temp dir, a roscore of its own
+    (self.uri, self.master, self.env), processes started in groups of their own (start) and
+    killed at the end of the test."""
+
     def setUp(self):
         try:
             import rosbag  # noqa: F401
@@ -190,6 +194,46 @@ class KfdNodeLive(unittest.TestCase):
         _, _, (pubs, subs, _) = self.master.getSystemState("/kfd_test")
         return dict(pubs), dict(subs)
 
+    def wait_idle(self, pid, seconds=120):
+        """Waits until process `pid` is idle, at most 1 % of a core over 2 s (a scan waiting for
+        /tf polls every 0.5 ms; idle, the node only wakes for its 1 Hz timer), at most
+        `seconds`: the node works off its queue (under load it lags the player)."""
+        settle_until = time.monotonic() + seconds
+        samples = [cpu_seconds(pid)]
+        while time.monotonic() < settle_until:
+            time.sleep(1.0)
+            samples.append(cpu_seconds(pid))
+            if len(samples) >= 3 and samples[-1] - samples[-3] <= 0.02:
+                break
+
+    def kfd_filter(self, bag, args=()):
+        """kfd-filter -i bag: its kept scans."""
+        ref = os.path.join(self.tmp, "ref.bag")
+        r = subprocess.run([os.path.join(APPS, "kfd-filter"), "-q", "-i", bag, "-o", ref]
+                           + list(args), capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        return scans_of(ref, "/scan")
+
+    def assert_same_scans(self, kept, ref):
+        """The node's kept scans are kfd-filter's first len(kept), field for field; returns the
+        number of NaN ranges in them."""
+        nan_points = 0
+        for i, (a, b) in enumerate(zip(kept, ref)):
+            where = "kept scan %d (node stamp %s, kfd-filter stamp %s)" % (
+                i, a.header.stamp.to_sec(), b.header.stamp.to_sec())
+            self.assertEqual(a.header.stamp, b.header.stamp, where)
+            self.assertEqual(a.header.frame_id, b.header.frame_id, where)
+            self.assertEqual((a.angle_min, a.angle_max, a.angle_increment, a.time_increment,
+                              a.scan_time, a.range_min, a.range_max),
+                             (b.angle_min, b.angle_max, b.angle_increment, b.time_increment,
+                              b.scan_time, b.range_min, b.range_max), where)
+            self.assertTrue(same_floats(a.ranges, b.ranges), "%s: %s" % (where, diff(a, b)))
+            self.assertTrue(same_floats(a.intensities, b.intensities), where)
+            nan_points += sum(1 for x in a.ranges if math.isnan(x))
+        return nan_points
+
+
+class KfdNodeLive(RosCase):
     def run_live(self, bag, node_args=(), play_args=(), filter_args=()):
         """Plays `bag` into kfd_node; returns (recorded kept scans, final stats dict, /scan
         messages the recorder saw, kfd-filter's kept scans)."""
@@ -224,16 +268,7 @@ class KfdNodeLive(unittest.TestCase):
             self.fail("rosbag play did not finish")
         self.assertEqual(play.returncode, 0, self.log_of("play"))
         self.node_cpu = (cpu_seconds(node.pid) - cpu0, time.monotonic() - wall0)  # the bench's
-        # The node works off its queue (under load it lags the player): wait until it is idle,
-        # at most 1 % of a core over 2 s (a scan waiting for /tf polls every 0.5 ms; idle, the
-        # node only wakes for its 1 Hz timer), at most 120 s.
-        settle_until = time.monotonic() + 120
-        samples = [cpu_seconds(node.pid)]
-        while time.monotonic() < settle_until:
-            time.sleep(1.0)
-            samples.append(cpu_seconds(node.pid))
-            if len(samples) >= 3 and samples[-1] - samples[-3] <= 0.02:
-                break
+        self.wait_idle(node.pid)
         self.assertIsNone(node.poll(), "kfd_node died: " + self.log_of("kfd_node"))
         _kill_group(node)  # SIGINT: it publishes ~stats once more at shutdown
         time.sleep(1.0)
@@ -249,11 +284,7 @@ class KfdNodeLive(unittest.TestCase):
         kept = scans_of(out, "/scan_filtered")
         played = scans_of(out, "/scan")
 
-        ref = os.path.join(self.tmp, "ref.bag")
-        r = subprocess.run([os.path.join(APPS, "kfd-filter"), "-q", "-i", bag, "-o", ref]
-                           + list(filter_args), capture_output=True, text=True)
-        self.assertEqual(r.returncode, 0, r.stderr)
-        return kept, stats, played, scans_of(ref, "/scan")
+        return kept, stats, played, self.kfd_filter(bag, filter_args)
 
     def prefix(self, bag, seconds, tail=2.0):
         """The first `seconds` of `bag`'s scans with `tail` seconds more of everything else (the
@@ -289,19 +320,7 @@ class KfdNodeLive(unittest.TestCase):
         self.assertLessEqual(len(kept), len(ref))
 
         # The node's kept scans are kfd-filter's first N, field for field.
-        nan_points = 0
-        for i, (a, b) in enumerate(zip(kept, ref)):
-            where = "kept scan %d (node stamp %s, kfd-filter stamp %s)" % (
-                i, a.header.stamp.to_sec(), b.header.stamp.to_sec())
-            self.assertEqual(a.header.stamp, b.header.stamp, where)
-            self.assertEqual(a.header.frame_id, b.header.frame_id, where)
-            self.assertEqual((a.angle_min, a.angle_max, a.angle_increment, a.time_increment,
-                              a.scan_time, a.range_min, a.range_max),
-                             (b.angle_min, b.angle_max, b.angle_increment, b.time_increment,
-                              b.scan_time, b.range_min, b.range_max), where)
-            self.assertTrue(same_floats(a.ranges, b.ranges), "%s: %s" % (where, diff(a, b)))
-            self.assertTrue(same_floats(a.intensities, b.intensities), where)
-            nan_points += sum(1 for x in a.ranges if math.isnan(x))
+        nan_points = self.assert_same_scans(kept, ref)
         print("  %s: %d scans played, node kept %d (kfd-filter %d), "
               "%d NaN ranges; p50 %s us, p99 %s us" % (
                   os.path.basename(bag), len(played), len(kept), len(ref), nan_points,
