@@ -49,11 +49,17 @@ class RecordingStage : public Stage {
         seen_denoised = chain.find<Denoiser::Result>() != nullptr;
         return keep_;
     }
+    void observeDropped(const Scan& scan) override {
+        ++observed;
+        observed_valid = scan.countValid();
+    }
     void reset() override {
         if (resets_) ++*resets_;
     }
     std::size_t seen_valid = 0;
     bool seen_denoised = false;
+    int observed = 0;                // dropped scans shown to it
+    std::size_t observed_valid = 0;  // valid beams of the last one
 
   private:
     const char* name_;
@@ -191,6 +197,25 @@ TEST(Pipeline, CustomStageCanDropScans) {
     EXPECT_EQ(r.dropped_by, "gate");
     EXPECT_EQ(first_calls, 1);
     EXPECT_EQ(second_calls, 0);
+}
+
+TEST(Pipeline, StagesAfterTheDropSeeTheDroppedScanAndStagesBeforeItDoNot) {
+    Pipeline p(withStages({"distance"}));
+    int calls[3] = {0, 0, 0};
+    auto before = std::make_unique<RecordingStage>("before", true, &calls[0]);
+    auto gate = std::make_unique<RecordingStage>("gate", false, &calls[1]);
+    auto after = std::make_unique<RecordingStage>("after", true, &calls[2]);
+    RecordingStage *b = before.get(), *g = gate.get(), *a = after.get();
+    p.add(std::move(before));
+    p.add(std::move(gate));
+    p.add(std::move(after));
+    Scan scan = noisyWall();
+    EXPECT_FALSE(p.process(scan).keep);
+    EXPECT_EQ(b->observed, 0);  // it processed the scan
+    EXPECT_EQ(g->observed, 0);  // it dropped it
+    EXPECT_EQ(a->observed, 1);
+    EXPECT_EQ(calls[2], 0);
+    EXPECT_EQ(a->observed_valid, 118u);  // as the gate left it: after the distance stage
 }
 
 TEST(Pipeline, AddRejectsNull) {

@@ -92,17 +92,21 @@ ScanReport Pipeline::process(Scan& scan) {
     report.points_in = scan.countValid();
     // One clock read per stage: each stage's end is the next one's start.
     auto t = t0;
-    for (auto& stage : stages_) {
+    for (std::size_t i = 0; i < stages_.size(); ++i) {
+        Stage& stage = *stages_[i];
         StageReport& sr = report.stage_reports[report.stage_count++];
-        sr.name = stage->name();
-        const bool keep = stage->process(scan, sr, report);
+        sr.name = stage.name();
+        const bool keep = stage.process(scan, sr, report);
+        if (!keep) {  // the later stages see the dropped scan (Stage::observeDropped)
+            for (std::size_t j = i + 1; j < stages_.size(); ++j) stages_[j]->observeDropped(scan);
+        }
         const auto now = Clock::now();
         sr.microseconds = std::chrono::duration<double, std::micro>(now - t).count();
         t = now;
         if (!keep) {
             sr.dropped = true;
             report.keep = false;
-            report.dropped_by = stage->name();
+            report.dropped_by = stage.name();
             break;
         }
     }

@@ -106,6 +106,12 @@ class Stage {
     virtual ~Stage() = default;
     virtual const char* name() const = 0;
     virtual bool process(Scan& scan, StageReport& report, const ScanReport& chain) = 0;
+    /// A scan an earlier stage dropped (process() does not run for it): a stage that learns
+    /// from every scan the sensor took (the denoiser's temporal evidence, issue 25) looks at it
+    /// here. Called for every stage after the one that dropped it, in order; must be cheap
+    /// (a dropped scan's whole cost is the point of dropping it) and not allocate in steady
+    /// state. The default ignores it.
+    virtual void observeDropped(const Scan& /*scan*/) {}
     /// Forget all stream state (called when the sensor's geometry changes).
     virtual void reset() {}
 };
