@@ -32,6 +32,8 @@ NOT_RUN = {
     "sh -c ": "a Slurm array task's line (runs one emitted job)",
     "kfd-compare --datasets": "an option of kfd-compare run, quoted in a sentence",
     "export ROS_PACKAGE_PATH": "ROS 1 node: needs a ROS master (the ros1 tests run the node)",
+    "ROS_PACKAGE_PATH=build/ros roslaunch ": "ROS 1 launch: needs a ROS master (kfd_launch_test "
+    "runs both launch files)",
     "roslaunch ": "ROS 1 launch: needs a ROS master (kfd_launch_test runs both launch files)",
     "build/apps/kfd_node": "ROS 1 node: needs a ROS master (the ros1 tests run the node)",
     "/usr/lib/nodelet/nodelet": "ROS 1 nodelet: needs a ROS master and a nodelet manager",
