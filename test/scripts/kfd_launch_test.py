@@ -131,18 +131,7 @@ class KfdLaunch(live.RosCase):
         seconds = time.monotonic() - start
         _kill_group(launched)  # SIGINT: roslaunch stops its nodes
         self.assertNotIn("has died", self.full_log("roslaunch"))
-        time.sleep(1.0)
-        _kill_group(recorder)
-        self.assertTrue(os.path.isfile(out), "no recorded bag: " + self.log_of("record"))
-
-        import rosbag
-        stats = None
-        with rosbag.Bag(out) as b:
-            for _, m, _ in b.read_messages(topics=["/kfd/stats"]):
-                stats = {kv.key: kv.value for kv in m.values}
-        self.assertIsNotNone(stats, "no ~stats recorded")
-        kept = scans_of(out, scan_filtered)
-        played = scans_of(out, "/scan")
+        stats, kept, played = self.stop_recording(recorder, out, "/kfd/stats", scan_filtered)
         ref = self.kfd_filter(bag, filter_args)
 
         # Nothing lost: the recorder saw every scan of the bag, the filter every scan played,

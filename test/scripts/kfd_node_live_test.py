@@ -163,6 +163,20 @@ class RosCase(unittest.TestCase):
         self.wait_for(lambda: self.master.getSystemState("/kfd_test")[0] == 1, 30,
                       "roscore on " + self.uri)
 
+
+    def stop_recording(self, recorder, out, stats_topic, filtered_topic):
+        """Stops `rosbag record` (a second after the filter, whose last ~stats it records) and
+        returns (the last ~stats as a dict, the filtered scans, the /scan messages) of `out`."""
+        time.sleep(1.0)
+        _kill_group(recorder)
+        self.assertTrue(os.path.isfile(out), "no recorded bag: " + self.log_of("record"))
+        import rosbag
+        stats = None
+        with rosbag.Bag(out) as b:
+            for _, m, _ in b.read_messages(topics=[stats_topic]):
+                stats = {kv.key: kv.value for kv in m.values}
+        self.assertIsNotNone(stats, "no ~stats recorded")
+        return stats, scans_of(out, filtered_topic), scans_of(out, "/scan")
     def start(self, name, argv):
         log = open(os.path.join(self.tmp, name + ".log"), "w")
         self.addCleanup(log.close)
@@ -271,19 +285,8 @@ class KfdNodeLive(RosCase):
         self.wait_idle(node.pid)
         self.assertIsNone(node.poll(), "kfd_node died: " + self.log_of("kfd_node"))
         _kill_group(node)  # SIGINT: it publishes ~stats once more at shutdown
-        time.sleep(1.0)
-        _kill_group(recorder)
-        self.assertTrue(os.path.isfile(out), "no recorded bag: " + self.log_of("record"))
-
-        import rosbag
-        stats = None
-        with rosbag.Bag(out) as b:
-            for _, m, _ in b.read_messages(topics=["/kfd_node/stats"]):
-                stats = {kv.key: kv.value for kv in m.values}
-        self.assertIsNotNone(stats, "no ~stats recorded")
-        kept = scans_of(out, "/scan_filtered")
-        played = scans_of(out, "/scan")
-
+        stats, kept, played = self.stop_recording(recorder, out, "/kfd_node/stats",
+                                                  "/scan_filtered")
         return kept, stats, played, self.kfd_filter(bag, filter_args)
 
     def prefix(self, bag, seconds, tail=2.0):
