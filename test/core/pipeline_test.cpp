@@ -215,7 +215,9 @@ TEST(Pipeline, StagesAfterTheDropSeeTheDroppedScanAndStagesBeforeItDoNot) {
     EXPECT_EQ(g->observed, 0);  // it dropped it
     EXPECT_EQ(a->observed, 1);
     EXPECT_EQ(calls[2], 0);
-    EXPECT_EQ(a->observed_valid, 118u);  // as the gate left it: after the distance stage
+    // As the gate left it, after the distance stage: the 121 wall beams (30-150, outliers
+    // included) less beam 60 (45 m) and beam 61 (NaN).
+    EXPECT_EQ(a->observed_valid, 119u);
 }
 
 TEST(Pipeline, AddRejectsNull) {
