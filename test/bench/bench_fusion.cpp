@@ -16,6 +16,7 @@
 // and divide by the dropped / keyframe counts the program prints.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -98,7 +99,8 @@ int main(int argc, char** argv) {
     auto src = kfd::openSource(argv[1]);
     kfd::SourceEntry e;
     kfd::Scan s;
-    std::vector<float> before, after;
+    std::vector<float> before, after, raw;
+    std::vector<std::uint8_t> changed;  // per residual: its beam was fused
     std::size_t scans = 0, dropped = 0, keyframes = 0, fused = 0, valid = 0, agreeing = 0;
     std::size_t used = 0, kept = 0, misaligned = 0;
     double sigma_sum = 0.0;
@@ -123,9 +125,11 @@ int main(int argc, char** argv) {
             }
             ++keyframes;
             residuals(s, before);
+            raw = s.range;
             kfd::StageReport sr;
             kfd_fx_keyframe(fuse, s, sr, r);
             residuals(s, after);
+            for (std::size_t i = 1; i + 1 < s.size(); ++i) changed.push_back(s.range[i] != raw[i]);
             const auto* d = sr.diagnostics<kfd::ScanFusion::Result>();
             fused += d->beams_fused;
             valid += d->beams_valid;
@@ -139,12 +143,21 @@ int main(int argc, char** argv) {
     }
     const double sig_b = quantile(before, 0.1) / kDecileScale;
     const double sig_a = quantile(after, 0.1) / kDecileScale;
-    std::vector<float> line_b, line_a;
+    std::vector<float> line_b, line_a, fused_b, fused_a, fline_b, fline_a;
     const float tol = static_cast<float>(3.0 * 1.2247448713915889 * sig_b);
     for (std::size_t i = 0; i < before.size(); ++i)
         if (std::isfinite(before[i]) && before[i] <= tol) {
             line_b.push_back(before[i]);
             line_a.push_back(after[i]);
+            if (changed[i]) {
+                fline_b.push_back(before[i]);
+                fline_a.push_back(after[i]);
+            }
+        }
+    for (std::size_t i = 0; i < before.size(); ++i)
+        if (changed[i]) {
+            fused_b.push_back(before[i]);
+            fused_a.push_back(after[i]);
         }
     std::printf("log %s\nscans %zu dropped %zu keyframes %zu\n", argv[1], scans, dropped,
                 keyframes);
@@ -156,5 +169,13 @@ int main(int argc, char** argv) {
     std::printf("sigma_decile_m before %.5f after %.5f\n", sig_b, sig_a);
     std::printf("med_line_m before %.5f after %.5f (line-like beams %zu)\n", quantile(line_b, 0.5),
                 quantile(line_a, 0.5), line_b.size());
+    // The same on the fused beams only (the others are unchanged, or changed only through a
+    // fused neighbour).
+    std::printf(
+        "fused beams: sigma_decile_m before %.5f after %.5f; med_line_m before %.5f "
+        "after %.5f (%zu); med_all_m before %.5f after %.5f (%zu)\n",
+        quantile(fused_b, 0.1) / kDecileScale, quantile(fused_a, 0.1) / kDecileScale,
+        quantile(fline_b, 0.5), quantile(fline_a, 0.5), fline_b.size(), quantile(fused_b, 0.5),
+        quantile(fused_a, 0.5), fused_b.size());
     return 0;
 }
