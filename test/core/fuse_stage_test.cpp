@@ -85,7 +85,8 @@ TEST(FuseStage, IsRegisteredWithItsKeys) {
     EXPECT_EQ(names, (std::vector<std::string>{
                          "fuse_max_scans", "fuse_min_agreeing", "fuse_gate_sigmas",
                          "fuse_max_bias_sigmas", "fuse_estimator", "fuse_min_sigma_m",
-                         "fuse_max_step_m", "fuse_max_step_deg", "fuse_max_span_beams"}));
+                         "fuse_max_step_m", "fuse_max_step_deg", "fuse_max_span_beams",
+                         "fuse_refine_iterations", "fuse_refine_samples", "fuse_refine_gate_m"}));
     auto params = info->defaults();
     for (const auto& k : info->keys) {  // every default prints and reads back
         const std::string text = k.get(params->data());

@@ -40,7 +40,17 @@ std::vector<StageKey> FuseStage::keys() {
                       180, true, [](P& p) -> double& { return p.max_step_deg; }),
         keys::count<P>("fuse_max_span_beams", "max_span_beams",
                        "fuse: keyframe beams one segment of a dropped scan may span", 1, 64,
-                       [](P& p) -> std::size_t& { return p.max_span_beams; })};
+                       [](P& p) -> std::size_t& { return p.max_span_beams; }),
+        keys::count<P>("fuse_refine_iterations", "refine_iterations",
+                       "fuse: Gauss-Newton steps aligning each dropped scan to the keyframe "
+                       "(point to line) before the gate; 0 = odometry only",
+                       0, 20, [](P& p) -> std::size_t& { return p.refine_iterations; }),
+        keys::count<P>("fuse_refine_samples", "refine_samples",
+                       "fuse: returns of a dropped scan used per alignment step", 12, 4096,
+                       [](P& p) -> std::size_t& { return p.refine_samples; }),
+        keys::real<P>("fuse_refine_gate_m", "refine_gate_m",
+                      "fuse: pairing gate of the first alignment step (m, halved after)", 0, 10,
+                      true, [](P& p) -> double& { return p.refine_gate_m; })};
 }
 
 bool FuseStage::process(Scan& scan, StageReport& report, const ScanReport&) {

@@ -50,6 +50,12 @@ void ScanFusion::initialize(const Params& p) {
         throw ParameterError("max_step_deg", "fuse_max_step_deg must be in (0, 180]");
     if (p.max_span_beams < 1 || p.max_span_beams > 64)
         throw ParameterError("max_span_beams", "fuse_max_span_beams must be in [1, 64]");
+    if (p.refine_iterations > 20)
+        throw ParameterError("refine_iterations", "fuse_refine_iterations must be in [0, 20]");
+    if (p.refine_samples < 12 || p.refine_samples > 4096)
+        throw ParameterError("refine_samples", "fuse_refine_samples must be in [12, 4096]");
+    if (!(p.refine_gate_m > 0.0) || !(p.refine_gate_m <= 10.0))
+        throw ParameterError("refine_gate_m", "fuse_refine_gate_m must be in (0, 10]");
     params_ = p;
     slots_.assign(p.max_scans, Slot{});
     used_.assign(p.max_scans, 0);
@@ -96,6 +102,80 @@ double ScanFusion::measureSigma(const Scan& scan, std::size_t stride, std::vecto
     return static_cast<double>(*q) / (0.1257 * kResidualScale);
 }
 
+bool ScanFusion::refine(const Scan& kf, const Slot& slot, Pose2D& d) const {
+    // Projective point-to-line alignment (EvidenceFilter::refineStep's method): each sampled
+    // return is projected into the keyframe and paired with the keyframe segment between its
+    // two bracketing beams (when they are one surface); Gauss-Newton on the distances to those
+    // lines corrects the step. The gate halves per iteration; too few pairs keep the step.
+    const std::size_t n = kf.range.size();
+    const std::size_t stride = std::max<std::size_t>(1, n / params_.refine_samples);
+    const float first = static_cast<float>(slot.geometry.angle(0));
+    const float inv_step = static_cast<float>(1.0 / slot.geometry.step());
+    double gate = params_.refine_gate_m;
+    bool changed = false;
+    for (std::size_t it = 0; it < params_.refine_iterations; ++it) {
+        const float c = static_cast<float>(std::cos(d.phi)),
+                    s = static_cast<float>(std::sin(d.phi));
+        const float tx = static_cast<float>(d.x), ty = static_cast<float>(d.y);
+        const float gate_f = static_cast<float>(gate);
+        double A[6] = {0, 0, 0, 0, 0, 0}, b[3] = {0, 0, 0};  // upper triangle of J^T J, J^T e
+        std::size_t pairs = 0;
+        for (std::size_t j = 0; j < n; j += stride) {
+            if (!slot.valid[j]) continue;
+            const float px = slot.range[j] * dirs_.cos[j], py = slot.range[j] * dirs_.sin[j];
+            const float qx = c * px - s * py + tx, qy = s * px + c * py + ty;
+            const float u = (EvidenceFilter::approxAtan2(qy, qx) - first) * inv_step;
+            if (!(u >= 0.0f) || !(u < static_cast<float>(n - 1))) continue;
+            const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
+            if (!klink_[k0]) continue;
+            float nx = ky_[k0] - ky_[k1], ny = kx_[k1] - kx_[k0];
+            const float len2 = nx * nx + ny * ny;
+            if (!(len2 > 1e-12f)) continue;
+            const float inv = 1.0f / std::sqrt(len2);
+            nx *= inv;
+            ny *= inv;
+            const float e = nx * (qx - kx_[k0]) + ny * (qy - ky_[k0]);
+            if (!(std::abs(e) <= gate_f)) continue;
+            const float j2 = -nx * qy + ny * qx;  // d e / d theta (rotation about the origin)
+            A[0] += nx * nx;
+            A[1] += nx * ny;
+            A[2] += nx * j2;
+            A[3] += ny * ny;
+            A[4] += ny * j2;
+            A[5] += j2 * j2;
+            b[0] += nx * e;
+            b[1] += ny * e;
+            b[2] += j2 * e;
+            ++pairs;
+        }
+        gate = 0.5 * gate;
+        if (pairs < 12) break;
+        // Damped normal equations (a corridor leaves one direction unconstrained).
+        const double damp = 1e-3 * static_cast<double>(pairs);
+        const double a00 = A[0] + damp, a01 = A[1], a02 = A[2], a11 = A[3] + damp, a12 = A[4],
+                     a22 = A[5] + damp * 10.0;
+        const double det = a00 * (a11 * a22 - a12 * a12) - a01 * (a01 * a22 - a12 * a02) +
+                           a02 * (a01 * a12 - a11 * a02);
+        if (!(std::abs(det) > 1e-12)) break;
+        const double b0 = b[0], b1 = b[1], b2 = b[2];
+        const double dx = -(b0 * (a11 * a22 - a12 * a12) - a01 * (b1 * a22 - a12 * b2) +
+                            a02 * (b1 * a12 - a11 * b2)) /
+                          det;
+        const double dy = -(a00 * (b1 * a22 - a12 * b2) - b0 * (a01 * a22 - a12 * a02) +
+                            a02 * (a01 * b2 - b1 * a02)) /
+                          det;
+        const double dt = -(a00 * (a11 * b2 - b1 * a12) - a01 * (a01 * b2 - b1 * a02) +
+                            b0 * (a01 * a12 - a11 * a02)) /
+                          det;
+        if (!std::isfinite(dx) || !std::isfinite(dy) || !std::isfinite(dt)) break;
+        // q' = R(dt) q + (dx, dy): compose the increment onto the step.
+        const double cd = std::cos(dt), sd = std::sin(dt);
+        d = Pose2D{cd * d.x - sd * d.y + dx, sd * d.x + cd * d.y + dy, d.phi + dt};
+        changed = true;
+    }
+    return changed;
+}
+
 ScanFusion::Result ScanFusion::fuse(Scan& kf) {
     Result res;
     const std::size_t n = kf.range.size();
@@ -130,16 +210,32 @@ ScanFusion::Result ScanFusion::fuse(Scan& kf) {
     const double dt = std::min(res_rad, 0.5 * kLambda);
     const float factor = static_cast<float>(std::sin(dt) / std::sin(kLambda - dt));
     const float span = static_cast<float>(params_.max_span_beams);
+    if (params_.refine_iterations > 0) {  // the keyframe's points and surfaces, for refine()
+        kx_.resize(n);
+        ky_.resize(n);
+        klink_.assign(n, 0);
+        for (std::size_t k = 0; k < n; ++k) {
+            kx_[k] = kf.range[k] * dirs_.cos[k];
+            ky_[k] = kf.range[k] * dirs_.sin[k];
+        }
+        for (std::size_t k = 0; k + 1 < n; ++k) {
+            if (!kf.valid[k] || !kf.valid[k + 1]) continue;
+            const float ex = kx_[k + 1] - kx_[k], ey = ky_[k + 1] - ky_[k];
+            const float dmax = std::min(kf.range[k], kf.range[k + 1]) * factor + noise;
+            klink_[k] = ex * ex + ey * ey <= dmax * dmax;
+        }
+    }
 
     // 2.-3. Each kept scan, oldest first, into column s of cand_.
     for (std::size_t s = 0; s < kept; ++s) {
         const Slot& slot = slots_[(head_ + S - kept + s) % S];
         used_[s] = 0;
         if (slot.geometry != g) continue;
-        const Pose2D d = between(kf_pose, slot.pose);
+        Pose2D d = between(kf_pose, slot.pose);
         if (std::hypot(d.x, d.y) > params_.max_step_m ||
             std::abs(wrapAngle(d.phi)) > params_.max_step_deg * kDeg)
             continue;
+        if (params_.refine_iterations > 0 && refine(kf, slot, d)) ++res.scans_refined;
         const float c = static_cast<float>(std::cos(d.phi)),
                     sn = static_cast<float>(std::sin(d.phi));
         const float tx = static_cast<float>(d.x), ty = static_cast<float>(d.y);

@@ -22,7 +22,7 @@ class FuseStage : public Stage {
     using Params = ScanFusion::Params;
     /// Keys: fuse_max_scans, fuse_min_agreeing, fuse_gate_sigmas, fuse_max_bias_sigmas,
     /// fuse_estimator, fuse_min_sigma_m, fuse_max_step_m, fuse_max_step_deg,
-    /// fuse_max_span_beams.
+    /// fuse_max_span_beams, fuse_refine_iterations, fuse_refine_samples, fuse_refine_gate_m.
     static std::vector<StageKey> keys();
 
     explicit FuseStage(const Params& p = {}) : algo_(p) {}

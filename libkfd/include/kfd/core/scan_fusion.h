@@ -26,9 +26,11 @@ namespace kfd {
 ///     (EvidenceFilter::lineResidual), / (0.1257 sqrt(1.5)), floored at min_sigma_m and
 ///     smoothed over keyframes (0.8 / 0.2).
 ///  2. Each kept scan within max_step_m / max_step_deg of the keyframe (odometry) is moved
-///     into the keyframe's sensor frame; each pair of neighbouring returns on one surface (the
-///     adaptive breakpoint of the evidence filter, lambda 10 deg, + 3 sqrt(2) sigma) that
-///     spans keyframe beams (at most max_span_beams) gives, for each of them, the range where
+///     into the keyframe's sensor frame, the step refined by a projective point-to-line
+///     alignment (refine_iterations x refine_samples returns, against the keyframe's segments
+///     between neighbouring returns on one surface); each pair of neighbouring returns on one
+///     surface (the adaptive breakpoint of the evidence filter, lambda 10 deg, + 3 sqrt(2) sigma)
+///     that spans keyframe beams (at most max_span_beams) gives, for each of them, the range where
 ///     the beam meets the segment between the two (the nearer when two segments meet a beam).
 ///  3. A return agrees when within gate = gate_sigmas sqrt(2) sigma of the keyframe's own
 ///     range (the difference of two returns has sigma sqrt(2) sigma). A scan whose agreeing
@@ -52,6 +54,11 @@ class ScanFusion {
         double max_step_m = 1.0;         // m: dropped scans farther from the keyframe: not used
         double max_step_deg = 20.0;      // deg: the same, in rotation
         std::size_t max_span_beams = 4;  // keyframe beams one segment of a dropped scan may span
+        /// Gauss-Newton steps aligning each dropped scan to the keyframe (point to line, as the
+        /// evidence filter aligns to its keyframe) before the gate; 0 = odometry only.
+        std::size_t refine_iterations = 3;
+        std::size_t refine_samples = 96;  // returns used per step (every n/96-th)
+        double refine_gate_m = 0.2;       // m: pairing gate of the first step (halved after)
     };
 
     /// Diagnostics of one keyframe.
@@ -61,6 +68,7 @@ class ScanFusion {
         std::size_t scans_kept = 0;         // dropped scans in the ring at this keyframe
         std::size_t scans_used = 0;         // of those, the ones that took part
         std::size_t scans_misaligned = 0;   // rejected by the median-bias test (step 3)
+        std::size_t scans_refined = 0;      // whose odometry step the alignment changed
         double mean_scans_per_fused = 0.0;  // agreeing returns per fused beam (without its own)
         double sigma = 0.0;                 // m: range noise used (step 1)
     };
@@ -92,14 +100,20 @@ class ScanFusion {
         Pose2D pose;  // sensor pose by odometry
     };
 
+    // Refines d (the dropped scan's sensor in the keyframe's frame) against the keyframe's
+    // points kx_, ky_ and links; true when it changed.
+    bool refine(const Scan& kf, const Slot& slot, Pose2D& d) const;
+
     Params params_;
     std::vector<Slot> slots_;
     std::size_t head_ = 0, count_ = 0;  // next slot to write, slots filled
     BeamDirections dirs_;
-    std::vector<float> cand_;         // n x max_scans: range of scan s at beam k
-    std::vector<float> qx_, qy_, u_;  // a dropped scan's points in the keyframe's frame
-    std::vector<float> scratch_;      // residuals, differences
-    std::vector<std::uint8_t> used_;  // per slot: takes part
+    std::vector<float> cand_;          // n x max_scans: range of scan s at beam k
+    std::vector<float> qx_, qy_, u_;   // a dropped scan's points in the keyframe's frame
+    std::vector<float> kx_, ky_;       // the keyframe's points
+    std::vector<std::uint8_t> klink_;  // per keyframe beam: one surface with the next
+    std::vector<float> scratch_;       // residuals, differences
+    std::vector<std::uint8_t> used_;   // per slot: takes part
     double sigma_smoothed_ = -1.0;
 };
 
