@@ -108,7 +108,8 @@ bool ScanFusion::refine(const Scan& kf, const Slot& slot, Pose2D& d) const {
     // two bracketing beams (when they are one surface); Gauss-Newton on the distances to those
     // lines corrects the step. The gate halves per iteration; too few pairs keep the step.
     const std::size_t n = kf.range.size();
-    const std::size_t stride = std::max<std::size_t>(1, n / params_.refine_samples);
+    // At most refine_samples returns: every ceil(n / refine_samples)-th.
+    const std::size_t stride = (n + params_.refine_samples - 1) / params_.refine_samples;
     const float first = static_cast<float>(slot.geometry.angle(0));
     const float inv_step = static_cast<float>(1.0 / slot.geometry.step());
     double gate = params_.refine_gate_m;

@@ -57,7 +57,7 @@ class ScanFusion {
         /// Gauss-Newton steps aligning each dropped scan to the keyframe (point to line, as the
         /// evidence filter aligns to its keyframe) before the gate; 0 = odometry only.
         std::size_t refine_iterations = 3;
-        std::size_t refine_samples = 96;  // returns used per step (every n/96-th)
+        std::size_t refine_samples = 96;  // returns used per step, at most (every ceil(n/96)-th)
         double refine_gate_m = 0.2;       // m: pairing gate of the first step (halved after)
     };
 
