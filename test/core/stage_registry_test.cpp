@@ -24,8 +24,8 @@ using test::noisyWall;
 
 TEST(StageRegistry, CoreRegistryHoldsThePapersStagesInOrder) {
     const auto& r = coreStageRegistry();
-    EXPECT_EQ(r.names(), "distance, keyframe, denoise, odometry_check");
-    ASSERT_EQ(r.stages().size(), 4u);
+    EXPECT_EQ(r.names(), "distance, keyframe, denoise, odometry_check, fuse");
+    ASSERT_EQ(r.stages().size(), 5u);
     for (const auto& s : r.stages()) {
         EXPECT_FALSE(s.help.empty()) << s.name;
         EXPECT_FALSE(s.keys.empty()) << s.name;
@@ -114,7 +114,7 @@ TEST(StageRegistry, RejectsRepeatedAndEmptyNames) {
     EXPECT_THROW(r.add<KeyframeStage>(), Error);
     StageInfo nameless;
     EXPECT_THROW(r.add(nameless), Error);
-    EXPECT_EQ(r.stages().size(), 4u);
+    EXPECT_EQ(r.stages().size(), 5u);
 }
 
 TEST(PipelineParams, TypedAccessCopiesAndDefaults) {

@@ -12,6 +12,7 @@
 #include <random>
 
 #include "kfd/core/pipeline.h"
+#include "kfd/core/scan_fusion.h"
 #include "kfd/mrpt/default_stages.h"
 #include "kfd/mrpt/stream_filter.h"
 
@@ -87,6 +88,47 @@ TEST(Allocation, ReferencePipelineAllocatesNothingInSteadyState) {
 
 TEST(Allocation, RangeAwarePipelineAllocatesNothingInSteadyState) {
     EXPECT_EQ(steadyStateAllocations(kfd::DenoiseVariant::RangeAware), 0u);
+}
+
+// Issue 25: the fuse stage keeps dropped scans in preallocated slots and fuses keyframes
+// without allocating once its buffers have grown. One room seen while creeping forward 1 cm a
+// scan, so that most scans are dropped and every keyframe has returns to fuse.
+TEST(Allocation, FusePipelineAllocatesNothingInSteadyState) {
+    kfd::Pipeline::Params p;
+    p.stages = {"odometry_check", "distance", "keyframe", "fuse", "denoise"};
+    kfd::Pipeline pipe(p, kfd::defaultStageRegistry());
+    std::vector<kfd::Scan> scans = randomScans(60, 1081, 11);
+    std::mt19937 rng(3);
+    std::normal_distribution<float> noise(0.0f, 0.01f);
+    for (std::size_t k = 0; k < scans.size(); ++k) {  // one room, 1 cm further each scan
+        kfd::Scan& s = scans[k];
+        const double x = 0.01 * static_cast<double>(k);
+        for (std::size_t i = 0; i < s.size(); ++i) {
+            const double a = s.geometry.angle(i), c = std::cos(a), sn = std::sin(a);
+            const double rx = c > 0 ? (5.0 - x) / c : c < 0 ? (-5.0 - x) / c : 1e9;
+            const double ry = std::abs(sn) > 0 ? 4.0 / std::abs(sn) : 1e9;
+            s.range[i] = static_cast<float>(std::min(rx, ry)) + noise(rng);
+            s.valid[i] = 1;
+        }
+        s.odometry = kfd::Pose2D{x, 0.0, 0.0};
+    }
+    std::vector<kfd::Scan> work = scans;
+    for (auto& s : work) pipe.process(s);  // warm-up: buffers grow to their final size
+    work = scans;
+    pipe.reset();
+    g_allocations = 0;
+    g_counting = true;
+    std::size_t kept = 0, fused = 0;
+    for (auto& s : work) {
+        const auto r = pipe.process(s);
+        kept += r.keep;
+        if (const auto* d = r.find<kfd::ScanFusion::Result>()) fused += d->beams_fused;
+    }
+    g_counting = false;
+    EXPECT_GT(kept, 1u);
+    EXPECT_LT(kept, scans.size() / 2);  // most scans were dropped and fused into keyframes
+    EXPECT_GT(fused, 0u);
+    EXPECT_EQ(g_allocations.load(), 0u);
 }
 
 TEST(Allocation, CounterSeesAllocations) {  // the test above would be vacuous without this

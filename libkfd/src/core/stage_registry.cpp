@@ -2,6 +2,7 @@
 
 #include "kfd/core/denoise_stage.h"
 #include "kfd/core/distance_stage.h"
+#include "kfd/core/fuse_stage.h"
 #include "kfd/core/keyframe_stage.h"
 #include "kfd/core/odometry_check_stage.h"
 
@@ -39,6 +40,7 @@ void registerCoreStages(StageRegistry& registry) {
     registry.add<KeyframeStage>();
     registry.add<DenoiseStage>();
     registry.add<OdometryCheckStage>();  // kfd's, beyond the paper
+    registry.add<FuseStage>();           // kfd's, beyond the paper (issue 25)
 }
 
 StageRegistry makeStageRegistry(std::initializer_list<void (*)(StageRegistry&)> registrars) {
