@@ -21,6 +21,7 @@ also simulated again with seed K + 1.
   parallel -j 8 < jobs.txt                       # (or xargs -P, a Slurm array), then:
   kfd-compare collect OUT       # summary.md, report.md, runs.csv, runs.json, plots/
   kfd-compare diagnose OUT --modes kfd odometry@kfd   # where the drops cost: diagnose.md
+  kfd-compare configs OUT --mode kfd --configs A.ini B.ini   # one mode, two configs: configs.md
 
 Logs: a dataset folder name under --datasets (NAME/NAME.rawlog with NAME.relations) or a path
 to any log kfd-icp-slam reads: a .rawlog, a ROS 1 bag or a CARMEN log (NAME.relations and
@@ -44,6 +45,7 @@ import time
 
 from . import diagnose as kfd_diagnose
 from . import report as kfd_report
+from . import stats as kfd_stats
 
 # The package is python/kfd_tools in the source tree (tools in build/apps) or, installed,
 # DATADIR/kfd/python/kfd_tools (tools in the prefix's bin, else on PATH).
@@ -466,6 +468,41 @@ class DefaultsHelpFormatter(argparse.HelpFormatter):
         return "%s (default: %s)" % (h, shown or "none")
 
 
+def compare_configs(out, mode, config_a, config_b):
+    """Markdown: MODE under CONFIG_A against MODE under CONFIG_B on every log of OUT, paired by
+    repeat (the same start offset): per log and metric the medians, wins/losses of A (lower is
+    better) with the sign test's p, and the median ratio A/B with its bootstrap 95 % interval.
+    For a change inside the [KFD] section (two .ini files that differ in one key)."""
+    a_tag, b_tag = config_tag(config_a), config_tag(config_b)
+    runs = [r for r in load_runs(out) if r["mode"] == mode and r.get("finished", True)]
+    by = {}
+    for r in runs:
+        by.setdefault((r["log"], r["config"]), {})[r["repeat"]] = r
+    logs = sorted({log for log, _ in by})
+    if not any((log, a_tag) in by and (log, b_tag) in by for log in logs):
+        raise CompareError("no log has finished '%s' runs under both %s and %s in %s"
+                           % (mode, a_tag, b_tag, out))
+    lines = ["# %s: %s against %s" % (mode, a_tag, b_tag), "",
+             "Paired by repeat; W/L: runs where %s is lower / higher; p: two-sided exact sign "
+             "test; ratio: median of per-run ratios %s/%s [bootstrap 95 %%]." % (a_tag, a_tag,
+                                                                                b_tag), "",
+             "| log | metric | n | median %s | median %s | W/L (p) | ratio [95 %%] |"
+             % (a_tag, b_tag), "|---|---|---:|---:|---:|---:|---:|"]
+    for log in logs:
+        ra, rb = by.get((log, a_tag), {}), by.get((log, b_tag), {})
+        for metric in ("local", "long", "all", "cpu"):
+            pairs = [(ra[k][metric], rb[k][metric]) for k in sorted(set(ra) & set(rb))
+                     if ra[k].get(metric) is not None and rb[k].get(metric) is not None]
+            if not pairs:
+                continue
+            xa, xb = [x for x, _ in pairs], [y for _, y in pairs]
+            st = kfd_stats.paired(xa, xb)
+            lines.append("| %s | %s | %d | %.3f | %.3f | %d/%d (%.2g) | %.2f [%.2f-%.2f] |" % (
+                log, metric, st["n"], kfd_stats.median(xa), kfd_stats.median(xb), st["wins"],
+                st["losses"], st["p_sign"], st["median_ratio"], st["ratio_lo"], st["ratio_hi"]))
+    return "\n".join(lines) + "\n"
+
+
 def build_parser():
     """kfd-compare's command line: run, job, collect, diagnose."""
     ap = argparse.ArgumentParser(
@@ -524,6 +561,11 @@ def build_parser():
     c = sub.add_parser("collect", parents=[report],
                        help="merge the finished runs of DIR into its report", **fmt)
     c.add_argument("dir", help="a comparison's output folder")
+    k = sub.add_parser("configs", help="one mode under two configs, paired by repeat", **fmt)
+    k.add_argument("dir", help="a comparison's output folder (run with both configs)")
+    k.add_argument("--mode", default="kfd", help="the mode to compare (default: kfd)")
+    k.add_argument("--configs", nargs=2, required=True, metavar=("A", "B"),
+                   help="the two kfd-icp-slam .ini files (or their names) of the run")
     g = sub.add_parser("diagnose", help="gaps between kept scans and the local error they cost",
                        **fmt)
     g.add_argument("dir", help="a comparison's output folder")
@@ -543,6 +585,12 @@ def main(argv=None):
         if a.command == "job":
             parse_mode(a.mode)
             run_job(a)
+            return 0
+        if a.command == "configs":
+            text = compare_configs(a.dir, a.mode, a.configs[0], a.configs[1])
+            with open(os.path.join(a.dir, "configs.md"), "w") as f:
+                f.write(text)
+            sys.stdout.write(text)
             return 0
         if a.command == "diagnose":
             text = kfd_diagnose.diagnose(a.dir, a.modes, a.reference, a.split_seconds,

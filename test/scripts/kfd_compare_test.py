@@ -30,6 +30,37 @@ class KfdCompare(unittest.TestCase):
     def tearDown(self):
         shutil.rmtree(self.tmp)
 
+    def fake_runs(self, out, config, mode, local):
+        """Finished runs of `mode` under `config` on log L, one per value of `local`."""
+        for k, v in enumerate(local):
+            d = os.path.join(out, "runs", "L", config, mode, "r%02d" % k)
+            os.makedirs(d)
+            with open(os.path.join(d, "run.json"), "w") as f:
+                json.dump({"log": "L", "config": config, "mode": mode, "repeat": k,
+                           "finished": True, "local": v, "long": 2 * v, "all": 3 * v,
+                           "cpu": 10.0 + k}, f)
+
+    def test_configs_pairs_one_mode_under_two_configs_by_repeat(self):
+        out = os.path.join(self.tmp, "out")
+        # Under A the local error is lower on 7 of 8 repeats; the repeats pair up by number.
+        a = [0.10, 0.11, 0.09, 0.12, 0.10, 0.08, 0.13, 0.30]
+        b = [0.20, 0.21, 0.19, 0.22, 0.20, 0.18, 0.23, 0.10]
+        self.fake_runs(out, "cfgA", "kfd", a)
+        self.fake_runs(out, "cfgB", "kfd", b)
+        self.fake_runs(out, "cfgB", "none", b)  # another mode: not in the table
+        r = compare("configs", out, "--mode", "kfd", "--configs", "share/x/cfgA.ini", "cfgB.ini")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        rows = {line.split("|")[2].strip(): line for line in r.stdout.splitlines()
+                if line.startswith("| L |")}
+        self.assertEqual(set(rows), {"local", "long", "all", "cpu"})
+        # 7 wins, 1 loss: two-sided exact sign test p = 18/256 = 0.0703
+        self.assertIn("| 8 | 0.105 | 0.200 | 7/1 (0.07) |", rows["local"])
+        self.assertIn("| 0/0 (1) |", rows["cpu"])  # the same CPU times: all ties
+        self.assertEqual(open(os.path.join(out, "configs.md")).read(), r.stdout)
+        bad = compare("configs", out, "--mode", "kfd", "--configs", "cfgA", "cfgC")
+        self.assertEqual(bad.returncode, 1)
+        self.assertIn("no log has finished 'kfd' runs under both cfgA and cfgC", bad.stderr)
+
     def test_small_run_reports_every_log_mode_and_pair(self):
         csail = os.path.join(DATASETS, "mit-csail", "mit-csail.rawlog")
         if not os.path.exists(csail):
