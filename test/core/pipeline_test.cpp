@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "kfd/core/denoise_stage.h"
 #include "test_scans.h"
 
 namespace kfd {
@@ -215,7 +216,41 @@ TEST(Pipeline, StagesAfterTheDropSeeTheDroppedScanAndStagesBeforeItDoNot) {
     EXPECT_EQ(g->observed, 0);  // it dropped it
     EXPECT_EQ(a->observed, 1);
     EXPECT_EQ(calls[2], 0);
-    EXPECT_EQ(a->observed_valid, 118u);  // as the gate left it: after the distance stage
+    // As the gate left it: after the distance stage (the wall's 121 returns, 30-150, less 60, 61).
+    EXPECT_EQ(a->observed_valid, 119u);
+}
+
+/// Drops every scan whose odometry is not a whole number of metres (the "keyframes").
+class WholeMetreGate : public Stage {
+  public:
+    const char* name() const override { return "gate"; }
+    bool process(Scan& scan, StageReport&, const ScanReport&) override {
+        return std::abs(scan.odometry->x - std::round(scan.odometry->x)) < 1e-9;
+    }
+};
+
+TEST(Pipeline, TheDenoiserUsesTheScanDroppedJustBeforeAKeyframe) {
+    // Keyframes 1 m apart (a wide keyframe margin supports a spike 0.12 m before the wall);
+    // the scan dropped 2 cm before the second keyframe sees through it (issue 25).
+    for (const std::size_t kept : {0u, 1u}) {
+        Pipeline p(withStages({}));
+        DenoiseStage::Params dp;
+        dp.evidence.sigma_m = 0.01;
+        dp.evidence.temporal_scans = kept;
+        p.add(std::make_unique<WholeMetreGate>());
+        p.add(std::make_unique<DenoiseStage>(dp));
+        auto wall = [](double x) {
+            Scan s = test::flatWall(361, test::deg2rad(150.0), 4.0 - x);
+            s.odometry = Pose2D{x, 0.0, 0.0};
+            return s;
+        };
+        Scan a = wall(0.0), dropped = wall(0.98), b = wall(1.0);
+        test::insertSpike(b, 180, 2.88);
+        EXPECT_TRUE(p.process(a).keep);
+        EXPECT_FALSE(p.process(dropped).keep);
+        EXPECT_TRUE(p.process(b).keep);
+        EXPECT_EQ(b.valid[180], kept > 0 ? 0 : 1) << kept;
+    }
 }
 
 TEST(Pipeline, AddRejectsNull) {
