@@ -211,6 +211,27 @@ TEST(EvidenceFilter, ASpikeNearAWallIsRemovedWithTheScanJustBeforeTheKeyframe) {
     }
 }
 
+TEST(EvidenceFilter, WhenTheScanJustBeforeWantsTooMuchTheKeyframesAloneDecide) {
+    // 20 beams 0.3 m before the wall: the scan 2 cm before sees through them, the keyframe
+    // 1 m back supports them. 20 returns exceed a 5 % bound (18 of 361): the keyframes decide.
+    for (const double bound : {0.05, 1.0}) {
+        EvidenceFilter::Params p = withRecent(1);
+        p.max_removed_fraction = bound;
+        EvidenceFilter f(p);
+        Clusters c;
+        Scan first = room();
+        f.filter(first, c);
+        f.observe(roomAfter(0.98));
+        Scan second = roomAfter(1.0);
+        test::setRange(second, 170, 189, 2.7);
+        const auto r = f.filter(second, c);
+        EXPECT_TRUE(r.recent);
+        EXPECT_EQ(r.recent_overruled, bound < 1.0) << bound;
+        EXPECT_FALSE(r.stale_references);
+        EXPECT_EQ(r.points_removed, bound < 1.0 ? 0u : 20u) << bound;
+    }
+}
+
 TEST(EvidenceFilter, AThinPostSeenJustBeforeIsKept) {
     // A two-beam post at 2 m (small) in front of the wall: the scan just before saw it too.
     auto withPost = [](Scan s) {

@@ -426,12 +426,13 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
 }
 
 bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, double sigma,
-                                      Result& res) {
+                                      Result& res, bool recent) {
     const std::size_t n = scan.range.size();
     have_pose_ = false;
     if (!params_.temporal) return false;
     // 3b. The raw scan just before (tight margins from its own alignment), when kept.
-    const Projection pt = recentProjection(scan, 0, sigma, res);
+    Projection pt;
+    if (recent) pt = recentProjection(scan, 0, sigma, res);
     res.recent = pt.usable;
     // This scan's sensor in the newest keyframe's frame: the odometry step (no motion without
     // odometry), refined.
@@ -503,7 +504,7 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
         const Projection p1 = projection(r1, between(r1.pose, pose_), sigma);
         if (p1.usable) support(p1);
     }
-    for (std::size_t age = 1; age < raw_count_ && !unknown_.empty(); ++age) {
+    for (std::size_t age = 1; recent && age < raw_count_ && !unknown_.empty(); ++age) {
         const Projection pa = recentProjection(scan, age, sigma, res);
         if (pa.usable) support(pa);
     }
@@ -555,7 +556,7 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
 
     // 3. Temporal evidence from the last two keyframes.
     evidence_.assign(n, kUnknown);
-    res.temporal = temporalEvidence(scan, out, sigma, res);
+    res.temporal = temporalEvidence(scan, out, sigma, res, true);
 
     // 4. Segments: small and unsupported, or mostly in free space.
     const std::size_t valid_in = scan.countValid();
@@ -563,15 +564,27 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
         std::floor(params_.max_removed_fraction * static_cast<double>(valid_in)));
     res.removal_wanted = markNoise(out, res.temporal, evidence_);
     // 5. Bounded removal: more than the bound disagrees with the references: they are stale.
+    // With the raw scan just before, first the keyframes alone (what temporal_scans = 0 does).
     bool temporal = res.temporal;
-    if (res.removal_wanted > cap && temporal) {
+    std::size_t wanted = res.removal_wanted;
+    if (wanted > cap && temporal && res.recent) {
+        Result kf;
+        evidence_.assign(n, kUnknown);
+        temporal = temporalEvidence(scan, out, sigma, kf, false);
+        res.free_points = kf.free_points;
+        res.supported = kf.supported;
+        res.tracked = kf.tracked;
+        res.recent_overruled = true;
+        wanted = markNoise(out, temporal, evidence_);
+    }
+    if (wanted > cap && temporal) {
         res.stale_references = true;
         temporal = false;
         if (markNoise(out, false, evidence_) > cap) {
             capNoise(out, cap);
             res.capped = true;
         }
-    } else if (res.removal_wanted > cap) {
+    } else if (wanted > cap) {
         capNoise(out, cap);
         res.capped = true;
     }

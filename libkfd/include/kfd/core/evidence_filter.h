@@ -67,7 +67,8 @@ namespace kfd {
 ///     evidence (first scan, too large a step, a new geometry) only small segments go.
 ///  5. Bounded removal (issue 22): when the removals of step 4 exceed max_removed_fraction of
 ///     the scan's valid returns, the references are stale (a turn or a walk away, odometry
-///     that lied), not the scan: step 4 runs again without temporal evidence. When even that
+///     that lied), not the scan: with step 3b's raw scans, steps 3-4 first run again on the
+///     keyframes alone; then step 4 runs again without temporal evidence. When even that
 ///     exceeds the bound, the smallest segments go first until the bound is reached. Both are
 ///     reported (Result::stale_references, Result::capped).
 class EvidenceFilter {
@@ -119,6 +120,7 @@ class EvidenceFilter {
         bool capped = false;             // step 5: spatial removal cut to the bound too
         bool recent = false;             // step 3b: the raw scan just before was used
         double recent_margin_m = 0.0;    // m: its margin's constant part (3 max(sqrt 2 sigma, s))
+        bool recent_overruled = false;   // step 5: it wanted too much; the keyframes alone used
     };
 
     EvidenceFilter() { initialize(Params{}); }
@@ -173,7 +175,9 @@ class EvidenceFilter {
     void updateTables(const ScanGeometry& g);
     double estimateSigma(const Scan& scan);
     void segment(const Scan& scan, double sigma, Clusters& out);
-    bool temporalEvidence(const Scan& scan, const Clusters& out, double sigma, Result& res);
+    // `recent`: use the raw scans of step 3b (false: the keyframes only).
+    bool temporalEvidence(const Scan& scan, const Clusters& out, double sigma, Result& res,
+                          bool recent);
     Projection projection(const Reference& ref, const Pose2D& d, double sigma) const;
     std::uint8_t classify(const Projection& pr, float x, float y, bool free_test) const;
     // `spread` (optional): 1.4826 x the median |residual| of the last iteration's pairs (m).
