@@ -42,6 +42,13 @@ kfd::Pipeline::Params viewDropParams(std::size_t temporal_scans = 0) {
     return p;
 }
 
+// The evidence denoiser on the keyframes alone (temporal_scans 0: before issue 25).
+kfd::Pipeline::Params keyframesOnlyParams() {
+    kfd::Pipeline::Params p = kb::paperParams(kfd::DenoiseVariant::Evidence);
+    p.get<kfd::DenoiseStage>().evidence.temporal_scans = 0;
+    return p;
+}
+
 // The evidence denoiser with the raw scan just before each keyframe (issue 25).
 kfd::Pipeline::Params temporalParams() {
     kfd::Pipeline::Params p = kb::paperParams(kfd::DenoiseVariant::Evidence);
@@ -81,7 +88,7 @@ struct Context {
         kb::paperParams(kfd::DenoiseVariant::Reference).get<kfd::DenoiseStage>()};
     kfd::Denoiser range_aware{
         kb::paperParams(kfd::DenoiseVariant::RangeAware).get<kfd::DenoiseStage>()};
-    kfd::Denoiser evidence{kb::paperParams(kfd::DenoiseVariant::Evidence).get<kfd::DenoiseStage>()};
+    kfd::Denoiser evidence{keyframesOnlyParams().get<kfd::DenoiseStage>()};
     kfd::Denoiser evidence_temporal{temporalParams().get<kfd::DenoiseStage>()};
     kfd::DbscanFilter dbscan{kfd::DbscanFilter::Params{0.7, 10}};
     kfd::RadiusOutlierFilter radius{kfd::RadiusOutlierFilter::Params{}};
