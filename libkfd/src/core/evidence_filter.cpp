@@ -122,21 +122,34 @@ bool EvidenceFilter::convertRaw(const Scan& scan, std::size_t age, double sigma)
     r.evidence.clear();  // no evidence of its own: nothing is tracked against it
     r.has_odom = w.has_odom;
     r.odom = r.pose = w.odom;
+    // Branch-free passes (this runs once per keyframe over every beam).
+    const float* range = w.range.data();
+    const std::uint8_t* wv = w.valid.data();
+    const float* cs = dirs_.cos.data();
+    const float* sn = dirs_.sin.data();
+    std::uint8_t* valid = r.valid.data();
+    float* x = r.x.data();
+    float* y = r.y.data();
+    const float max_range = kMaxScanRangeM;
+#pragma omp simd
     for (std::size_t k = 0; k < n; ++k) {
-        const float range = w.range[k];
-        r.valid[k] = static_cast<std::uint8_t>(w.valid[k] && isUsableRange(range));
-        r.x[k] = range * dirs_.cos[k];
-        r.y[k] = range * dirs_.sin[k];
+        const float rk = range[k];
+        valid[k] = static_cast<std::uint8_t>((wv[k] != 0) & (rk >= 0.0f) & (rk <= max_range));
+        x[k] = rk * cs[k];
+        y[k] = rk * sn[k];
     }
     // Links: the breakpoint test of step 2 between neighbouring returns (one surface).
     const double dt = std::min(static_cast<double>(res_), 0.5 * lambda_);
     const float factor = static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt));
     const float noise = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
-    for (std::size_t k = 0; k + 1 < n; ++k) {
-        if (!r.valid[k] || !r.valid[k + 1]) continue;
-        const float dx = r.x[k + 1] - r.x[k], dy = r.y[k + 1] - r.y[k];
-        const float dmax = std::min(r.range[k], r.range[k + 1]) * factor + noise;
-        r.link[k] = static_cast<std::uint8_t>(dx * dx + dy * dy <= dmax * dmax);
+    std::uint8_t* link = r.link.data();
+    const std::size_t pairs = n > 0 ? n - 1 : 0;
+#pragma omp simd
+    for (std::size_t k = 0; k < pairs; ++k) {
+        const float dx = x[k + 1] - x[k], dy = y[k + 1] - y[k];
+        const float dmax = std::min(range[k], range[k + 1]) * factor + noise;
+        link[k] =
+            static_cast<std::uint8_t>(valid[k] & valid[k + 1] & (dx * dx + dy * dy <= dmax * dmax));
     }
     return true;
 }
