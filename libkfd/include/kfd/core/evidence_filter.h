@@ -99,7 +99,7 @@ class EvidenceFilter {
         /// Raw scans kept for step 3b (the scans just before a keyframe, dropped or not), in
         /// [0, 16]; 0 = keyframes only (no copies, the behaviour before issue 25). 1: on six
         /// real logs with injected noise (seed 7, kept scans) every kind's recall rose (isolated
-        /// +2 to +8 points) at -0.04 to +0.16 points of real returns kept on the clean logs;
+        /// +1 to +8 points) at -0.04 to +0.16 points of real returns kept on the clean logs;
         /// 2 gave the same within 0.5 points (docs/RESULTS.md, issue 25).
         std::size_t temporal_scans = 1;
     };
