@@ -10,8 +10,8 @@
 int main(int argc, char** argv) {
     kfd::app::Cli cli(
         "kfd-denoise-eval", "-i SIM.rawlog -l SIM.labels.csv -c CONFIG",
-        "Runs every scan through the CONFIG pipeline (.ini [KFD] or .yaml; use a pipeline\n"
-        "without the keyframe stage to denoise every scan) and scores the removed beams\n"
+        "Runs every scan through the CONFIG pipeline (.ini [KFD] or .yaml) and scores the\n"
+        "removed beams of the scans it keeps (all, without a keyframe stage)\n"
         "against the labels of kfd-simulate or kfd-inject: precision, recall, F1, recall per\n"
         "noise kind (and per model, for kfd-inject's labels), the fraction of true points\n"
         "kept and the share removed by range (0-2, 2-5, 5-10, 10+ m).",
@@ -34,9 +34,11 @@ int main(int argc, char** argv) {
     return cli.run(argc, argv, [&] {
         const auto q =
             kfd::evaluateDenoising(rawlog, labels, kfd::loadConfigFile(config), laser_only);
-        std::printf("scans %zu, points %zu, noise %zu (isolated %zu, clustered %zu, edge %zu)\n",
-                    q.scans, q.points, q.noise, q.noise_by_kind[1], q.noise_by_kind[2],
-                    q.noise_by_kind[3]);
+        std::printf(
+            "scans %zu (scored %zu kept of %zu), points %zu, noise %zu (isolated %zu, "
+            "clustered %zu, edge %zu)\n",
+            q.scans, q.scored, q.scans, q.points, q.noise, q.noise_by_kind[1], q.noise_by_kind[2],
+            q.noise_by_kind[3]);
         std::printf("precision %.4f recall %.4f f1 %.4f clean_kept %.5f\n", q.precision(),
                     q.recall(), q.f1(), q.cleanKept());
         std::printf("recall_isolated %.4f recall_clustered %.4f recall_edge %.4f\n",

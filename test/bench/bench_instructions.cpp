@@ -33,10 +33,26 @@ namespace {
 
 // kfd's default pipeline (distance, view keyframe, denoise) with the view selector's thresholds
 // out of reach: every dropped-set scan is dropped by the keyframe decision.
-kfd::Pipeline::Params viewDropParams() {
+// `temporal_scans`: the evidence denoiser's (issue 25; 0 = the default's).
+kfd::Pipeline::Params viewDropParams(std::size_t temporal_scans = 0) {
     kfd::Pipeline::Params p;
     p.get<kfd::DistanceStage>() = kb::paperParams().get<kfd::DistanceStage>();
     p.get<kfd::KeyframeStage>() = kb::viewParamsThatDrop();
+    p.get<kfd::DenoiseStage>().evidence.temporal_scans = temporal_scans;
+    return p;
+}
+
+// The evidence denoiser on the keyframes alone (temporal_scans 0: before issue 25).
+kfd::Pipeline::Params keyframesOnlyParams() {
+    kfd::Pipeline::Params p = kb::paperParams(kfd::DenoiseVariant::Evidence);
+    p.get<kfd::DenoiseStage>().evidence.temporal_scans = 0;
+    return p;
+}
+
+// The evidence denoiser with the raw scan just before each keyframe (issue 25).
+kfd::Pipeline::Params temporalParams() {
+    kfd::Pipeline::Params p = kb::paperParams(kfd::DenoiseVariant::Evidence);
+    p.get<kfd::DenoiseStage>().evidence.temporal_scans = 1;
     return p;
 }
 
@@ -72,15 +88,17 @@ struct Context {
         kb::paperParams(kfd::DenoiseVariant::Reference).get<kfd::DenoiseStage>()};
     kfd::Denoiser range_aware{
         kb::paperParams(kfd::DenoiseVariant::RangeAware).get<kfd::DenoiseStage>()};
-    kfd::Denoiser evidence{kb::paperParams(kfd::DenoiseVariant::Evidence).get<kfd::DenoiseStage>()};
+    kfd::Denoiser evidence{keyframesOnlyParams().get<kfd::DenoiseStage>()};
+    kfd::Denoiser evidence_temporal{temporalParams().get<kfd::DenoiseStage>()};
     kfd::DbscanFilter dbscan{kfd::DbscanFilter::Params{0.7, 10}};
     kfd::RadiusOutlierFilter radius{kfd::RadiusOutlierFilter::Params{}};
     kfd::StatisticalOutlierFilter sor{kfd::StatisticalOutlierFilter::Params{}};
     kfd::Pipeline pipe_dropped{kb::paperParams()};
     kfd::Pipeline pipe_reference{kb::paperParams(kfd::DenoiseVariant::Reference)};
     kfd::Pipeline pipe_range_aware{kb::paperParams(kfd::DenoiseVariant::RangeAware)};
-    kfd::Pipeline pipe_view{viewDropParams()};  // kfd's default pipeline, dropping
-    kfd::StreamFilter door{viewDropParams()};   // the same behind the one door (MRPT scans)
+    kfd::Pipeline pipe_view{viewDropParams()};            // kfd's default pipeline, dropping
+    kfd::Pipeline pipe_view_temporal{viewDropParams(1)};  // the same, keeping the dropped scan
+    kfd::StreamFilter door{viewDropParams()};  // the same behind the one door (MRPT scans)
     std::vector<mrpt::obs::CObservation2DRangeScan> obs_dropped, obs_work;
     std::size_t sink = 0;       // results feed this so nothing is optimised away
     std::size_t surprises = 0;  // dropped-set scans kept or keyframe-set scans dropped
@@ -95,6 +113,8 @@ struct Context {
         for (kfd::Scan s : sc.prefix) pipe_dropped.process(s);
         kfd::Scan first = sc.prefix.back();
         pipe_view.process(first);  // the keyframe every dropped-set scan is measured against
+        kfd::Scan first_t = sc.prefix.back();
+        pipe_view_temporal.process(first_t);
         auto first_obs = toMrpt(sc.prefix.back());
         door.process(first_obs, sc.prefix.back().odometry);
         for (const auto& s : sc.dropped) obs_dropped.push_back(toMrpt(s));
@@ -137,6 +157,19 @@ __attribute__((noinline)) void kfd_ir_denoise_range_aware(Context& c, std::size_
 __attribute__((noinline)) void kfd_ir_denoise_evidence(Context& c, std::size_t k) {
     c.sink += c.evidence.filter(c.work_loop[k]).points_removed;
 }
+// A loop keyframe after the scan just before it was dropped: the observe (the dropped scan's
+// share, counted apart) and the keyframe's filter with that raw scan as evidence.
+__attribute__((noinline)) void kfd_ir_evidence_observe(Context& c, std::size_t k) {
+    c.evidence_temporal.observe(c.sc.loop_before[k]);
+}
+__attribute__((noinline)) void kfd_ir_denoise_evidence_temporal_keyframe(Context& c,
+                                                                         std::size_t k) {
+    c.sink += c.evidence_temporal.filter(c.work_loop[k]).points_removed;
+}
+__attribute__((noinline)) void kfd_ir_denoise_evidence_temporal(Context& c, std::size_t k) {
+    kfd_ir_evidence_observe(c, k);
+    kfd_ir_denoise_evidence_temporal_keyframe(c, k);
+}
 __attribute__((noinline)) void kfd_ir_dbscan_loop(Context& c, std::size_t k) {
     c.sink += c.dbscan.filter(c.work_loop[k]).points_removed;
 }
@@ -154,6 +187,9 @@ __attribute__((noinline)) void kfd_ir_pipeline_dropped(Context& c, std::size_t k
 }
 __attribute__((noinline)) void kfd_ir_pipeline_dropped_view(Context& c, std::size_t k) {
     c.surprises += c.pipe_view.process(c.work_dropped[k]).keep;
+}
+__attribute__((noinline)) void kfd_ir_pipeline_dropped_view_temporal(Context& c, std::size_t k) {
+    c.surprises += c.pipe_view_temporal.process(c.work_dropped[k]).keep;
 }
 __attribute__((noinline)) void kfd_ir_door_dropped_view(Context& c, std::size_t k) {
     c.surprises += c.door.process(c.obs_work[k], c.sc.dropped[k].odometry).keep;
@@ -185,12 +221,14 @@ const Case kCases[] = {
     {"denoise_reference", kfd_ir_denoise_reference, false},
     {"denoise_range_aware", kfd_ir_denoise_range_aware, false},
     {"denoise_evidence", kfd_ir_denoise_evidence, false, true},
+    {"denoise_evidence_temporal", kfd_ir_denoise_evidence_temporal, false, true},
     {"dbscan_loop", kfd_ir_dbscan_loop, false, true},
     {"dbscan", kfd_ir_dbscan, false},
     {"radius_outlier", kfd_ir_radius_outlier, false},
     {"statistical_outlier", kfd_ir_statistical_outlier, false},
     {"pipeline_dropped", kfd_ir_pipeline_dropped, true},
     {"pipeline_dropped_view", kfd_ir_pipeline_dropped_view, true},
+    {"pipeline_dropped_view_temporal", kfd_ir_pipeline_dropped_view_temporal, true},
     {"door_dropped_view", kfd_ir_door_dropped_view, true},
     {"pipeline_keyframe_reference", kfd_ir_pipeline_keyframe_reference, false},
     {"pipeline_keyframe_range_aware", kfd_ir_pipeline_keyframe_range_aware, false},
@@ -203,6 +241,10 @@ void warmUp(Context& c, const Case& cs) {
         for (std::size_t k = 0; k < c.sc.loop_keyframes.size(); ++k) {
             kb::restoreValid(c.sc.loop_keyframes[k], c.work_loop[k]);
             if (name == "denoise_evidence") c.evidence.filter(c.work_loop[k]);
+            if (name == "denoise_evidence_temporal") {
+                c.evidence_temporal.observe(c.sc.loop_before[k]);
+                c.evidence_temporal.filter(c.work_loop[k]);
+            }
             if (name == "dbscan_loop") c.dbscan.filter(c.work_loop[k]);
         }
         return;
@@ -223,6 +265,7 @@ void warmUp(Context& c, const Case& cs) {
         if (name == "statistical_outlier") c.sor.filter(s);
         if (name == "pipeline_dropped") c.pipe_dropped.process(s);
         if (name == "pipeline_dropped_view") c.pipe_view.process(s);
+        if (name == "pipeline_dropped_view_temporal") c.pipe_view_temporal.process(s);
         if (name == "door_dropped_view") {
             c.obs_work[k] = c.obs_dropped[k];
             c.door.process(c.obs_work[k], c.sc.dropped[k].odometry);

@@ -189,6 +189,9 @@ struct Scenario {
     /// odometry), closing the circle: the evidence denoiser, cycled through them, always has
     /// its previous keyframe (temporal evidence on every call).
     std::vector<Scan> loop_keyframes;
+    /// The stream scan just before each loop keyframe (1.88 cm and 0.6 deg back): what the
+    /// keyframe stage dropped last, the evidence denoiser's temporal_scans reference.
+    std::vector<Scan> loop_before;
 };
 
 inline Scenario makeScenario(unsigned seed = kSeed) {
@@ -230,6 +233,10 @@ inline Scenario makeScenario(unsigned seed = kSeed) {
         Scan s = simulateScan(scene, loopPose(index), seed + 2, index);
         distance.filter(s);
         sc.loop_keyframes.push_back(std::move(s));
+        const std::size_t before = index > 0 ? index - 1 : static_cast<std::size_t>(per_turn) - 1;
+        Scan b = simulateScan(scene, loopPose(before), seed + 2, before);
+        distance.filter(b);
+        sc.loop_before.push_back(std::move(b));
     }
     return sc;
 }

@@ -180,6 +180,136 @@ TEST(EvidenceFilter, WithoutOdometryTheStepIsFoundByAlignment) {
     EXPECT_EQ(r.points_removed, 1u);
 }
 
+EvidenceFilter::Params withRecent(std::size_t scans) {
+    EvidenceFilter::Params p = exact();
+    p.temporal_scans = scans;
+    return p;
+}
+
+TEST(EvidenceFilter, ASpikeNearAWallIsRemovedWithTheScanJustBeforeTheKeyframe) {
+    // The keyframe 1 m back supports a spike 0.12 m in front of the wall (its margin is
+    // 0.04 + 0.05 + 0.2 x 1 m); the scan dropped 2 cm before sees through it.
+    for (const std::size_t kept : {0u, 1u}) {
+        EvidenceFilter f(withRecent(kept));
+        Clusters c;
+        Scan first = room();
+        f.filter(first, c);
+        f.observe(roomAfter(0.98));
+        Scan second = roomAfter(1.0);
+        test::insertSpike(second, 180, 2.88f);
+        const auto r = f.filter(second, c);
+        EXPECT_TRUE(r.temporal);
+        EXPECT_EQ(r.recent, kept > 0);
+        if (kept == 0) {
+            EXPECT_EQ(second.valid[180], 1);  // the wide keyframe margin supports it
+            EXPECT_EQ(r.points_removed, 0u);
+        } else {
+            EXPECT_EQ(second.valid[180], 0);
+            EXPECT_EQ(r.points_removed, 1u);
+            EXPECT_NEAR(r.recent_margin_m, 3.0 * std::sqrt(2.0) * 0.01, 1e-6);  // sigma-bound
+        }
+    }
+}
+
+TEST(EvidenceFilter, WhenTheScanJustBeforeWantsTooMuchTheKeyframesAloneDecide) {
+    // 20 beams 0.3 m before the wall: the scan 2 cm before sees through them, the keyframe
+    // 1 m back supports them. 20 returns exceed a 5 % bound (18 of 361): the keyframes decide.
+    for (const double bound : {0.05, 1.0}) {
+        EvidenceFilter::Params p = withRecent(1);
+        p.max_removed_fraction = bound;
+        EvidenceFilter f(p);
+        Clusters c;
+        Scan first = room();
+        f.filter(first, c);
+        f.observe(roomAfter(0.98));
+        Scan second = roomAfter(1.0);
+        test::setRange(second, 170, 189, 2.7);
+        const auto r = f.filter(second, c);
+        EXPECT_TRUE(r.recent);
+        EXPECT_EQ(r.recent_overruled, bound < 1.0) << bound;
+        EXPECT_FALSE(r.stale_references);
+        EXPECT_EQ(r.points_removed, bound < 1.0 ? 0u : 20u) << bound;
+    }
+}
+
+TEST(EvidenceFilter, AThinPostSeenJustBeforeIsKept) {
+    // A two-beam post at 2 m (small) in front of the wall: the scan just before saw it too.
+    auto withPost = [](Scan s) {
+        test::setRange(s, 180, 181, 2.0);
+        return s;
+    };
+    EvidenceFilter f(withRecent(1));
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    f.observe(withPost(roomAfter(0.08)));
+    Scan second = withPost(roomAfter(0.1));
+    const auto r = f.filter(second, c);
+    EXPECT_TRUE(r.recent);
+    EXPECT_EQ(second.valid[180], 1);
+    EXPECT_EQ(second.valid[181], 1);
+    EXPECT_EQ(r.points_removed, 0u);
+}
+
+TEST(EvidenceFilter, WithoutOdometryTheScanJustBeforeIsAligned) {
+    EvidenceFilter f(withRecent(2));
+    Clusters c;
+    Scan first = corner(0.0);
+    f.filter(first, c);
+    f.observe(corner(0.13));
+    f.observe(corner(0.14));
+    Scan second = corner(0.15);
+    test::insertSpike(second, 200, 2.5);
+    const auto r = f.filter(second, c);
+    EXPECT_TRUE(r.recent);
+    EXPECT_EQ(second.valid[200], 0);
+    EXPECT_EQ(r.points_removed, 1u);
+}
+
+TEST(EvidenceFilter, TheKeyframeItselfIsTheScanBeforeTheNextWhenNothingWasDropped) {
+    EvidenceFilter f(withRecent(1));
+    Clusters c;
+    Scan first = room();
+    EXPECT_FALSE(f.filter(first, c).recent);  // nothing before the first scan
+    Scan second = roomAfter(0.02);
+    EXPECT_TRUE(f.filter(second, c).recent);
+    f.reset();
+    Scan third = roomAfter(0.04);
+    EXPECT_FALSE(f.filter(third, c).recent);  // reset forgets the raw scans too
+}
+
+TEST(EvidenceFilter, ObservingDoesNothingWithoutTemporalScans) {
+    // temporal_scans = 0 keeps today's behaviour: an observed scan changes no result.
+    EvidenceFilter a(withRecent(0)), b(withRecent(0));
+    Clusters c;
+    Scan first = room(), first_b = room();
+    a.filter(first, c);
+    b.filter(first_b, c);
+    Scan seen = roomAfter(0.98);
+    test::insertSpike(seen, 100, 1.0);
+    b.observe(seen);
+    Scan x = roomAfter(1.0), y = roomAfter(1.0);
+    test::insertSpike(x, 180, 2.88f);
+    test::insertSpike(y, 180, 2.88f);
+    const auto ra = a.filter(x, c), rb = b.filter(y, c);
+    EXPECT_EQ(ra.points_removed, rb.points_removed);
+    EXPECT_EQ(ra.supported, rb.supported);
+    EXPECT_EQ(x.valid, y.valid);
+    EXPECT_FALSE(rb.recent);
+}
+
+TEST(EvidenceFilter, ARawScanOfAnotherGeometryIsNotUsed) {
+    EvidenceFilter f(withRecent(1));
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    Scan other = test::flatWall(181, deg2rad(150.0), 3.0);
+    other.odometry = Pose2D{0.98, 0.0, 0.0};
+    f.observe(other);
+    Scan second = roomAfter(1.0);
+    EXPECT_FALSE(f.filter(second, c).recent);
+}
+
 TEST(EvidenceFilter, TheNoiseEstimateFollowsTheSensor) {
     std::mt19937 rng(7);
     for (const double sigma : {0.01, 0.03}) {
@@ -239,6 +369,14 @@ TEST(EvidenceFilter, LineResidualIsZeroOnAnyLine) {
         EXPECT_NEAR(EvidenceFilter::lineResidual(r(-res), r(0.0), r(res), std::cos(res)), 0.0, 1e-9)
             << incidence;
     }
+}
+
+TEST(EvidenceFilter, TooManyTemporalScansAreRejected) {
+    EvidenceFilter::Params p;
+    p.temporal_scans = 17;
+    EXPECT_THROW(EvidenceFilter{p}, ParameterError);
+    p.temporal_scans = 16;
+    EXPECT_NO_THROW(EvidenceFilter{p});
 }
 
 TEST(EvidenceFilter, BadParametersAreRejected) {

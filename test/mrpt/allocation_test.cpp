@@ -61,7 +61,7 @@ std::vector<kfd::Scan> randomScans(std::size_t count, std::size_t beams, unsigne
     return scans;
 }
 
-std::size_t steadyStateAllocations(kfd::DenoiseVariant variant) {
+std::size_t steadyStateAllocations(kfd::DenoiseVariant variant, std::size_t* kept_out = nullptr) {
     kfd::Pipeline::Params p;
     p.get<kfd::DenoiseStage>().variant = variant;
     p.get<kfd::KeyframeStage>().window = 3;
@@ -77,6 +77,7 @@ std::size_t steadyStateAllocations(kfd::DenoiseVariant variant) {
     for (auto& s : work) kept += pipe.process(s).keep;
     g_counting = false;
     EXPECT_GT(kept, 0u);
+    if (kept_out) *kept_out = kept;
     return g_allocations;
 }
 
@@ -129,6 +130,15 @@ TEST(Allocation, FusePipelineAllocatesNothingInSteadyState) {
     EXPECT_LT(kept, scans.size() / 2);  // most scans were dropped and fused into keyframes
     EXPECT_GT(fused, 0u);
     EXPECT_EQ(g_allocations.load(), 0u);
+}
+
+TEST(Allocation, EvidencePipelineKeepingDroppedScansAllocatesNothingInSteadyState) {
+    // The default denoiser with temporal_scans = 1 (issue 25): dropped scans are copied into
+    // its ring, keyframes convert and align the newest.
+    ASSERT_GE(kfd::Pipeline::Params{}.get<kfd::DenoiseStage>().evidence.temporal_scans, 1u);
+    std::size_t kept = 0;
+    EXPECT_EQ(steadyStateAllocations(kfd::DenoiseVariant::Evidence, &kept), 0u);
+    EXPECT_LT(kept, 40u);  // some scans were dropped and observed
 }
 
 TEST(Allocation, CounterSeesAllocations) {  // the test above would be vacuous without this

@@ -178,6 +178,26 @@ TEST(DenoiseQuality, NothingRemovedScoresZeroRecallAndKeepsEveryPoint) {
     EXPECT_THROW(kfd::evaluateDenoising(s.rawlog, s.ground_truth, p), kfd::SimulationError);
 }
 
+TEST(DenoiseQuality, OnlyTheScansThePipelineKeepsAreScored) {
+    // A dropped scan never reaches the SLAM: its noise is neither found nor missed.
+    TempDir dir;
+    const auto s = kfd::Simulator().run(shortRun(dir / "sim.rawlog"));
+    kfd::Pipeline::Params all;
+    all.stages = {};
+    const auto every = kfd::evaluateDenoising(s.rawlog, s.labels, all);
+    EXPECT_EQ(every.scans, s.scans);
+    EXPECT_EQ(every.scored, every.scans);  // no keyframe stage: every scan kept and scored
+    kfd::Pipeline::Params kf;
+    kf.stages = {"keyframe"};
+    const auto kept = kfd::evaluateDenoising(s.rawlog, s.labels, kf);
+    EXPECT_EQ(kept.scans, s.scans);
+    EXPECT_GT(kept.scored, 0u);
+    EXPECT_LT(kept.scored, kept.scans);
+    EXPECT_LT(kept.points, every.points);
+    EXPECT_LT(kept.noise, every.noise);
+    EXPECT_EQ(kept.removed_noise + kept.removed_clean, 0u);  // dropping is not denoising
+}
+
 TEST(Simulator, ReproducesTheBundledSampleLog) {
     // rawlogs/office-mit-0.752.* were made with: kfd-simulate -o ... -d 15 (defaults otherwise).
     TempDir dir;

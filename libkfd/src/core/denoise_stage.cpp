@@ -89,7 +89,11 @@ std::vector<StageKey> DenoiseStage::keys() {
                       [](P& p) -> double& { return p.evidence.motion_error_fraction; }),
         keys::real<P>("max_removed_fraction", "max_removed_fraction",
                       "evidence: largest share of a scan's valid returns removed (step 5)", 0, 1,
-                      true, [](P& p) -> double& { return p.evidence.max_removed_fraction; })};
+                      true, [](P& p) -> double& { return p.evidence.max_removed_fraction; }),
+        keys::count<P>("temporal_scans", "temporal_scans",
+                       "evidence: raw scans kept before a keyframe (the dropped ones) as "
+                       "temporal evidence with margins from their alignment; 0 = keyframes only",
+                       0, 16, [](P& p) -> std::size_t& { return p.evidence.temporal_scans; })};
 }
 
 }  // namespace kfd

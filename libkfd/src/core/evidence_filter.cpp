@@ -74,7 +74,11 @@ void EvidenceFilter::initialize(const Params& p) {
         throw ParameterError("refine", "refine_iterations <= 20, refine_samples >= 1, gate > 0");
     if (!(p.max_removed_fraction > 0.0 && p.max_removed_fraction <= 1.0))
         throw ParameterError("max_removed_fraction", "max_removed_fraction must be in (0, 1]");
+    if (p.temporal_scans > 16)
+        throw ParameterError("temporal_scans", "temporal_scans must be in [0, 16]");
     params_ = p;
+    raw_.assign(p.temporal_scans, RawScan{});
+    residuals_.reserve(2 * p.refine_samples + 2);
     lambda_ = p.incidence_deg * kDeg;
     reset();
 }
@@ -84,6 +88,93 @@ void EvidenceFilter::reset() {
     sigma_smoothed_ = -1.0;
     measured_smoothed_ = -1.0;
     have_pose_ = false;
+    raw_next_ = raw_count_ = 0;
+}
+
+void EvidenceFilter::observe(const Scan& scan) {
+    if (!raw_.empty() && params_.temporal) keepRaw(scan);
+}
+
+void EvidenceFilter::keepRaw(const Scan& scan) {
+    RawScan& w = raw_[raw_next_];
+    w.geometry = scan.geometry;
+    w.range.assign(scan.range.begin(), scan.range.end());
+    w.valid.assign(scan.valid.begin(), scan.valid.end());
+    w.has_odom = scan.odometry.has_value();
+    w.odom = w.has_odom ? compose(*scan.odometry, scan.sensor_pose) : Pose2D{};
+    raw_next_ = (raw_next_ + 1) % raw_.size();
+    raw_count_ = std::min(raw_count_ + 1, raw_.size());
+}
+
+bool EvidenceFilter::convertRaw(const Scan& scan, std::size_t age, double sigma) {
+    if (age >= raw_count_) return false;
+    const RawScan& w = raw_[(raw_next_ + raw_.size() - 1 - age) % raw_.size()];
+    const std::size_t n = scan.range.size();
+    if (w.geometry != scan.geometry || w.range.size() != n) return false;
+    Reference& r = recent_;
+    r.present = true;
+    r.geometry = w.geometry;
+    r.range.assign(w.range.begin(), w.range.end());
+    r.valid.resize(n);
+    r.x.resize(n);
+    r.y.resize(n);
+    r.link.assign(n, 0);
+    r.evidence.clear();  // no evidence of its own: nothing is tracked against it
+    r.has_odom = w.has_odom;
+    r.odom = r.pose = w.odom;
+    // Branch-free passes (this runs once per keyframe over every beam).
+    const float* range = w.range.data();
+    const std::uint8_t* wv = w.valid.data();
+    const float* cs = dirs_.cos.data();
+    const float* sn = dirs_.sin.data();
+    std::uint8_t* valid = r.valid.data();
+    float* x = r.x.data();
+    float* y = r.y.data();
+    const float max_range = kMaxScanRangeM;
+#pragma omp simd
+    for (std::size_t k = 0; k < n; ++k) {
+        const float rk = range[k];
+        valid[k] = static_cast<std::uint8_t>((wv[k] != 0) & (rk >= 0.0f) & (rk <= max_range));
+        x[k] = rk * cs[k];
+        y[k] = rk * sn[k];
+    }
+    // Links: the breakpoint test of step 2 between neighbouring returns (one surface).
+    const double dt = std::min(static_cast<double>(res_), 0.5 * lambda_);
+    const float factor = static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt));
+    const float noise = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
+    std::uint8_t* link = r.link.data();
+    const std::size_t pairs = n > 0 ? n - 1 : 0;
+#pragma omp simd
+    for (std::size_t k = 0; k < pairs; ++k) {
+        const float dx = x[k + 1] - x[k], dy = y[k + 1] - y[k];
+        const float dmax = std::min(range[k], range[k + 1]) * factor + noise;
+        link[k] =
+            static_cast<std::uint8_t>(valid[k] & valid[k + 1] & (dx * dx + dy * dy <= dmax * dmax));
+    }
+    return true;
+}
+
+EvidenceFilter::Projection EvidenceFilter::recentProjection(const Scan& scan, std::size_t age,
+                                                            double sigma, Result& res) {
+    Projection pr;
+    if (!convertRaw(scan, age, sigma)) return pr;
+    Pose2D d;  // this scan's sensor in the raw scan's frame
+    if (scan.odometry && recent_.has_odom)
+        d = between(recent_.odom, compose(*scan.odometry, scan.sensor_pose));
+    else if (scan.odometry || recent_.has_odom)
+        return pr;  // no common frame
+    if (!projection(recent_, d, sigma).usable) return pr;
+    double spread = 0.0;
+    if (!refineStep(scan, recent_, d, &spread)) return pr;  // no alignment: no margin to trust
+    pr = projection(recent_, d, sigma);
+    // The margin from what was measured: the larger of the two scans' range noise and the
+    // alignment's own residual spread (3 standard deviations), plus the odometry-error share
+    // of this (short) step; no constant pose error.
+    const double base = 3.0 * std::max(std::sqrt(2.0) * sigma, spread);
+    pr.m0 = static_cast<float>(base + params_.motion_error_fraction * std::hypot(d.x, d.y));
+    pr.m1 = static_cast<float>(params_.motion_error_fraction * std::abs(d.phi));
+    if (age == 0) res.recent_margin_m = base;
+    return pr;
 }
 
 void EvidenceFilter::updateTables(const ScanGeometry& g) {
@@ -231,7 +322,7 @@ std::uint8_t EvidenceFilter::classify(const Projection& pr, float x, float y,
     if (free_test && ref.valid[k0] && ref.valid[k1]) {
         const float mf = ref.link[k0] ? m : m + arc;
         if (ref.range[k0] > rho + mf && ref.range[k1] > rho + mf)
-            return trackedMotion(ref, qx, qy, rho, k0) ? kTracked : kFree;
+            return !ref.evidence.empty() && trackedMotion(ref, qx, qy, rho, k0) ? kTracked : kFree;
     }
     // Supported: a reference return within m plus one beam's arc (the same object sampled at
     // other angles), a beam either side of the bracket, or the reference surface segment
@@ -267,7 +358,8 @@ bool EvidenceFilter::trackedMotion(const Reference& ref, float qx, float qy, flo
     return false;
 }
 
-bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& d) const {
+bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& d,
+                                double* spread) const {
     // Projective point-to-line alignment: each sampled return is projected into the reference
     // scan and paired with the reference segment between its two bracketing beams (when they
     // are one surface); Gauss-Newton on the distances to those lines corrects the step. The
@@ -284,6 +376,7 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
         const float gate_f = static_cast<float>(gate);
         float A[6] = {0, 0, 0, 0, 0, 0}, b[3] = {0, 0, 0};  // upper triangle of J^T J, J^T e
         std::size_t pairs = 0;
+        if (spread) residuals_.clear();
         for (std::size_t i = 0; i < n; i += stride) {
             if (!scan.valid[i]) continue;
             const float qx = c * x_[i] - s * y_[i] + tx, qy = s * x_[i] + c * y_[i] + ty;
@@ -310,9 +403,15 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
             b[1] += ny * e;
             b[2] += j2 * e;
             ++pairs;
+            if (spread) residuals_.push_back(std::abs(e));
         }
         gate = std::max(0.5 * gate, 0.1);
         if (pairs < 12) break;
+        if (spread) {  // the robust spread of the residuals at the step before this update
+            auto mid = residuals_.begin() + static_cast<std::ptrdiff_t>(residuals_.size() / 2);
+            std::nth_element(residuals_.begin(), mid, residuals_.end());
+            *spread = 1.4826 * static_cast<double>(*mid);
+        }
         // Damped normal equations (a corridor leaves one direction unconstrained).
         const double damp = 1e-3 * static_cast<double>(pairs);
         const double a00 = A[0] + damp, a01 = A[1], a02 = A[2], a11 = A[3] + damp, a12 = A[4],
@@ -340,24 +439,33 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
 }
 
 bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, double sigma,
-                                      Result& res) {
+                                      Result& res, bool recent) {
     const std::size_t n = scan.range.size();
     have_pose_ = false;
     if (!params_.temporal) return false;
-    const Reference& r0 = refs_[0];
-    if (!r0.present || r0.geometry != scan.geometry) return false;
+    // 3b. The raw scan just before (tight margins from its own alignment), when kept.
+    Projection pt;
+    if (recent) pt = recentProjection(scan, 0, sigma, res);
+    res.recent = pt.usable;
     // This scan's sensor in the newest keyframe's frame: the odometry step (no motion without
     // odometry), refined.
-    Pose2D d;
-    if (scan.odometry && r0.has_odom)
-        d = between(r0.odom, compose(*scan.odometry, scan.sensor_pose));
-    else if (scan.odometry || r0.has_odom)
-        return false;  // odometry appeared or vanished: no common frame
-    if (!projection(r0, d, sigma).usable) return false;
-    res.refined = refineStep(scan, r0, d);
-    const Projection p0 = projection(r0, d, sigma);
-    pose_ = compose(r0.pose, d);
-    have_pose_ = true;
+    Projection p0;
+    const Reference& r0 = refs_[0];
+    if (r0.present && r0.geometry == scan.geometry) {
+        Pose2D d;
+        bool common = true;
+        if (scan.odometry && r0.has_odom)
+            d = between(r0.odom, compose(*scan.odometry, scan.sensor_pose));
+        else if (scan.odometry || r0.has_odom)
+            common = false;  // odometry appeared or vanished: no common frame
+        if (common && projection(r0, d, sigma).usable) {
+            res.refined = refineStep(scan, r0, d);
+            p0 = projection(r0, d, sigma);
+            pose_ = compose(r0.pose, d);
+            have_pose_ = true;
+        }
+    }
+    if (!pt.usable && !p0.usable) return false;
     // Every return off a line, every return of a short segment, and every fourth return along
     // a line (enough to tell how much of a surface lies in free space).
     free_in_.assign(out.count(), 0);
@@ -369,7 +477,16 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
         if (label < 0) continue;
         const auto c = static_cast<std::size_t>(label);
         if (line_[i] && (i & 3u) != 0 && out.size[c] >= 8) continue;
-        const std::uint8_t e = classify(p0, x_[i], y_[i], true);
+        // The raw scan just before decides first; the keyframe decides what it left unknown,
+        // and a return free just before is still tracked when the keyframe saw a moving object
+        // here.
+        std::uint8_t e = kUnknown;
+        if (pt.usable) {
+            e = classify(pt, x_[i], y_[i], true);
+            if (e == kFree && p0.usable && classify(p0, x_[i], y_[i], true) == kTracked)
+                e = kTracked;
+        }
+        if (e == kUnknown && p0.usable) e = classify(p0, x_[i], y_[i], true);
         evidence_[i] = e;
         ++classified_in_[c];
         if (e == kFree) {
@@ -384,18 +501,25 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
             unknown_.push_back(static_cast<std::uint32_t>(i));
         }
     }
-    // The keyframe before it can support what the newest could not (a thin object between two
-    // beams, a return among dropouts); it never overrules free space.
+    // The keyframe before it (and the older raw scans) can support what the newest could not
+    // (a thin object between two beams, a return among dropouts); they never overrule free
+    // space.
+    auto support = [&](const Projection& p) {
+        for (const std::uint32_t i : unknown_)
+            if (evidence_[i] == kUnknown && classify(p, x_[i], y_[i], false) == kSupported) {
+                evidence_[i] = kSupported;
+                ++supported_in_[static_cast<std::size_t>(out.label[i])];
+                ++res.supported;
+            }
+    };
     const Reference& r1 = refs_[1];
-    if (r1.present && r1.geometry == scan.geometry) {
+    if (have_pose_ && r1.present && r1.geometry == scan.geometry && !unknown_.empty()) {
         const Projection p1 = projection(r1, between(r1.pose, pose_), sigma);
-        if (p1.usable)
-            for (const std::uint32_t i : unknown_)
-                if (classify(p1, x_[i], y_[i], false) == kSupported) {
-                    evidence_[i] = kSupported;
-                    ++supported_in_[static_cast<std::size_t>(out.label[i])];
-                    ++res.supported;
-                }
+        if (p1.usable) support(p1);
+    }
+    for (std::size_t age = 1; recent && age < raw_count_ && !unknown_.empty(); ++age) {
+        const Projection pa = recentProjection(scan, age, sigma, res);
+        if (pa.usable) support(pa);
     }
     return true;
 }
@@ -445,7 +569,7 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
 
     // 3. Temporal evidence from the last two keyframes.
     evidence_.assign(n, kUnknown);
-    res.temporal = temporalEvidence(scan, out, sigma, res);
+    res.temporal = temporalEvidence(scan, out, sigma, res, true);
 
     // 4. Segments: small and unsupported, or mostly in free space.
     const std::size_t valid_in = scan.countValid();
@@ -453,15 +577,27 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
         std::floor(params_.max_removed_fraction * static_cast<double>(valid_in)));
     res.removal_wanted = markNoise(out, res.temporal, evidence_);
     // 5. Bounded removal: more than the bound disagrees with the references: they are stale.
+    // With the raw scan just before, first the keyframes alone (what temporal_scans = 0 does).
     bool temporal = res.temporal;
-    if (res.removal_wanted > cap && temporal) {
+    std::size_t wanted = res.removal_wanted;
+    if (wanted > cap && temporal && res.recent) {
+        Result kf;
+        evidence_.assign(n, kUnknown);
+        temporal = temporalEvidence(scan, out, sigma, kf, false);
+        res.free_points = kf.free_points;
+        res.supported = kf.supported;
+        res.tracked = kf.tracked;
+        res.recent_overruled = true;
+        wanted = markNoise(out, temporal, evidence_);
+    }
+    if (wanted > cap && temporal) {
         res.stale_references = true;
         temporal = false;
         if (markNoise(out, false, evidence_) > cap) {
             capNoise(out, cap);
             res.capped = true;
         }
-    } else if (res.removal_wanted > cap) {
+    } else if (wanted > cap) {
         capNoise(out, cap);
         res.capped = true;
     }
@@ -469,6 +605,7 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     // The previous keyframe for the next scan keeps every return (removed ones too: a thin
     // object removed once as unsupported must still support the next view).
     keepAsReference(scan);  // swaps evidence_, x_, y_, link_ away: use the reference's below
+    if (!raw_.empty() && params_.temporal) keepRaw(scan);  // before removal: the raw scan
     const std::vector<std::uint8_t>& kept_ev = refs_[0].present ? refs_[0].evidence : evidence_;
     // Free returns go unless they lie on a line with their neighbours (a surface the previous
     // keyframe saw a little farther: pose error, a door that moved); every return of a removed

@@ -93,10 +93,13 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
             }
         const auto r = filter.process(*scan, e.odometry);
         q.microseconds += r.report.microseconds;
+        ++q.scans;
+        if (!r.keep) return;  // dropped: the SLAM never sees it, nothing to score
+        ++q.scored;
         for (std::size_t i = 0; i < n; ++i) {
             if (!before[i]) continue;
             ++q.points;
-            const bool removed = r.keep && !scan->getScanRangeValidity(i);
+            const bool removed = !scan->getScanRangeValidity(i);
             const auto ki = static_cast<std::size_t>(kind[i]);
             if (kind[i] == NoiseKind::Clean) {
                 ++q.clean;
@@ -116,7 +119,6 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
                 q.removed_by_model[mi] += removed;
             }
         }
-        ++q.scans;
     };
     while (source->next(e)) e.forEachScan(score);
     if (q.scans == 0) throw SimulationError("no scans in " + rawlog);

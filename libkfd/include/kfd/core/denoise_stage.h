@@ -17,12 +17,15 @@ class DenoiseStage : public DenoisingStage<Denoiser> {
     /// Keys: variant, rings, ring_r_max, angle_gap_factor, merge_distance_m, m_threshold,
     /// jump_lambda_deg, jump_sigma_m, min_object_size_m, min_points_floor, and the evidence
     /// variant's incidence_deg, sigma_m, max_gap_beams, max_small_points, temporal,
-    /// pose_trans_error_m, pose_rot_error_deg, motion_error_fraction.
+    /// pose_trans_error_m, pose_rot_error_deg, motion_error_fraction, max_removed_fraction,
+    /// temporal_scans.
     static std::vector<StageKey> keys();
 
     explicit DenoiseStage(const Params& p = {}) : DenoisingStage(p) {}
     const char* name() const override { return kName; }
     void reset() override { mutableAlgorithm().reset(); }
+    /// The evidence variant's temporal evidence from the scans the keyframe stage drops.
+    void observeDropped(const Scan& scan) override { mutableAlgorithm().observe(scan); }
 };
 
 }  // namespace kfd

@@ -59,6 +59,7 @@ class Denoiser {
         std::size_t free_points = 0;     // evidence: returns the previous keyframe saw through
         bool stale_references = false;   // evidence: bound on removal ignored its references
         bool capped = false;             // evidence: removal cut to the bound
+        bool recent = false;             // evidence: the raw scan just before was used
     };
 
     Denoiser() { initialize(Params{}); }
@@ -73,6 +74,12 @@ class Denoiser {
     /// passes over the beams plus union-find, each beam compared only with the clusters still
     /// open within the angle gap.
     Result filter(Scan& scan);
+    /// A scan not filtered (dropped by the keyframe stage): the evidence variant keeps a copy
+    /// as temporal evidence for the next keyframe (EvidenceFilter::observe); the others
+    /// ignore it.
+    void observe(const Scan& scan) {
+        if (params_.variant == DenoiseVariant::Evidence) evidence_.observe(scan);
+    }
     /// Forgets stream state (the evidence variant's previous keyframe and noise estimate).
     void reset() { evidence_.reset(); }
 

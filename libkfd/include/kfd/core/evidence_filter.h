@@ -47,6 +47,18 @@ namespace kfd {
 ///         + range x (pose_rot_error_deg + motion_error_fraction x rotation),
 ///     plus range x resolution for the free test across a depth edge of the keyframe.
 ///     Returns off a line, of short segments, and every fourth along a line are classified.
+///  3b. Temporal evidence from the raw scans just before (issue 25, temporal_scans > 0): the
+///     last temporal_scans scans the filter was shown (observe(): the scans the keyframe stage
+///     dropped; filter(): the keyframes, before removal) are kept as copies of their ranges,
+///     flags and odometry. At a keyframe the newest is converted (points, breakpoint links)
+///     and aligned like a keyframe (refineStep from odometry or zero motion); its step is
+///     milliseconds long, so its margin comes from the alignment instead of the constants:
+///     m = 3 max(sqrt(2) sigma, s) + motion_error_fraction x translation
+///         + range x motion_error_fraction x rotation,
+///     s = 1.4826 x the median |point-to-line residual| of the alignment's last iteration.
+///     Its verdict (free or supported) comes first; the keyframes decide what it left unknown
+///     (and may still call a free return tracked); older raw scans only add support. Without
+///     a usable alignment (too few pairs, no common odometry frame) it is not used.
 ///  4. Removal: every free return not on a line with its neighbours; every segment whose
 ///     classified returns are at least half free; every small segment without a supported
 ///     return. A segment is small when it has fewer points than an object of
@@ -55,7 +67,8 @@ namespace kfd {
 ///     evidence (first scan, too large a step, a new geometry) only small segments go.
 ///  5. Bounded removal (issue 22): when the removals of step 4 exceed max_removed_fraction of
 ///     the scan's valid returns, the references are stale (a turn or a walk away, odometry
-///     that lied), not the scan: step 4 runs again without temporal evidence. When even that
+///     that lied), not the scan: with step 3b's raw scans, steps 3-4 first run again on the
+///     keyframes alone; then step 4 runs again without temporal evidence. When even that
 ///     exceeds the bound, the smallest segments go first until the bound is reached. Both are
 ///     reported (Result::stale_references, Result::capped).
 class EvidenceFilter {
@@ -83,6 +96,12 @@ class EvidenceFilter {
         /// Largest share of a scan's valid returns removed (step 5), in (0, 1]; 1 = no bound.
         /// 5 %: issue 22's bound; real bursts cover 0.3-1.2 % of a log's returns (RESULTS).
         double max_removed_fraction = 0.05;
+        /// Raw scans kept for step 3b (the scans just before a keyframe, dropped or not), in
+        /// [0, 16]; 0 = keyframes only (no copies, the behaviour before issue 25). 1: on six
+        /// real logs with injected noise (seed 7, kept scans) every kind's recall rose (isolated
+        /// +1 to +8 points) at -0.04 to +0.16 points of real returns kept on the clean logs;
+        /// 2 gave the same within 0.5 points (docs/RESULTS.md, issue 25).
+        std::size_t temporal_scans = 1;
     };
 
     struct Result {
@@ -102,6 +121,9 @@ class EvidenceFilter {
         std::size_t removal_wanted = 0;  // returns steps 1-4 would have removed
         bool stale_references = false;   // step 5: temporal evidence ignored for this scan
         bool capped = false;             // step 5: spatial removal cut to the bound too
+        bool recent = false;             // step 3b: the raw scan just before was used
+        double recent_margin_m = 0.0;    // m: its margin's constant part (3 max(sqrt 2 sigma, s))
+        bool recent_overruled = false;   // step 5: it wanted too much; the keyframes alone used
     };
 
     EvidenceFilter() { initialize(Params{}); }
@@ -112,6 +134,11 @@ class EvidenceFilter {
     /// Filters the scan (clears the valid flag of removed returns); `out` receives the
     /// segments as clusters (label per beam, noise flag per segment).
     Result filter(Scan& scan, Clusters& out);
+    /// Keeps a copy of a scan not filtered (one the keyframe stage dropped) as a temporal
+    /// reference for the next keyframe (step 3b). Copies ranges, flags and odometry into a
+    /// ring of temporal_scans preallocated slots: no allocation once they have grown, O(n).
+    /// Does nothing when temporal_scans is 0 or temporal is off.
+    void observe(const Scan& scan);
     /// Forget the previous keyframe and the noise estimate (a new sensor or log).
     void reset();
 
@@ -133,6 +160,14 @@ class EvidenceFilter {
         bool has_odom = false;
         Pose2D odom, pose;
     };
+    // A raw scan kept for step 3b: copies, converted only when a keyframe comes.
+    struct RawScan {
+        ScanGeometry geometry;
+        std::vector<float> range;
+        std::vector<std::uint8_t> valid;
+        bool has_odom = false;
+        Pose2D odom;
+    };
     // A reference seen from this scan: the step and the margins (m0 + m1 x range).
     struct Projection {
         bool usable = false;
@@ -143,10 +178,19 @@ class EvidenceFilter {
     void updateTables(const ScanGeometry& g);
     double estimateSigma(const Scan& scan);
     void segment(const Scan& scan, double sigma, Clusters& out);
-    bool temporalEvidence(const Scan& scan, const Clusters& out, double sigma, Result& res);
+    // `recent`: use the raw scans of step 3b (false: the keyframes only).
+    bool temporalEvidence(const Scan& scan, const Clusters& out, double sigma, Result& res,
+                          bool recent);
     Projection projection(const Reference& ref, const Pose2D& d, double sigma) const;
     std::uint8_t classify(const Projection& pr, float x, float y, bool free_test) const;
-    bool refineStep(const Scan& scan, const Reference& ref, Pose2D& d) const;
+    // `spread` (optional): 1.4826 x the median |residual| of the last iteration's pairs (m).
+    bool refineStep(const Scan& scan, const Reference& ref, Pose2D& d,
+                    double* spread = nullptr) const;
+    // Step 3b: the newest raw scan as a projection (usable = false when it cannot be used).
+    Projection recentProjection(const Scan& scan, std::size_t age, double sigma, Result& res);
+    // Converts raw scan `age` (0 = newest) into recent_ (points, breakpoint links).
+    bool convertRaw(const Scan& scan, std::size_t age, double sigma);
+    void keepRaw(const Scan& scan);
     bool trackedMotion(const Reference& ref, float qx, float qy, float rho, std::size_t k0) const;
     void keepAsReference(const Scan& scan);
     // Step 4: marks noise segments; returns the returns it would remove (`kept_ev`: evidence).
@@ -169,9 +213,14 @@ class EvidenceFilter {
     std::vector<std::uint32_t> order_;                                   // segments by size
     std::vector<std::uint8_t> small_;                                    // per segment: small
     double sigma_smoothed_ = -1.0;
-    double measured_smoothed_ = -1.0;  // the same, of the estimates before the floor
-    Reference refs_[2];                // [0] the newest keyframe
-    Pose2D pose_;                      // this scan's refined pose (when have_pose_)
+    double measured_smoothed_ = -1.0;       // the same, of the estimates before the floor
+    Reference refs_[2];                     // [0] the newest keyframe
+    std::vector<RawScan> raw_;              // step 3b: ring of temporal_scans raw scans
+    std::size_t raw_next_ = 0;              // the slot the next raw scan goes to
+    std::size_t raw_count_ = 0;             // raw scans held
+    Reference recent_;                      // a raw scan converted for this keyframe
+    mutable std::vector<float> residuals_;  // refineStep's last iteration |e|
+    Pose2D pose_;                           // this scan's refined pose (when have_pose_)
     bool have_pose_ = false;
 };
 

@@ -13,7 +13,8 @@
 namespace kfd {
 
 struct DenoiseQuality {
-    std::size_t scans = 0;
+    std::size_t scans = 0;   // scans in the log
+    std::size_t scored = 0;  // scans kept by the pipeline: the only ones scored (what SLAM sees)
     std::size_t points = 0;  // valid beams on input
     std::size_t noise = 0, clean = 0;
     std::size_t removed_noise = 0;                 // true positives
@@ -61,7 +62,8 @@ struct DenoiseQuality {
 /// stage, so every scan is denoised) and scores the removed beams against the labels CSV
 /// written by kfd-simulate ("scan,timestamp,beam,kind") or kfd-inject (with a fifth column,
 /// the model). A clean log scored against a label file with no rows gives the real points a
-/// method removes. A dropped scan counts as removing nothing. Throws
+/// method removes. Only the scans the pipeline keeps are scored (a dropped scan's noise never
+/// reaches the SLAM; a pipeline without a keyframe stage keeps, and scores, every scan). Throws
 /// SimulationError on unreadable files or labels that do not fit the rawlog. With
 /// `laser_only` the log's odometry is withheld from the pipeline (a LaserScan-only source).
 DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& labels_csv,
