@@ -44,13 +44,26 @@ TEST(StageRegistry, EachStageOwnsItsKeys) {
                   "view_tolerance_deg", "max_view_change", "change_tolerance_m",
                   "change_tolerance_ratio", "max_changed_fraction", "degeneracy_ratio",
                   "corridor_translation_m", "corridor_rotation_deg", "corridor_interval_s"}));
-    EXPECT_EQ(keyNames(*r.find("denoise")),
-              (std::vector<std::string>{
-                  "variant", "rings", "ring_r_max", "angle_gap_factor", "merge_distance_m",
-                  "m_threshold", "jump_lambda_deg", "jump_sigma_m", "min_object_size_m",
-                  "min_points_floor", "incidence_deg", "sigma_m", "max_gap_beams",
-                  "max_small_points", "temporal", "pose_trans_error_m", "pose_rot_error_deg",
-                  "motion_error_fraction", "max_removed_fraction"}));
+    EXPECT_EQ(keyNames(*r.find("denoise")), (std::vector<std::string>{"variant",
+                                                                      "rings",
+                                                                      "ring_r_max",
+                                                                      "angle_gap_factor",
+                                                                      "merge_distance_m",
+                                                                      "m_threshold",
+                                                                      "jump_lambda_deg",
+                                                                      "jump_sigma_m",
+                                                                      "min_object_size_m",
+                                                                      "min_points_floor",
+                                                                      "incidence_deg",
+                                                                      "sigma_m",
+                                                                      "max_gap_beams",
+                                                                      "max_small_points",
+                                                                      "temporal",
+                                                                      "pose_trans_error_m",
+                                                                      "pose_rot_error_deg",
+                                                                      "motion_error_fraction",
+                                                                      "max_removed_fraction",
+                                                                      "temporal_scans"}));
     EXPECT_EQ(keyNames(*r.find("odometry_check")),
               (std::vector<std::string>{"frozen_changed_fraction", "jump_margin"}));
 }
