@@ -41,6 +41,14 @@ class KfdLaunch(live.RosCase):
         path = self.env.get("ROS_PACKAGE_PATH")
         self.env["ROS_PACKAGE_PATH"] = ROS_PKGS + (os.pathsep + path if path else "")
 
+    def nodelet(self):
+        """Skips a nodelet case in a sanitizer build: Debian's nodelet manager is not
+        instrumented, so it cannot load an instrumented libkfd_nodelet.so (dlopen: undefined
+        symbol __ubsan_vptr_type_cache). The GCC job runs these cases."""
+        if os.environ.get("KFD_SANITIZED"):
+            self.skipTest("sanitizer build: Debian's uninstrumented nodelet manager cannot load "
+                          "the instrumented nodelet (the GCC job runs this case)")
+
     def fast_bag(self):
         if not FAST_BAG_EXE or not os.access(FAST_BAG_EXE, os.X_OK):
             self.skipTest("no bag writer (kfd_bench_fast_bag: Google Benchmark missing)")
@@ -172,11 +180,13 @@ class KfdLaunch(live.RosCase):
                                            "delay:=3"], "/kfd", params=True)
 
     def test_bag_launch_nodelet_own_manager_matches_kfd_filter(self):
+        self.nodelet()
         self.run_launch("kfd_bag.launch", ["bag:=" + os.path.join(self.tmp, "fast.bag"),
                                            "delay:=3", "manager:=" + MANAGER,
                                            "start_manager:=true"], "/" + MANAGER)
 
     def test_launch_nodelet_into_running_manager_matches_kfd_filter(self):
+        self.nodelet()
         self.run_launch("kfd.launch", ["manager:=" + MANAGER, "scan_filtered:=/scan_kfd"],
                         "/" + MANAGER, scan_filtered="/scan_kfd", external_manager=True,
                         params=True)
@@ -185,6 +195,7 @@ class KfdLaunch(live.RosCase):
         self.assertEqual(self.run_failing(["removed_as:=bogus"], "removed_as"), 2)
 
     def test_bad_config_key_stops_nodelet_launch(self):
+        self.nodelet()
         config = os.path.join(self.tmp, "bad.ini")
         with open(config, "w") as f:
             f.write("[KFD]\nwindw = 3\n")
