@@ -1,4 +1,5 @@
 #include "kfd/core/scan_fusion.h"
+#include "kfd/core/point_to_line.h"
 
 #include <algorithm>
 #include <cmath>
@@ -119,8 +120,7 @@ bool ScanFusion::refine(const Scan& kf, const Slot& slot, Pose2D& d) const {
                     s = static_cast<float>(std::sin(d.phi));
         const float tx = static_cast<float>(d.x), ty = static_cast<float>(d.y);
         const float gate_f = static_cast<float>(gate);
-        double A[6] = {0, 0, 0, 0, 0, 0}, b[3] = {0, 0, 0};  // upper triangle of J^T J, J^T e
-        std::size_t pairs = 0;
+        PointToLineSystem<double> sys;
         for (std::size_t j = 0; j < n; j += stride) {
             if (!slot.valid[j]) continue;
             const float px = slot.range[j] * dirs_.cos[j], py = slot.range[j] * dirs_.sin[j];
@@ -137,41 +137,11 @@ bool ScanFusion::refine(const Scan& kf, const Slot& slot, Pose2D& d) const {
             ny *= inv;
             const float e = nx * (qx - kx_[k0]) + ny * (qy - ky_[k0]);
             if (!(std::abs(e) <= gate_f)) continue;
-            const float j2 = -nx * qy + ny * qx;  // d e / d theta (rotation about the origin)
-            A[0] += nx * nx;
-            A[1] += nx * ny;
-            A[2] += nx * j2;
-            A[3] += ny * ny;
-            A[4] += ny * j2;
-            A[5] += j2 * j2;
-            b[0] += nx * e;
-            b[1] += ny * e;
-            b[2] += j2 * e;
-            ++pairs;
+            sys.add(nx, ny, qx, qy, e);
         }
         gate = 0.5 * gate;
-        if (pairs < 12) break;
-        // Damped normal equations (a corridor leaves one direction unconstrained).
-        const double damp = 1e-3 * static_cast<double>(pairs);
-        const double a00 = A[0] + damp, a01 = A[1], a02 = A[2], a11 = A[3] + damp, a12 = A[4],
-                     a22 = A[5] + damp * 10.0;
-        const double det = a00 * (a11 * a22 - a12 * a12) - a01 * (a01 * a22 - a12 * a02) +
-                           a02 * (a01 * a12 - a11 * a02);
-        if (!(std::abs(det) > 1e-12)) break;
-        const double b0 = b[0], b1 = b[1], b2 = b[2];
-        const double dx = -(b0 * (a11 * a22 - a12 * a12) - a01 * (b1 * a22 - a12 * b2) +
-                            a02 * (b1 * a12 - a11 * b2)) /
-                          det;
-        const double dy = -(a00 * (b1 * a22 - a12 * b2) - b0 * (a01 * a22 - a12 * a02) +
-                            a02 * (a01 * b2 - b1 * a02)) /
-                          det;
-        const double dt = -(a00 * (a11 * b2 - b1 * a12) - a01 * (a01 * b2 - b1 * a02) +
-                            b0 * (a01 * a12 - a11 * a02)) /
-                          det;
-        if (!std::isfinite(dx) || !std::isfinite(dy) || !std::isfinite(dt)) break;
-        // q' = R(dt) q + (dx, dy): compose the increment onto the step.
-        const double cd = std::cos(dt), sd = std::sin(dt);
-        d = Pose2D{cd * d.x - sd * d.y + dx, sd * d.x + cd * d.y + dy, d.phi + dt};
+        if (sys.pairs < 12) break;
+        if (!sys.step(d)) break;
         changed = true;
     }
     return changed;

@@ -5,6 +5,7 @@
 #include <tf2/exceptions.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -122,9 +123,11 @@ bool ScanFilterNode::newestTfAfter(const ros::Time& stamp) const {
 
 double ScanFilterNode::waitBound() const {
     if (intervals_.empty()) return config_.tf_wait;
-    std::vector<double> v = intervals_;
-    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
-    return std::min(config_.tf_wait, double(config_.queue_size - 1) * v[v.size() / 2]);
+    std::array<double, kIntervals> v;  // a copy on the stack: no allocation per scan
+    const auto end = std::copy(intervals_.begin(), intervals_.end(), v.begin());
+    const auto mid = v.begin() + std::ptrdiff_t(intervals_.size() / 2);
+    std::nth_element(v.begin(), mid, end);
+    return std::min(config_.tf_wait, double(config_.queue_size - 1) * *mid);
 }
 
 template <class Ready>
@@ -235,7 +238,7 @@ void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
     const ros::Time stamp = in->header.stamp.isZero() ? now : in->header.stamp;
     if (last_scan_stamp_ && stamp != *last_scan_stamp_) {  // the queue's pace, every laser
         const double dt = std::abs((stamp - *last_scan_stamp_).toSec());
-        if (intervals_.size() < 32)
+        if (intervals_.size() < kIntervals)
             intervals_.push_back(dt);
         else
             intervals_[next_interval_++ % intervals_.size()] = dt;

@@ -83,8 +83,9 @@ class ScanFilterNode {
     OdometryBuffer odom_buffer_;
     LatencyStats latency_;  // callback entry to publish return
     LatencyStats work_;     // odometry in hand (or given up on) to publish return: kfd's own
-    std::vector<double> intervals_;  // the last scan intervals (|stamp difference|), s
-    std::size_t next_interval_ = 0;  // ring position in intervals_
+    static constexpr std::size_t kIntervals = 32;  // scan intervals kept for waitBound
+    std::vector<double> intervals_;                // the last kIntervals (|stamp difference|), s
+    std::size_t next_interval_ = 0;                // ring position in intervals_
     std::optional<ros::Time> last_scan_stamp_;
     // /tf down: the newest transform when a scan's wait last timed out. Until a newer one comes,
     // scans do not wait (laser only at once, counted), so the queue keeps flowing.
