@@ -80,6 +80,9 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
                     kfd::plural(s.scans_denoise_stale + s.scans_denoise_capped, "scan").c_str(),
                     kfd::plural(s.scans_denoise_stale, "stale reference").c_str(),
                     s.scans_denoise_capped);
+    if (s.scans_denoise_confirmed)
+        std::printf("; above the bound but confirmed by the scan just before on %s",
+                    kfd::plural(s.scans_denoise_confirmed, "scan").c_str());
     if (s.points_removed_noise) std::printf("\n");
     if (s.output_format == kfd::LogFormat::Carmen)
         std::printf(

@@ -340,6 +340,7 @@ TEST(CliApps, FilterVersionAndEarlyExits) {
     for (const auto& [key, value] :
          {std::pair{"incidence_deg", kfd::keys::formatReal(ev.incidence_deg)},
           {"max_removed_fraction", kfd::keys::formatReal(ev.max_removed_fraction)},
+          {"max_confirmed_fraction", kfd::keys::formatReal(ev.max_confirmed_fraction)},
           {"temporal_scans", std::to_string(ev.temporal_scans)},
           {"view_samples", std::to_string(kf.view.max_samples)}}) {
         std::istringstream lines(r.out);

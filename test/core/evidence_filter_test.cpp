@@ -213,10 +213,12 @@ TEST(EvidenceFilter, ASpikeNearAWallIsRemovedWithTheScanJustBeforeTheKeyframe) {
 
 TEST(EvidenceFilter, WhenTheScanJustBeforeWantsTooMuchTheKeyframesAloneDecide) {
     // 20 beams 0.3 m before the wall: the scan 2 cm before sees through them, the keyframe
-    // 1 m back supports them. 20 returns exceed a 5 % bound (18 of 361): the keyframes decide.
+    // 1 m back supports them. 20 returns exceed a 5 % bound (18 of 361): without the burst
+    // exception (max_confirmed_fraction = 0) the keyframes decide.
     for (const double bound : {0.05, 1.0}) {
         EvidenceFilter::Params p = withRecent(1);
         p.max_removed_fraction = bound;
+        p.max_confirmed_fraction = 0.0;
         EvidenceFilter f(p);
         Clusters c;
         Scan first = room();
@@ -228,8 +230,67 @@ TEST(EvidenceFilter, WhenTheScanJustBeforeWantsTooMuchTheKeyframesAloneDecide) {
         EXPECT_TRUE(r.recent);
         EXPECT_EQ(r.recent_overruled, bound < 1.0) << bound;
         EXPECT_FALSE(r.stale_references);
+        EXPECT_FALSE(r.confirmed);
         EXPECT_EQ(r.points_removed, bound < 1.0 ? 0u : 20u) << bound;
     }
+}
+
+// The keyframe 1 m back, the scan dropped 2 cm before the next keyframe (`recent`), and that
+// keyframe with a burst of beams [first, last] 0.3 m in front of the wall.
+EvidenceFilter::Result burstAfter(const EvidenceFilter::Params& p, const Scan& recent,
+                                  std::size_t first, std::size_t last, Scan& out) {
+    EvidenceFilter f(p);
+    Clusters c;
+    Scan start = room();
+    f.filter(start, c);
+    f.observe(recent);
+    out = roomAfter(1.0);
+    test::setRange(out, first, last, 2.7);
+    return f.filter(out, c);
+}
+
+TEST(EvidenceFilter, ABurstAboveTheBoundIsRemovedWholeWhenTheScanJustBeforeConfirmsIt) {
+    // The same 20-beam burst (5.5 % of the returns, above the 5 % bound): the scan just before
+    // supports every other return it judged, so the burst is what changed, not the references.
+    Scan second;
+    const auto r = burstAfter(withRecent(1), roomAfter(0.98), 170, 189, second);
+    EXPECT_TRUE(r.recent);
+    EXPECT_TRUE(r.confirmed);
+    EXPECT_FALSE(r.recent_overruled);
+    EXPECT_FALSE(r.stale_references);
+    EXPECT_FALSE(r.capped);
+    EXPECT_EQ(r.removal_wanted, 20u);
+    EXPECT_EQ(r.points_removed, 20u);
+    for (std::size_t i = 170; i <= 189; ++i) EXPECT_EQ(second.valid[i], 0) << i;
+}
+
+TEST(EvidenceFilter, ABurstIsNotConfirmedWhenTheScanJustBeforeDisagreesElsewhere) {
+    // The scan just before saw a recess 1.2 m deep over beams 100-159 (beyond the alignment's
+    // gate, so the alignment holds) that this scan does not: 15 of the 88 wall returns it
+    // judged are free (83 % supported). With confirm_support 0.9 it is not trusted beyond the
+    // bound and the keyframes decide (their margin supports the burst); asking half confirms.
+    Scan recent = roomAfter(0.98);
+    test::setWall(recent, 100, 159, 4.0 - 0.98 + 1.2);
+    for (const double support : {0.9, 0.5}) {
+        EvidenceFilter::Params p = withRecent(1);
+        p.confirm_support = support;
+        Scan second;
+        const auto r = burstAfter(p, recent, 170, 189, second);
+        EXPECT_TRUE(r.recent);
+        EXPECT_EQ(r.confirmed, support < 0.9) << support;
+        EXPECT_EQ(r.recent_overruled, support >= 0.9) << support;
+        EXPECT_EQ(r.points_removed, support < 0.9 ? 20u : 0u) << support;
+    }
+}
+
+TEST(EvidenceFilter, ABurstAboveTheConfirmedBoundIsNotRemovedWhole) {
+    // 100 beams (28 % of the returns) exceed max_confirmed_fraction (25 %): the references
+    // are taken as stale even though the scan just before agrees with the rest.
+    Scan second;
+    const auto r = burstAfter(withRecent(1), roomAfter(0.98), 130, 229, second);
+    EXPECT_FALSE(r.confirmed);
+    EXPECT_LE(r.points_removed, 18u);  // the 5 % bound
+    EXPECT_EQ(second.valid[180], 1);
 }
 
 TEST(EvidenceFilter, AThinPostSeenJustBeforeIsKept) {
@@ -397,6 +458,9 @@ TEST(EvidenceFilter, BadParametersAreRejected) {
     bad([](auto& p) { p.refine_samples = 0; });
     bad([](auto& p) { p.max_removed_fraction = 0.0; });
     bad([](auto& p) { p.max_removed_fraction = 1.5; });
+    bad([](auto& p) { p.max_confirmed_fraction = -0.1; });
+    bad([](auto& p) { p.max_confirmed_fraction = 1.1; });
+    bad([](auto& p) { p.confirm_support = 0.0; });
 }
 
 TEST(EvidenceFilter, DegenerateScansAreHandled) {

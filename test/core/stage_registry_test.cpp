@@ -63,6 +63,8 @@ TEST(StageRegistry, EachStageOwnsItsKeys) {
                                                                       "pose_rot_error_deg",
                                                                       "motion_error_fraction",
                                                                       "max_removed_fraction",
+                                                                      "max_confirmed_fraction",
+                                                                      "confirm_support",
                                                                       "temporal_scans"}));
     EXPECT_EQ(keyNames(*r.find("odometry_check")),
               (std::vector<std::string>{"frozen_changed_fraction", "jump_margin"}));

@@ -90,6 +90,14 @@ std::vector<StageKey> DenoiseStage::keys() {
         keys::real<P>("max_removed_fraction", "max_removed_fraction",
                       "evidence: largest share of a scan's valid returns removed (step 5)", 0, 1,
                       true, [](P& p) -> double& { return p.evidence.max_removed_fraction; }),
+        keys::real<P>("max_confirmed_fraction", "max_confirmed_fraction",
+                      "evidence: removal beyond the bound kept up to this share when the raw "
+                      "scan just before confirms it (step 5; 0 = off)",
+                      0, 1, false,
+                      [](P& p) -> double& { return p.evidence.max_confirmed_fraction; }),
+        keys::real<P>("confirm_support", "confirm_support",
+                      "evidence: ... when it supports this share of the other returns it judged", 0,
+                      1, true, [](P& p) -> double& { return p.evidence.confirm_support; }),
         keys::count<P>("temporal_scans", "temporal_scans",
                        "evidence: raw scans kept before a keyframe (the dropped ones) as "
                        "temporal evidence with margins from their alignment; 0 = keyframes only",

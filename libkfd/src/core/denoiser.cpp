@@ -62,6 +62,7 @@ Denoiser::Result Denoiser::filter(Scan& scan) {
         res.free_points = r.free_points;
         res.stale_references = r.stale_references;
         res.capped = r.capped;
+        res.confirmed = r.confirmed;
         res.recent = r.recent;
     } else if (params_.variant == DenoiseVariant::Reference) {
         const auto r = reference_.cluster(scan, clusters_);

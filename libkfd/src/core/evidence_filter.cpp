@@ -75,6 +75,10 @@ void EvidenceFilter::initialize(const Params& p) {
         throw ParameterError("refine", "refine_iterations <= 20, refine_samples >= 1, gate > 0");
     if (!(p.max_removed_fraction > 0.0 && p.max_removed_fraction <= 1.0))
         throw ParameterError("max_removed_fraction", "max_removed_fraction must be in (0, 1]");
+    if (!(p.max_confirmed_fraction >= 0.0 && p.max_confirmed_fraction <= 1.0))
+        throw ParameterError("max_confirmed_fraction", "max_confirmed_fraction must be in [0, 1]");
+    if (!(p.confirm_support > 0.0 && p.confirm_support <= 1.0))
+        throw ParameterError("confirm_support", "confirm_support must be in (0, 1]");
     if (p.temporal_scans > 16)
         throw ParameterError("temporal_scans", "temporal_scans must be in [0, 16]");
     params_ = p;
@@ -436,6 +440,7 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
         }
     }
     if (!pt.usable && !p0.usable) return false;
+    recent_ev_.assign(pt.usable ? n : 0, kUnknown);
     // Every return off a line, every return of a short segment, and every fourth return along
     // a line (enough to tell how much of a surface lies in free space).
     free_in_.assign(out.count(), 0);
@@ -453,6 +458,7 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
         std::uint8_t e = kUnknown;
         if (pt.usable) {
             e = classify(pt, x_[i], y_[i], true);
+            recent_ev_[i] = e;
             if (e == kFree && p0.usable && classify(p0, x_[i], y_[i], true) == kTracked)
                 e = kTracked;
         }
@@ -550,6 +556,10 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     // With the raw scan just before, first the keyframes alone (what temporal_scans = 0 does).
     bool temporal = res.temporal;
     std::size_t wanted = res.removal_wanted;
+    if (wanted > cap && temporal && res.recent && confirmedByRecent(out, valid_in, wanted)) {
+        res.confirmed = true;  // a burst the raw scan just before saw through: removed whole
+        wanted = 0;
+    }
     if (wanted > cap && temporal && res.recent) {
         Result kf;
         evidence_.assign(n, kUnknown);
@@ -589,6 +599,26 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
         }
     }
     return res;
+}
+
+bool EvidenceFilter::confirmedByRecent(const Clusters& out, std::size_t valid_in,
+                                       std::size_t wanted) const {
+    if (recent_ev_.size() != out.label.size()) return false;
+    if (static_cast<double>(wanted) >
+        params_.max_confirmed_fraction * static_cast<double>(valid_in))
+        return false;
+    // The rest of the scan, as the raw scan just before saw it: a good alignment supports the
+    // surfaces outside the removed segments; stale references or a wrong alignment leave free
+    // returns scattered over them.
+    std::size_t supported = 0, free = 0;
+    for (std::size_t i = 0; i < out.label.size(); ++i) {
+        if (out.label[i] < 0 || out.noise[static_cast<std::size_t>(out.label[i])]) continue;
+        supported += recent_ev_[i] == kSupported;
+        free += recent_ev_[i] == kFree;
+    }
+    const std::size_t judged = supported + free;
+    return judged >= kMinConfirmJudged &&
+           static_cast<double>(supported) >= params_.confirm_support * static_cast<double>(judged);
 }
 
 std::size_t EvidenceFilter::markNoise(Clusters& out, bool temporal,

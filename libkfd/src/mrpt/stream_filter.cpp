@@ -132,6 +132,7 @@ void StreamFilter::record(StreamResult& res) {
     }
     rec.denoise_bound = n.capped             ? DenoiseBound::Capped
                         : n.stale_references ? DenoiseBound::StaleReferences
+                        : n.confirmed        ? DenoiseBound::Confirmed
                                              : DenoiseBound::None;
     rec.points_out = rep.points_out;
     rec.microseconds = rep.microseconds;
@@ -149,6 +150,7 @@ void StreamFilter::record(StreamResult& res) {
         c.points_removed_noise += rec.removed_noise;
         c.scans_denoise_stale += rec.denoise_bound == DenoiseBound::StaleReferences;
         c.scans_denoise_capped += rec.denoise_bound == DenoiseBound::Capped;
+        c.scans_denoise_confirmed += rec.denoise_bound == DenoiseBound::Confirmed;
         const std::size_t usable = rep.points_in - rec.removed_range;
         if (usable > 0)
             c.max_removed_noise_share =

@@ -255,6 +255,7 @@ std::string toJson(const IcpSlamSummary& s) {
     j["scans_odometry_jump"] = s.scans_odometry_jump;
     j["scans_denoise_stale"] = s.scans_denoise_stale;
     j["scans_denoise_capped"] = s.scans_denoise_capped;
+    j["scans_denoise_confirmed"] = s.scans_denoise_confirmed;
     j["prefilter_us_per_scan"] = s.prefilter_us_per_scan;
     j["icp_ms_per_scan"] = s.icp_ms_per_scan;
     j["icp_ms_per_kept_scan"] = s.icp_ms_per_kept_scan;

@@ -59,7 +59,8 @@ class Denoiser {
         std::size_t free_points = 0;     // evidence: returns the previous keyframe saw through
         bool stale_references = false;   // evidence: bound on removal ignored its references
         bool capped = false;             // evidence: removal cut to the bound
-        bool recent = false;             // evidence: the raw scan just before was used
+        bool confirmed = false;  // evidence: above the bound, confirmed by the scan just before
+        bool recent = false;     // evidence: the raw scan just before was used
     };
 
     Denoiser() { initialize(Params{}); }

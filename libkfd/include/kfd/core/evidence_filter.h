@@ -71,6 +71,12 @@ namespace kfd {
 ///     keyframes alone; then step 4 runs again without temporal evidence. When even that
 ///     exceeds the bound, the smallest segments go first until the bound is reached. Both are
 ///     reported (Result::stale_references, Result::capped).
+///     Except for a burst (issue 25): when the raw scan just before was used and supports at
+///     least confirm_support of the returns it judged outside the segments to be removed (its
+///     alignment holds: the scan, not the reference, changed there), the removal stands up to
+///     max_confirmed_fraction of the valid returns (Result::confirmed). A 3-20-beam burst is
+///     up to 11 % of a 180-beam scan; stale references or a failed alignment leave free
+///     returns scattered over the surfaces that stay, and fall back as above.
 class EvidenceFilter {
   public:
     struct Params {
@@ -96,6 +102,12 @@ class EvidenceFilter {
         /// Largest share of a scan's valid returns removed (step 5), in (0, 1]; 1 = no bound.
         /// 5 %: issue 22's bound; real bursts cover 0.3-1.2 % of a log's returns (RESULTS).
         double max_removed_fraction = 0.05;
+        /// Step 5's exception for bursts: removals beyond max_removed_fraction are kept, up to
+        /// max_confirmed_fraction of the valid returns, when the raw scan just before (step 3b)
+        /// supports at least confirm_support of the returns it judged outside the removed
+        /// segments (a good alignment: the burst is what changed, not the references).
+        double max_confirmed_fraction = 0.25;
+        double confirm_support = 0.9;
         /// Raw scans kept for step 3b (the scans just before a keyframe, dropped or not), in
         /// [0, 16]; 0 = keyframes only (no copies, the behaviour before issue 25). 1: on six
         /// real logs with injected noise (seed 7, kept scans) every kind's recall rose (isolated
@@ -124,6 +136,7 @@ class EvidenceFilter {
         bool recent = false;             // step 3b: the raw scan just before was used
         double recent_margin_m = 0.0;    // m: its margin's constant part (3 max(sqrt 2 sigma, s))
         bool recent_overruled = false;   // step 5: it wanted too much; the keyframes alone used
+        bool confirmed = false;  // step 5: beyond the bound, confirmed by the raw scan just before
     };
 
     EvidenceFilter() { initialize(Params{}); }
@@ -195,6 +208,9 @@ class EvidenceFilter {
     void keepAsReference(const Scan& scan);
     // Step 4: marks noise segments; returns the returns it would remove (`kept_ev`: evidence).
     std::size_t markNoise(Clusters& out, bool temporal, const std::vector<std::uint8_t>& ev);
+    // Step 5: removals beyond the bound that the raw scan just before confirms.
+    bool confirmedByRecent(const Clusters& out, std::size_t valid_in, std::size_t wanted) const;
+    static constexpr std::size_t kMinConfirmJudged = 16;  // returns judged outside the removal
     // Step 5: the smallest noise segments only, up to `cap` returns.
     void capNoise(Clusters& out, std::size_t cap);
 
@@ -219,6 +235,7 @@ class EvidenceFilter {
     std::size_t raw_next_ = 0;              // the slot the next raw scan goes to
     std::size_t raw_count_ = 0;             // raw scans held
     Reference recent_;                      // a raw scan converted for this keyframe
+    std::vector<std::uint8_t> recent_ev_;   // per beam: the raw scan just before's verdict
     mutable std::vector<float> residuals_;  // refineStep's last iteration |e|
     Pose2D pose_;                           // this scan's refined pose (when have_pose_)
     bool have_pose_ = false;

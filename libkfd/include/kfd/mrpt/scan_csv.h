@@ -30,7 +30,8 @@ class ScanCsvError : public Error {
 /// clusters; microseconds: the pipeline's time; view_change, changed_fraction, degeneracy,
 /// corridor (1/0): the view selector and corridor switch; denoise_bound: "none", or how the
 /// evidence denoiser's bound on removal acted ("stale_references": temporal evidence ignored,
-/// "capped": cut to the bound); odometry_check: "none" (no odometry or no check), "ok",
+/// "capped": cut to the bound, "confirmed": above it, confirmed by the scan just before and
+/// removed whole); odometry_check: "none" (no odometry or no check), "ok",
 /// "frozen" or "jump" (kfd/core/odometry_check.h: withheld from the stages); icp_goodness:
 /// kfd-icp-slam, ICP's goodness when it corrected this scan's pose (0-1; "r" appended when the
 /// map builder rejected the correction), else empty; odom_x, odom_y, odom_phi: the odometry

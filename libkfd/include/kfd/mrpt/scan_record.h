@@ -18,11 +18,13 @@ enum class DenoiseBound {
     None,             // removed what the evidence said (within the bound)
     StaleReferences,  // the references disagreed with too much of the scan: spatial only
     Capped,           // even so above the bound: the smallest segments only
+    Confirmed,        // above the bound, but the raw scan just before confirmed it: all removed
 };
-/// "none", "stale_references", "capped".
+/// "none", "stale_references", "capped", "confirmed".
 inline const char* toString(DenoiseBound b) {
     return b == DenoiseBound::Capped            ? "capped"
            : b == DenoiseBound::StaleReferences ? "stale_references"
+           : b == DenoiseBound::Confirmed       ? "confirmed"
                                                 : "none";
 }
 
@@ -81,6 +83,7 @@ struct ScanCounters {
     std::size_t scans_odometry_jump = 0;    // scans whose odometry jumped where they did not
     std::size_t scans_denoise_stale = 0;    // kept scans whose denoiser found its references stale
     std::size_t scans_denoise_capped = 0;   // kept scans whose removal was cut to the bound
+    std::size_t scans_denoise_confirmed = 0;  // kept scans above the bound, confirmed (all removed)
     /// The largest share of a kept scan's valid returns the denoising stages removed (0-1).
     double max_removed_noise_share = 0.0;
     std::size_t points_in = 0;             // valid beams of the scans that ran
