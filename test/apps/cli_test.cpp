@@ -341,6 +341,7 @@ TEST(CliApps, FilterVersionAndEarlyExits) {
          {std::pair{"incidence_deg", kfd::keys::formatReal(ev.incidence_deg)},
           {"max_removed_fraction", kfd::keys::formatReal(ev.max_removed_fraction)},
           {"temporal_scans", std::to_string(ev.temporal_scans)},
+          {"next_scan", std::string(ev.next_scan ? "true" : "false")},
           {"view_samples", std::to_string(kf.view.max_samples)}}) {
         std::istringstream lines(r.out);
         std::string line, name, def, kfd_value;

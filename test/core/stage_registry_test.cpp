@@ -63,7 +63,8 @@ TEST(StageRegistry, EachStageOwnsItsKeys) {
                                                                       "pose_rot_error_deg",
                                                                       "motion_error_fraction",
                                                                       "max_removed_fraction",
-                                                                      "temporal_scans"}));
+                                                                      "temporal_scans",
+                                                                      "next_scan"}));
     EXPECT_EQ(keyNames(*r.find("odometry_check")),
               (std::vector<std::string>{"frozen_changed_fraction", "jump_margin"}));
 }
