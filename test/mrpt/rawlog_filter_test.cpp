@@ -336,6 +336,23 @@ TEST(RawlogFilter, NextScanKeepsTheSameScansInTheSameOrderOnTheBundledLog) {
     const auto ia = firstColumn(on.stats_csv);
     EXPECT_EQ(ia, firstColumn(off.stats_csv));
     EXPECT_EQ(ia.size(), a.scans_in + 1);  // a header and one row per scan
+
+    // A CARMEN output: the same kinds of line in the same order.
+    on.output = dir / "on.clf";
+    off.output = dir / "off.clf";
+    on.stats_csv = off.stats_csv = "";
+    kfd::RawlogFilter().run(on);
+    kfd::RawlogFilter().run(off);
+    auto kinds = [](const std::string& path) {
+        std::ifstream f(path);
+        std::vector<std::string> v;
+        std::string line;
+        while (std::getline(f, line)) v.push_back(line.substr(0, line.find(' ')));
+        return v;
+    };
+    const auto ka = kinds(on.output);
+    EXPECT_EQ(ka, kinds(off.output));
+    EXPECT_GT(ka.size(), a.scans_kept);
 }
 
 namespace {

@@ -64,6 +64,8 @@ void Pipeline::initialize(const Params& p, const StageRegistry& registry) {
         const StageParams* set = p.find(info->name);
         stages.push_back(set ? info->create(*set) : info->create(*info->defaults()));
     }
+    finished_ = false;
+    if (held_) finishHeld(nullptr);  // by the stages that held it; finished() returns it
     stages_ = std::move(stages);
     params_ = p;
     registry_ = &registry;

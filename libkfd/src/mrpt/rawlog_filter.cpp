@@ -105,7 +105,7 @@ class Run {
     void writeCarmenScan(const CObservation2DRangeScan::Ptr& scan, const Pose2D& odo);
     void writeCarmenOdometry(const Pose2D& odo, double stamp, bool always);
     // Processes one scan through the door; returns true when kept.
-    bool handleScan(CObservation2DRangeScan& scan);
+    bool handleScan(const CObservation2DRangeScan::Ptr& scan);
     void noteSensor(const CObservation2DRangeScan& scan, const StreamResult& r);
     void noteNoise(const StreamResult& r);
     void write(const mrpt::serialization::CSerializable& obj);
@@ -124,6 +124,7 @@ class Run {
     }
     // The door's finished scans: their stats rows filled in; the queue runs once none is held.
     void collectFinished();
+    void runDeferred();
     void flushPendingAction(bool frame_kept);
     void reportProgress(std::uint64_t bytes_read);
 
@@ -147,7 +148,11 @@ class Run {
     ScanRateMeter rate_;          // the first sensor's stamps (SensorSummary::rate_hz)
     std::size_t held_scans_ = 0;  // kept scans the door holds (pending)
     std::vector<std::function<void()>> deferred_;  // output waiting for them, in order
-    std::map<const CObservation2DRangeScan*, std::shared_ptr<ScanRecord>> held_rows_;
+    struct HeldRow {
+        CObservation2DRangeScan::Ptr scan;  // kept alive while the door holds it
+        std::shared_ptr<ScanRecord> row;    // its stats row, filled in once finished
+    };
+    std::map<const CObservation2DRangeScan*, HeldRow> held_rows_;
 };
 
 void Run::write(const mrpt::serialization::CSerializable& obj) {
@@ -189,14 +194,15 @@ void Run::noteNoise(const StreamResult& r) {
             }
 }
 
-bool Run::handleScan(CObservation2DRangeScan& scan) {
+bool Run::handleScan(const CObservation2DRangeScan::Ptr& ptr) {
+    CObservation2DRangeScan& scan = *ptr;
     const StreamResult r = filter_.process(scan, odometry_);
     collectFinished();  // the scans this one finished come first
     if (r.skipped == ScanSkipReason::None) noteSensor(scan, r);
     if (r.pending) {  // its row (and everything after it) once the door finishes it
         ++held_scans_;
         auto row = std::make_shared<ScanRecord>(r.record);
-        held_rows_[&scan] = row;
+        held_rows_[&scan] = HeldRow{ptr, row};
         if (csv_.isOpen()) emit([this, row] { asRawlogError([&] { csv_.write(*row); }); });
         return true;
     }
@@ -215,11 +221,15 @@ void Run::collectFinished() {
         noteNoise(f);
         const auto it = held_rows_.find(f.scan);
         if (it == held_rows_.end()) continue;
-        *it->second = f.record;
+        *it->second.row = f.record;
         held_rows_.erase(it);
         --held_scans_;
     }
     if (held_scans_ > 0 || deferred_.empty()) return;
+    runDeferred();
+}
+
+void Run::runDeferred() {
     auto queue = std::move(deferred_);
     deferred_.clear();
     for (auto& fn : queue) fn();
@@ -284,7 +294,7 @@ void Run::handleFrame(const std::shared_ptr<CSensoryFrame>& sf) {
             continue;
         }
         ++scans;
-        if (handleScan(*scan)) {
+        if (handleScan(scan)) {
             ++it;
         } else {
             it = sf->erase(it);
@@ -415,7 +425,7 @@ void Run::handleObservation(const SourceEntry& e) {
     auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(e.observation);
     if (!scan) {
         if (!bag_) writeShared(e.observation);
-    } else if (!handleScan(*scan)) {
+    } else if (!handleScan(scan)) {
         ++sum_.objects_dropped;
     } else if (!bag_) {
         writeShared(scan);
@@ -441,7 +451,7 @@ void Run::handleCarmenEntry(const SourceEntry& e) {
     }
     auto scanOrOdometry = [&](const mrpt::obs::CObservation::Ptr& obs) {
         if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(obs)) {
-            if (!handleScan(*scan)) {
+            if (!handleScan(scan)) {
                 ++sum_.objects_dropped;
                 return false;
             }
@@ -500,6 +510,9 @@ void Run::writeCarmenOdometry(const Pose2D& odo, double stamp, bool always) {
 void Run::finish() {
     filter_.finish();  // the last kept scan, when held for its next: finished without it
     collectFinished();
+    held_scans_ = 0;  // nothing is held any more: whatever waits goes out
+    held_rows_.clear();
+    runDeferred();
     if (!carmen_pending_.empty())
         throw RawlogError("a CARMEN output needs the robot's odometry (a FLASER line holds it): " +
                               opts_.input + " has none (a laser-only log): write a .rawlog" +

@@ -90,7 +90,8 @@ class Pipeline {
     /// Builds the stages. Throws kfd::ParameterError (field "stages") on an unknown or repeated
     /// stage name, and the stage's kfd::ParameterError on invalid stage parameters. Parameters
     /// of registered stages that are set but not listed are validated too, so that a bad value
-    /// is reported even while its stage is switched off.
+    /// is reported even while its stage is switched off. A held scan (see process()) is
+    /// finished by the old stages first, without a next scan (finished() returns it).
     void initialize(const Params& p, const StageRegistry& registry);
     /// Rebuilds from the registry given at construction.
     void initialize(const Params& p) { initialize(p, *registry_); }
