@@ -447,6 +447,63 @@ TEST(PipelineNextScan, WithoutTheOptionNothingIsHeld) {
     EXPECT_FALSE(p.finish());
 }
 
+// A stage that holds each scan for the next (Stage::defers): it records what finish() got.
+class HoldingStage : public Stage {
+  public:
+    const char* name() const override { return "hold"; }
+    bool process(Scan&, StageReport&, const ScanReport&) override {
+        ADD_FAILURE() << "process() called on a holding stage";
+        return true;
+    }
+    bool defers() const override { return true; }
+    bool finish(Scan& scan, StageReport& report, const ScanReport&, const Scan* next) override {
+        held_stamps.push_back(scan.timestamp);
+        next_stamps.push_back(next ? next->timestamp : -1.0);
+        for (auto& v : scan.valid)  // marks what it finished: its first valid beam goes
+            if (v) {
+                v = 0;
+                break;
+            }
+        report.points_removed = 1;
+        return true;
+    }
+    std::vector<double> held_stamps, next_stamps;
+};
+
+TEST(PipelineNextScan, TheStagesAfterTheHoldingOneRunOnTheFinishedScanInOrder) {
+    Pipeline p(withStages({}));
+    auto hold = std::make_unique<HoldingStage>();
+    HoldingStage* h = hold.get();
+    int after_calls = 0;
+    auto after = std::make_unique<RecordingStage>("after", true, &after_calls);
+    RecordingStage* a = after.get();
+    p.add(std::move(hold));
+    p.add(std::move(after));
+    std::vector<double> out;
+    ScanReport done;
+    for (int k = 0; k < 4; ++k) {
+        Scan s = noisyWall();
+        s.timestamp = 10.0 + k;
+        const std::size_t valid = s.countValid();
+        const ScanReport r = p.process(s);
+        EXPECT_TRUE(r.pending);
+        EXPECT_EQ(r.stage_count, 0u);      // the holding stage did not run yet
+        EXPECT_EQ(s.countValid(), valid);  // the caller's scan is not touched
+        if (const Scan* f = p.finished(done)) {
+            out.push_back(f->timestamp);
+            EXPECT_EQ(done.stage_count, 2u);
+            EXPECT_EQ(done.points_out, valid - 1);
+            EXPECT_EQ(a->seen_valid, valid - 1);  // the later stage saw the finished scan
+        }
+    }
+    EXPECT_TRUE(p.finish());
+    ASSERT_NE(p.finished(done), nullptr);
+    out.push_back(p.finished(done)->timestamp);
+    EXPECT_EQ(out, (std::vector<double>{10, 11, 12, 13}));
+    EXPECT_EQ(h->next_stamps, (std::vector<double>{11, 12, 13, -1}));
+    EXPECT_EQ(after_calls, 4);
+}
+
 TEST(PipelineNextScan, ABadValueOfTheKeyNamesIt) {
     const StageInfo& denoise = *coreStageRegistry().find("denoise");
     const StageKey* key = denoise.keyForField("next_scan");
