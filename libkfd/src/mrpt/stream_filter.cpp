@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <utility>
 
 #include "kfd/core/denoiser.h"
@@ -29,6 +30,19 @@ const char* skippedReason(ScanSkipReason r) {
             break;
     }
     return "ok";
+}
+
+// Marks invalid in `obs` the first n beams whose flag in `valid` is 0 (the stages' removals;
+// no beam made valid again). memchr skips the runs of valid beams: most beams of most scans.
+void writeBack(const std::uint8_t* valid, std::size_t n, mrpt::obs::CObservation2DRangeScan& obs) {
+    const std::uint8_t* end = valid + n;
+    for (const void* hit = std::memchr(valid, 0, n); hit;) {
+        const auto* p = static_cast<const std::uint8_t*>(hit);
+        const auto i = static_cast<std::size_t>(p - valid);
+        if (obs.getScanRangeValidity(i)) obs.setScanRangeValidity(i, false);
+        ++p;
+        hit = p < end ? std::memchr(p, 0, static_cast<std::size_t>(end - p)) : nullptr;
+    }
 }
 
 }  // namespace
@@ -104,9 +118,7 @@ StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
     res.keep = rec.kept = res.report.keep;
     // Written back: the beams the stages removed become invalid in the MRPT scan (ranges, beam
     // count and angles kept; no beam made valid again). Only those beams are touched.
-    const std::uint8_t* valid = s.scan.valid.data();
-    for (std::size_t i = 0, n = s.scan.size(); i < n; ++i)
-        if (!valid[i] && obs.getScanRangeValidity(i)) obs.setScanRangeValidity(i, false);
+    writeBack(s.scan.valid.data(), s.scan.size(), obs);
     if (res.report.pending) {  // recorded once finished
         res.pending = true;
         s.held = res;
@@ -127,9 +139,7 @@ void StreamFilter::collectFinished(Sensor& s) {
     res.report = report;
     res.keep = res.record.kept = report.keep;
     mrpt::obs::CObservation2DRangeScan& obs = *res.scan;
-    const std::uint8_t* valid = done->valid.data();
-    for (std::size_t i = 0, n = std::min(done->size(), obs.getScanSize()); i < n; ++i)
-        if (!valid[i] && obs.getScanRangeValidity(i)) obs.setScanRangeValidity(i, false);
+    writeBack(done->valid.data(), std::min(done->size(), obs.getScanSize()), obs);
     record(res);
     finished_.push_back(std::move(res));
 }
