@@ -342,6 +342,7 @@ TEST(CliApps, FilterVersionAndEarlyExits) {
           {"max_removed_fraction", kfd::keys::formatReal(ev.max_removed_fraction)},
           {"max_confirmed_fraction", kfd::keys::formatReal(ev.max_confirmed_fraction)},
           {"temporal_scans", std::to_string(ev.temporal_scans)},
+          {"next_scan", std::string(ev.next_scan ? "true" : "false")},
           {"view_samples", std::to_string(kf.view.max_samples)}}) {
         std::istringstream lines(r.out);
         std::string line, name, def, kfd_value;

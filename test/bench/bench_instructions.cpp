@@ -56,6 +56,13 @@ kfd::Pipeline::Params temporalParams() {
     return p;
 }
 
+// The same with the scan just after each keyframe too (next_scan, issue 25).
+kfd::Pipeline::Params nextScanParams() {
+    kfd::Pipeline::Params p = temporalParams();
+    p.get<kfd::DenoiseStage>().evidence.next_scan = true;
+    return p;
+}
+
 // The MRPT form of a core scan (what a driver gives the door).
 mrpt::obs::CObservation2DRangeScan toMrpt(const kfd::Scan& s) {
     mrpt::obs::CObservation2DRangeScan o;
@@ -90,6 +97,7 @@ struct Context {
         kb::paperParams(kfd::DenoiseVariant::RangeAware).get<kfd::DenoiseStage>()};
     kfd::Denoiser evidence{keyframesOnlyParams().get<kfd::DenoiseStage>()};
     kfd::Denoiser evidence_temporal{temporalParams().get<kfd::DenoiseStage>()};
+    kfd::Denoiser evidence_next{nextScanParams().get<kfd::DenoiseStage>()};
     kfd::DbscanFilter dbscan{kfd::DbscanFilter::Params{0.7, 10}};
     kfd::RadiusOutlierFilter radius{kfd::RadiusOutlierFilter::Params{}};
     kfd::StatisticalOutlierFilter sor{kfd::StatisticalOutlierFilter::Params{}};
@@ -170,6 +178,15 @@ __attribute__((noinline)) void kfd_ir_denoise_evidence_temporal(Context& c, std:
     kfd_ir_evidence_observe(c, k);
     kfd_ir_denoise_evidence_temporal_keyframe(c, k);
 }
+// The same keyframe confirmed against the scan just after it too (next_scan): the observe
+// of the scan before and the keyframe's filter with both raw scans.
+__attribute__((noinline)) void kfd_ir_denoise_evidence_next_keyframe(Context& c, std::size_t k) {
+    c.sink += c.evidence_next.filter(c.work_loop[k], &c.sc.loop_after[k]).points_removed;
+}
+__attribute__((noinline)) void kfd_ir_denoise_evidence_next(Context& c, std::size_t k) {
+    c.evidence_next.observe(c.sc.loop_before[k]);
+    kfd_ir_denoise_evidence_next_keyframe(c, k);
+}
 __attribute__((noinline)) void kfd_ir_dbscan_loop(Context& c, std::size_t k) {
     c.sink += c.dbscan.filter(c.work_loop[k]).points_removed;
 }
@@ -222,6 +239,7 @@ const Case kCases[] = {
     {"denoise_range_aware", kfd_ir_denoise_range_aware, false},
     {"denoise_evidence", kfd_ir_denoise_evidence, false, true},
     {"denoise_evidence_temporal", kfd_ir_denoise_evidence_temporal, false, true},
+    {"denoise_evidence_next", kfd_ir_denoise_evidence_next, false, true},
     {"dbscan_loop", kfd_ir_dbscan_loop, false, true},
     {"dbscan", kfd_ir_dbscan, false},
     {"radius_outlier", kfd_ir_radius_outlier, false},
@@ -244,6 +262,10 @@ void warmUp(Context& c, const Case& cs) {
             if (name == "denoise_evidence_temporal") {
                 c.evidence_temporal.observe(c.sc.loop_before[k]);
                 c.evidence_temporal.filter(c.work_loop[k]);
+            }
+            if (name == "denoise_evidence_next") {
+                c.evidence_next.observe(c.sc.loop_before[k]);
+                c.evidence_next.filter(c.work_loop[k], &c.sc.loop_after[k]);
             }
             if (name == "dbscan_loop") c.dbscan.filter(c.work_loop[k]);
         }

@@ -192,6 +192,8 @@ struct Scenario {
     /// The stream scan just before each loop keyframe (1.88 cm and 0.6 deg back): what the
     /// keyframe stage dropped last, the evidence denoiser's temporal_scans reference.
     std::vector<Scan> loop_before;
+    /// The stream scan just after each loop keyframe: the next_scan reference (issue 25).
+    std::vector<Scan> loop_after;
 };
 
 inline Scenario makeScenario(unsigned seed = kSeed) {
@@ -237,6 +239,9 @@ inline Scenario makeScenario(unsigned seed = kSeed) {
         Scan b = simulateScan(scene, loopPose(before), seed + 2, before);
         distance.filter(b);
         sc.loop_before.push_back(std::move(b));
+        Scan a = simulateScan(scene, loopPose(index + 1), seed + 2, index + 1);
+        distance.filter(a);
+        sc.loop_after.push_back(std::move(a));
     }
     return sc;
 }

@@ -339,6 +339,80 @@ TEST(EvidenceFilter, TheKeyframeItselfIsTheScanBeforeTheNextWhenNothingWasDroppe
     EXPECT_FALSE(f.filter(third, c).recent);  // reset forgets the raw scans too
 }
 
+EvidenceFilter::Params withNext(bool next) {
+    EvidenceFilter::Params p = withRecent(1);
+    p.next_scan = next;
+    return p;
+}
+
+TEST(EvidenceFilter, ABurstOnlyInTheKeyframeIsRemovedWithTheScanJustAfter) {
+    // A 5-beam burst 0.28 m in front of the wall in the keyframe only. The scan just before
+    // has dropouts there (no verdict); the keyframe 1 m back supports the burst (its wide
+    // margin). Without the next scan it stays; the scan 2 cm after sees through it.
+    for (const bool next : {false, true}) {
+        EvidenceFilter f(withNext(next));
+        Clusters c;
+        Scan first = room();
+        f.filter(first, c);
+        Scan before = roomAfter(0.98);
+        for (std::size_t i = 175; i <= 185; ++i) before.valid[i] = 0;
+        f.observe(before);
+        Scan key = roomAfter(1.0);
+        test::setRange(key, 178, 182, 2.72f);  // its own segment (0.19 m breakpoint)
+        const Scan after = roomAfter(1.02);
+        const auto r = f.filter(key, c, &after);
+        EXPECT_TRUE(r.recent);
+        EXPECT_EQ(r.next, next);
+        for (std::size_t i = 178; i <= 182; ++i) EXPECT_EQ(key.valid[i], next ? 0 : 1) << i;
+        EXPECT_EQ(r.points_removed, next ? 5u : 0u);
+    }
+}
+
+TEST(EvidenceFilter, ASurfaceThatAppearsInTheKeyframeAndStaysInTheNextScanIsKept) {
+    // 12 beams at 2 m (a door swung open, a person stepping in): the keyframe and the scan
+    // just after see it, the scan just before and the keyframe before saw the wall through
+    // it. Without the next scan it goes as free space; with it, its support keeps it.
+    auto withSurface = [](Scan s) {
+        test::setRange(s, 175, 186, 2.0f);
+        return s;
+    };
+    for (const bool next : {false, true}) {
+        EvidenceFilter f(withNext(next));
+        Clusters c;
+        Scan first = room();
+        f.filter(first, c);
+        f.observe(roomAfter(0.98));
+        Scan key = withSurface(roomAfter(1.0));
+        const Scan after = withSurface(roomAfter(1.02));
+        const auto r = f.filter(key, c, &after);
+        EXPECT_TRUE(r.recent);
+        EXPECT_EQ(r.next, next);
+        for (std::size_t i = 175; i <= 186; ++i) EXPECT_EQ(key.valid[i], next ? 1 : 0) << i;
+        EXPECT_EQ(r.points_removed, next ? 0u : 12u);
+    }
+}
+
+TEST(EvidenceFilter, WithoutANextScanTheKeyframeIsFilteredAsWithoutTheOption) {
+    // The end of a log: no scan after the keyframe. next = nullptr gives what next_scan =
+    // false gives; and a next scan is ignored when the option is off.
+    EvidenceFilter on(withNext(true)), off(withNext(false));
+    Clusters c;
+    Scan a = room(), b = room();
+    on.filter(a, c);
+    off.filter(b, c);
+    Scan x = roomAfter(1.0), y = roomAfter(1.0), z = roomAfter(1.0);
+    test::setRange(x, 178, 182, 2.88f);
+    test::setRange(y, 178, 182, 2.88f);
+    test::insertSpike(x, 100, 1.5f);
+    test::insertSpike(y, 100, 1.5f);
+    const auto rx = on.filter(x, c, nullptr);
+    const auto ry = off.filter(y, c, &z);
+    EXPECT_FALSE(rx.next);
+    EXPECT_FALSE(ry.next);
+    EXPECT_EQ(x.valid, y.valid);
+    EXPECT_EQ(rx.points_removed, ry.points_removed);
+}
+
 TEST(EvidenceFilter, ObservingDoesNothingWithoutTemporalScans) {
     // temporal_scans = 0 keeps today's behaviour: an observed scan changes no result.
     EvidenceFilter a(withRecent(0)), b(withRecent(0));

@@ -317,3 +317,209 @@ TEST(Pipeline, StageParamsArePassedOn) {
 
 }  // namespace
 }  // namespace kfd
+
+namespace kfd {
+namespace {
+
+// One scan of latency (the denoise key next_scan, issue 25): a robot driving towards a wall
+// at 10 cm a scan, odometry along; every fifth scan has a 5-beam burst in front of the wall.
+std::vector<Scan> approach(std::size_t count) {
+    std::vector<Scan> scans;
+    for (std::size_t k = 0; k < count; ++k) {
+        const double x = 0.1 * static_cast<double>(k);
+        Scan s = test::flatWall(361, test::deg2rad(150.0), 6.0 - x);
+        s.odometry = Pose2D{x, 0.0, 0.0};
+        s.timestamp = 100.0 + 0.1 * static_cast<double>(k);
+        if (k % 5 == 2) test::setRange(s, 178, 182, 6.0 - x - 0.5);
+        scans.push_back(std::move(s));
+    }
+    return scans;
+}
+
+Pipeline::Params nextScan(bool on) {
+    Pipeline::Params p;
+    p.get<DenoiseStage>().evidence.next_scan = on;
+    return p;
+}
+
+struct Output {
+    double stamp;
+    bool keep;
+    std::vector<std::uint8_t> valid;
+};
+
+// Runs the scans through; the outputs in the order the pipeline finishes them.
+std::vector<Output> run(Pipeline& p, std::vector<Scan> scans, std::size_t* pending = nullptr) {
+    std::vector<Output> out;
+    ScanReport done;
+    for (Scan& s : scans) {
+        const ScanReport r = p.process(s);
+        if (const Scan* f = p.finished(done)) {
+            EXPECT_FALSE(done.pending);
+            out.push_back({f->timestamp, done.keep, f->valid});
+        }
+        if (r.pending) {
+            EXPECT_TRUE(r.keep);
+            EXPECT_TRUE(p.holding());
+            if (pending) ++*pending;
+        } else {
+            out.push_back({s.timestamp, r.keep, s.valid});
+        }
+    }
+    if (p.finish()) {
+        const Scan* f = p.finished(done);
+        EXPECT_NE(f, nullptr);
+        if (f) out.push_back({f->timestamp, done.keep, f->valid});
+    }
+    EXPECT_FALSE(p.holding());
+    return out;
+}
+
+TEST(PipelineNextScan, AKeyframeIsHeldUntilTheNextScanAndFinishedByIt) {
+    Pipeline p(nextScan(true));
+    auto scans = approach(2);
+    const ScanReport first = p.process(scans[0]);
+    EXPECT_TRUE(first.pending);
+    EXPECT_TRUE(first.keep);
+    EXPECT_EQ(first.find<Denoiser::Result>(), nullptr);  // the denoise stage has not run
+    ScanReport done;
+    EXPECT_EQ(p.finished(done), nullptr);
+    p.process(scans[1]);
+    const Scan* f = p.finished(done);
+    ASSERT_NE(f, nullptr);
+    EXPECT_EQ(f->timestamp, scans[0].timestamp);
+    EXPECT_FALSE(done.pending);
+    ASSERT_NE(done.find<Denoiser::Result>(), nullptr);
+    EXPECT_TRUE(done.find<Denoiser::Result>()->next);  // the next scan was used
+    EXPECT_EQ(done.stage_count, 3u);
+}
+
+TEST(PipelineNextScan, TheLastKeyframeIsFinishedWithoutANextScan) {
+    Pipeline p(nextScan(true));
+    Scan only = approach(1)[0];
+    EXPECT_TRUE(p.process(only).pending);
+    ScanReport done;
+    EXPECT_TRUE(p.finish());
+    const Scan* f = p.finished(done);
+    ASSERT_NE(f, nullptr);
+    EXPECT_TRUE(done.keep);
+    ASSERT_NE(done.find<Denoiser::Result>(), nullptr);
+    EXPECT_FALSE(done.find<Denoiser::Result>()->next);
+    EXPECT_FALSE(p.finish());  // nothing held any more
+    // Exactly what the option off gives for a lone scan.
+    Pipeline off(nextScan(false));
+    Scan same = approach(1)[0];
+    off.process(same);
+    EXPECT_EQ(f->valid, same.valid);
+}
+
+TEST(PipelineNextScan, ResetFinishesTheHeldKeyframeFirst) {
+    Pipeline p(nextScan(true));
+    Scan only = approach(1)[0];
+    EXPECT_TRUE(p.process(only).pending);
+    p.reset();
+    ScanReport done;
+    EXPECT_NE(p.finished(done), nullptr);
+    EXPECT_FALSE(p.holding());
+}
+
+TEST(PipelineNextScan, OutputsKeepTheInputOrderAndCountsOnlyRemovalsDiffer) {
+    Pipeline on(nextScan(true)), off(nextScan(false));
+    std::size_t pending = 0;
+    const auto a = run(on, approach(30), &pending);
+    const auto b = run(off, approach(30));
+    EXPECT_GT(pending, 1u);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a[i].stamp, b[i].stamp) << i;
+        EXPECT_EQ(a[i].keep, b[i].keep) << i;
+        ASSERT_EQ(a[i].valid.size(), b[i].valid.size());
+    }
+}
+
+TEST(PipelineNextScan, WithoutTheOptionNothingIsHeld) {
+    Pipeline p(nextScan(false));
+    for (Scan& s : approach(10)) {
+        EXPECT_FALSE(p.process(s).pending);
+        ScanReport done;
+        EXPECT_EQ(p.finished(done), nullptr);
+    }
+    EXPECT_FALSE(p.finish());
+}
+
+// A stage that holds each scan for the next (Stage::defers): it records what finish() got.
+class HoldingStage : public Stage {
+  public:
+    const char* name() const override { return "hold"; }
+    bool process(Scan&, StageReport&, const ScanReport&) override {
+        ADD_FAILURE() << "process() called on a holding stage";
+        return true;
+    }
+    bool defers() const override { return true; }
+    bool finish(Scan& scan, StageReport& report, const ScanReport&, const Scan* next) override {
+        held_stamps.push_back(scan.timestamp);
+        next_stamps.push_back(next ? next->timestamp : -1.0);
+        for (auto& v : scan.valid)  // marks what it finished: its first valid beam goes
+            if (v) {
+                v = 0;
+                break;
+            }
+        report.points_removed = 1;
+        return true;
+    }
+    std::vector<double> held_stamps, next_stamps;
+};
+
+TEST(PipelineNextScan, TheStagesAfterTheHoldingOneRunOnTheFinishedScanInOrder) {
+    Pipeline p(withStages({}));
+    auto hold = std::make_unique<HoldingStage>();
+    HoldingStage* h = hold.get();
+    int after_calls = 0;
+    auto after = std::make_unique<RecordingStage>("after", true, &after_calls);
+    RecordingStage* a = after.get();
+    p.add(std::move(hold));
+    p.add(std::move(after));
+    std::vector<double> out;
+    ScanReport done;
+    for (int k = 0; k < 4; ++k) {
+        Scan s = noisyWall();
+        s.timestamp = 10.0 + k;
+        const std::size_t valid = s.countValid();
+        const ScanReport r = p.process(s);
+        EXPECT_TRUE(r.pending);
+        EXPECT_EQ(r.stage_count, 0u);      // the holding stage did not run yet
+        EXPECT_EQ(s.countValid(), valid);  // the caller's scan is not touched
+        if (const Scan* f = p.finished(done)) {
+            out.push_back(f->timestamp);
+            EXPECT_EQ(done.stage_count, 2u);
+            EXPECT_EQ(done.points_out, valid - 1);
+            EXPECT_EQ(a->seen_valid, valid - 1);  // the later stage saw the finished scan
+        }
+    }
+    EXPECT_TRUE(p.finish());
+    ASSERT_NE(p.finished(done), nullptr);
+    out.push_back(p.finished(done)->timestamp);
+    EXPECT_EQ(out, (std::vector<double>{10, 11, 12, 13}));
+    EXPECT_EQ(h->next_stamps, (std::vector<double>{11, 12, 13, -1}));
+    EXPECT_EQ(after_calls, 4);
+}
+
+TEST(PipelineNextScan, ABadValueOfTheKeyNamesIt) {
+    const StageInfo& denoise = *coreStageRegistry().find("denoise");
+    const StageKey* key = denoise.keyForField("next_scan");
+    ASSERT_NE(key, nullptr);
+    Pipeline::Params p;
+    StageParams& sp = p.at(denoise);
+    try {
+        key->set(sp.data(), "maybe");
+        FAIL() << "no error";
+    } catch (const ParameterError& e) {
+        EXPECT_EQ(e.field(), "next_scan");
+        EXPECT_NE(std::string(e.what()).find("next_scan"), std::string::npos);
+    }
+    key->set(sp.data(), "true");
+    EXPECT_EQ(key->get(sp.data()), "true");
+}
+
+}  // namespace
+}  // namespace kfd

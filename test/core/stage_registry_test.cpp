@@ -65,7 +65,8 @@ TEST(StageRegistry, EachStageOwnsItsKeys) {
                                                                       "max_removed_fraction",
                                                                       "max_confirmed_fraction",
                                                                       "confirm_support",
-                                                                      "temporal_scans"}));
+                                                                      "temporal_scans",
+                                                                      "next_scan"}));
     EXPECT_EQ(keyNames(*r.find("odometry_check")),
               (std::vector<std::string>{"frozen_changed_fraction", "jump_margin"}));
 }

@@ -200,3 +200,74 @@ TEST(StreamFilter, FrozenOdometryIsDecidedAsLaserOnly) {
     EXPECT_GE(frozen.counters().scans_denoise_confirmed, above_bound);
     EXPECT_GT(above_bound, 0u);
 }
+
+// One scan of latency (the denoise key next_scan, issue 25).
+namespace {
+
+kfd::Pipeline::Params nextScanParams() {
+    kfd::Pipeline::Params p;
+    p.get<kfd::DenoiseStage>().evidence.next_scan = true;
+    return p;
+}
+
+}  // namespace
+
+TEST(StreamFilter, ADoorThatCannotHoldScansRefusesNextScanNamingIt) {
+    try {
+        kfd::StreamFilter f(nextScanParams());
+        FAIL() << "accepted";
+    } catch (const kfd::ParameterError& e) {
+        EXPECT_EQ(e.field(), "next_scan");
+        EXPECT_NE(std::string(e.what()).find("one scan of latency"), std::string::npos);
+    }
+    EXPECT_NO_THROW(kfd::StreamFilter(nextScanParams(), {}, true));
+}
+
+TEST(StreamFilter, WithNextScanAKeptScanIsPendingUntilTheNextScanFinishesIt) {
+    kfd::StreamFilter f(nextScanParams(), {}, true);
+    auto a = roomScan(361, M_PI, 3.0);
+    a.timestamp = mrpt::Clock::fromDouble(100.0);
+    const auto ra = f.process(a);
+    EXPECT_TRUE(ra.keep);
+    EXPECT_TRUE(ra.pending);
+    EXPECT_EQ(ra.scan, &a);
+    EXPECT_EQ(f.pendingCount(), 1u);
+    EXPECT_EQ(f.counters().scans_kept, 0u);  // counted once finished
+    kfd::StreamResult done;
+    EXPECT_FALSE(f.takeFinished(done));
+    auto b = roomScan(361, M_PI, 3.0, "LASER", 0.3);  // turned: a keyframe too
+    b.timestamp = mrpt::Clock::fromDouble(100.1);
+    const auto rb = f.process(b);
+    ASSERT_TRUE(f.takeFinished(done));
+    EXPECT_EQ(done.scan, &a);
+    EXPECT_FALSE(done.pending);
+    EXPECT_TRUE(done.keep);
+    EXPECT_EQ(done.record.index, 0u);
+    EXPECT_NE(done.report.find<kfd::Denoiser::Result>(), nullptr);
+    EXPECT_FALSE(f.takeFinished(done));
+    EXPECT_EQ(f.counters().scans_kept, 1u);
+    if (rb.pending) {  // the end of the log: finished without a next scan
+        f.finish();
+        ASSERT_TRUE(f.takeFinished(done));
+        EXPECT_EQ(done.scan, &b);
+        EXPECT_TRUE(done.keep);
+    }
+    EXPECT_EQ(f.pendingCount(), 0u);
+    EXPECT_EQ(f.counters().scans_kept + f.counters().scans_dropped, 2u);
+}
+
+TEST(StreamFilter, AGeometryChangeFinishesThePendingScan) {
+    kfd::StreamFilter f(nextScanParams(), {}, true);
+    auto a = roomScan(361, M_PI, 3.0);
+    EXPECT_TRUE(f.process(a).pending);
+    auto b = roomScan(181, M_PI, 3.0);  // another beam count: the sensor's state is reset
+    const auto rb = f.process(b);
+    EXPECT_TRUE(rb.geometry_reset);
+    kfd::StreamResult done;
+    ASSERT_TRUE(f.takeFinished(done));
+    EXPECT_EQ(done.scan, &a);
+    EXPECT_TRUE(done.keep);
+    f.finish();
+    while (f.takeFinished(done)) EXPECT_EQ(done.scan, &b);
+    EXPECT_EQ(f.pendingCount(), 0u);
+}

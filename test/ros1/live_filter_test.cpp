@@ -180,3 +180,21 @@ TEST(LiveFilter, RemovedBeamsAreNaN) { expectMarked(kfd::RemovedMark::NaN); }
 TEST(LiveFilter, RemovedBeamsArePlusInfWhenAsked) { expectMarked(kfd::RemovedMark::PlusInf); }
 
 }  // namespace
+
+namespace {
+
+// next_scan (issue 25) holds each keyframe for one scan; the node does not publish a scan one
+// scan later yet, so it refuses the key at start (kfd_node prints the error and exits).
+TEST(LiveFilter, NextScanIsRefusedAtStartNamingTheKey) {
+    LiveFilter::Params p = defaults();
+    p.pipeline.get<kfd::DenoiseStage>().evidence.next_scan = true;
+    try {
+        LiveFilter f(p);
+        FAIL() << "accepted";
+    } catch (const kfd::ParameterError& e) {
+        EXPECT_EQ(e.field(), "next_scan");
+        EXPECT_NE(std::string(e.what()).find("one scan of latency"), std::string::npos);
+    }
+}
+
+}  // namespace

@@ -231,3 +231,32 @@ TEST(NoisyLog, LabelsMatchTheInjectedBeamsAndScoreBackPerModel) {
 }
 
 }  // namespace
+
+namespace {
+
+// kfd-denoise-eval with next_scan (issue 25): a held keyframe is scored once finished (the
+// last one at the end of the log); the same scans are scored and every labelled beam counted.
+TEST(NoisyLog, WithNextScanTheSameScansAreScoredOnceFinished) {
+    const std::string office = std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog";
+    kfd::test::TempDir dir("kfd_noisy_next_");
+    kfd::NoisyLogOptions o;
+    o.input = office;
+    o.output = dir / "noisy.rawlog";
+    o.seed = 3;
+    const auto s = kfd::writeNoisyLog(o);
+    kfd::Pipeline::Params off =
+        kfd::loadConfigFile(std::string(KFD_SOURCE_DIR) + "/share/kfd/default.ini");
+    kfd::Pipeline::Params on = off;
+    on.get<kfd::DenoiseStage>().evidence.next_scan = true;
+    const auto a = kfd::evaluateDenoising(o.output, s.labels, on);
+    const auto b = kfd::evaluateDenoising(o.output, s.labels, off);
+    EXPECT_EQ(a.scans, 600u);
+    EXPECT_EQ(a.scored, b.scored);
+    EXPECT_GT(a.scored, 1u);
+    EXPECT_EQ(a.points, b.points);
+    EXPECT_EQ(a.noise, b.noise);
+    EXPECT_EQ(a.clean, b.clean);
+    EXPECT_GT(a.removed_noise, 0u);
+}
+
+}  // namespace

@@ -399,6 +399,27 @@ TEST(IcpSlamRunner, BadInputIsAClearError) {
     EXPECT_THROW(runAndReport(o), kfd::ConfigError);
 }
 
+// next_scan (issue 25) holds each keyframe for one scan, which the SLAM loop does not
+// support: the run refuses the key before anything runs, naming it.
+TEST(IcpSlamRunner, NextScanIsRefusedNamingTheKey) {
+    TempDir dir;
+    std::string ini = text(kConfig);
+    const auto at = ini.find("[KFD]\n");
+    ASSERT_NE(at, std::string::npos);
+    ini.insert(at + 6, "next_scan = true\n");
+    std::ofstream(dir / "next.ini") << ini;
+    auto o = options(std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog", dir / "out",
+                     kfd::PrefilterMode::Kfd);
+    o.config_file = dir / "next.ini";
+    try {
+        runAndReport(o);
+        FAIL() << "accepted";
+    } catch (const kfd::ParameterError& e) {
+        EXPECT_EQ(e.field(), "next_scan");
+        EXPECT_NE(std::string(e.what()).find("one scan of latency"), std::string::npos);
+    }
+}
+
 TEST(IcpSlamRunner, ModesAreNamedStageListsOfTheRegistry) {
     const auto& modes = kfd::prefilterModes();
     std::vector<std::string> names;

@@ -101,7 +101,22 @@ std::vector<StageKey> DenoiseStage::keys() {
         keys::count<P>("temporal_scans", "temporal_scans",
                        "evidence: raw scans kept before a keyframe (the dropped ones) as "
                        "temporal evidence with margins from their alignment; 0 = keyframes only",
-                       0, 16, [](P& p) -> std::size_t& { return p.evidence.temporal_scans; })};
+                       0, 16, [](P& p) -> std::size_t& { return p.evidence.temporal_scans; }),
+        keys::custom<P>(
+            "next_scan", "next_scan",
+            "evidence: also confirm a keyframe against the scan just after it (one scan of "
+            "latency: the keyframe is output when the next scan arrives)",
+            "true, false",
+            [](P& p, const std::string& text) {
+                if (text == "true" || text == "1")
+                    p.evidence.next_scan = true;
+                else if (text == "false" || text == "0")
+                    p.evidence.next_scan = false;
+                else
+                    throw ParameterError("next_scan",
+                                         "next_scan must be true or false, not '" + text + "'");
+            },
+            [](const P& p) { return std::string(p.evidence.next_scan ? "true" : "false"); })};
 }
 
 }  // namespace kfd

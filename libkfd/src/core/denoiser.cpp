@@ -40,7 +40,7 @@ void Denoiser::initialize(const Params& p) {
     params_ = p;
 }
 
-Denoiser::Result Denoiser::filter(Scan& scan) {
+Denoiser::Result Denoiser::filter(Scan& scan, const Scan* next) {
     Result res;
     res.variant = params_.variant;
     res.points_in = scan.countValid();
@@ -54,7 +54,7 @@ Denoiser::Result Denoiser::filter(Scan& scan) {
         }
     if (params_.variant == DenoiseVariant::Evidence) {
         // Marks its segments' noise flags and removes their points itself.
-        const auto r = evidence_.filter(scan, clusters_);
+        const auto r = evidence_.filter(scan, clusters_, next);
         res.points_removed = unusable + r.points_removed;
         res.temporal = r.temporal;
         res.sigma = r.sigma;
@@ -64,6 +64,7 @@ Denoiser::Result Denoiser::filter(Scan& scan) {
         res.capped = r.capped;
         res.confirmed = r.confirmed;
         res.recent = r.recent;
+        res.next = r.next;
     } else if (params_.variant == DenoiseVariant::Reference) {
         const auto r = reference_.cluster(scan, clusters_);
         res.blocks = r.blocks;

@@ -113,10 +113,13 @@ void EvidenceFilter::keepRaw(const Scan& scan) {
 
 bool EvidenceFilter::convertRaw(const Scan& scan, std::size_t age, double sigma) {
     if (age >= raw_count_) return false;
-    const RawScan& w = raw_[(raw_next_ + raw_.size() - 1 - age) % raw_.size()];
+    return convertInto(raw_[(raw_next_ + raw_.size() - 1 - age) % raw_.size()], recent_, scan,
+                       sigma);
+}
+
+bool EvidenceFilter::convertInto(const RawScan& w, Reference& r, const Scan& scan, double sigma) {
     const std::size_t n = scan.range.size();
     if (w.geometry != scan.geometry || w.range.size() != n) return false;
-    Reference& r = recent_;
     r.present = true;
     r.geometry = w.geometry;
     r.range.assign(w.range.begin(), w.range.end());
@@ -179,6 +182,35 @@ EvidenceFilter::Projection EvidenceFilter::recentProjection(const Scan& scan, st
     pr.m0 = static_cast<float>(base + params_.motion_error_fraction * std::hypot(d.x, d.y));
     pr.m1 = static_cast<float>(params_.motion_error_fraction * std::abs(d.phi));
     if (age == 0) res.recent_margin_m = base;
+    return pr;
+}
+
+EvidenceFilter::Projection EvidenceFilter::nextProjection(const Scan& scan, double sigma,
+                                                          Result& res) {
+    // Step 3c: the next scan, copied and converted like a raw scan of step 3b, aligned the
+    // same way and with the same margins.
+    Projection pr;
+    const Scan& next = *next_;
+    RawScan& w = next_raw_;
+    w.geometry = next.geometry;
+    w.range.assign(next.range.begin(), next.range.end());
+    w.valid.assign(next.valid.begin(), next.valid.end());
+    w.has_odom = next.odometry.has_value();
+    w.odom = w.has_odom ? compose(*next.odometry, next.sensor_pose) : Pose2D{};
+    if (!convertInto(w, next_ref_, scan, sigma)) return pr;
+    Pose2D d;  // this scan's sensor in the next scan's frame
+    if (scan.odometry && next_ref_.has_odom)
+        d = between(next_ref_.odom, compose(*scan.odometry, scan.sensor_pose));
+    else if (scan.odometry || next_ref_.has_odom)
+        return pr;  // no common frame
+    if (!projection(next_ref_, d, sigma).usable) return pr;
+    double spread = 0.0;
+    if (!refineStep(scan, next_ref_, d, &spread)) return pr;
+    pr = projection(next_ref_, d, sigma);
+    const double base = 3.0 * std::max(std::sqrt(2.0) * sigma, spread);
+    pr.m0 = static_cast<float>(base + params_.motion_error_fraction * std::hypot(d.x, d.y));
+    pr.m1 = static_cast<float>(params_.motion_error_fraction * std::abs(d.phi));
+    res.next = true;
     return pr;
 }
 
@@ -421,6 +453,9 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
     Projection pt;
     if (recent) pt = recentProjection(scan, 0, sigma, res);
     res.recent = pt.usable;
+    // 3c. The raw scan just after (next_scan), the same way.
+    Projection pn;
+    if (recent && next_) pn = nextProjection(scan, sigma, res);
     // This scan's sensor in the newest keyframe's frame: the odometry step (no motion without
     // odometry), refined.
     Projection p0;
@@ -439,8 +474,8 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
             have_pose_ = true;
         }
     }
-    if (!pt.usable && !p0.usable) return false;
-    recent_ev_.assign(pt.usable ? n : 0, kUnknown);
+    if (!pt.usable && !pn.usable && !p0.usable) return false;
+    recent_ev_.assign(pt.usable || pn.usable ? n : 0, kUnknown);
     // Every return off a line, every return of a short segment, and every fourth return along
     // a line (enough to tell how much of a surface lies in free space).
     free_in_.assign(out.count(), 0);
@@ -456,12 +491,13 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
         // and a return free just before is still tracked when the keyframe saw a moving object
         // here.
         std::uint8_t e = kUnknown;
-        if (pt.usable) {
-            e = classify(pt, x_[i], y_[i], true);
-            recent_ev_[i] = e;
-            if (e == kFree && p0.usable && classify(p0, x_[i], y_[i], true) == kTracked)
-                e = kTracked;
+        if (pt.usable) e = classify(pt, x_[i], y_[i], true);
+        if (pn.usable && e != kSupported) {  // 3c: either raw neighbour's support keeps it
+            const std::uint8_t en = classify(pn, x_[i], y_[i], true);
+            if (en != kUnknown) e = en;
         }
+        if (!recent_ev_.empty()) recent_ev_[i] = e;  // the raw neighbours' verdict (step 5)
+        if (e == kFree && p0.usable && classify(p0, x_[i], y_[i], true) == kTracked) e = kTracked;
         if (e == kUnknown && p0.usable) e = classify(p0, x_[i], y_[i], true);
         evidence_[i] = e;
         ++classified_in_[c];
@@ -521,6 +557,19 @@ void EvidenceFilter::keepAsReference(const Scan& scan) {
     // a new chain, and the older keyframe is no longer in it.
     r.pose = have_pose_ ? pose_ : r.odom;
     if (!have_pose_) refs_[1].present = false;
+}
+
+EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out, const Scan* next) {
+    next_ = params_.next_scan ? next : nullptr;
+    Result res;
+    try {
+        res = filter(scan, out);
+    } catch (...) {
+        next_ = nullptr;
+        throw;
+    }
+    next_ = nullptr;
+    return res;
 }
 
 EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {

@@ -64,6 +64,8 @@ void Pipeline::initialize(const Params& p, const StageRegistry& registry) {
         const StageParams* set = p.find(info->name);
         stages.push_back(set ? info->create(*set) : info->create(*info->defaults()));
     }
+    finished_ = false;
+    if (held_) finishHeld(nullptr);  // by the stages that held it; finished() returns it
     stages_ = std::move(stages);
     params_ = p;
     registry_ = &registry;
@@ -89,16 +91,31 @@ ScanReport Pipeline::process(Scan& scan) {
         if (why != ScanSkipReason::None)
             throw ScanError(std::string("scan: unusable geometry (") + toString(why) + ")");
     }
+    finished_ = false;
     report.points_in = scan.countValid();
     // One clock read per stage: each stage's end is the next one's start.
     auto t = t0;
     for (std::size_t i = 0; i < stages_.size(); ++i) {
         Stage& stage = *stages_[i];
+        // This scan reached the stage holding the one before: that one is finished first,
+        // with this scan as its next.
+        if (held_ && i == held_stage_) t += finishHeld(&scan);  // not this scan's time
         StageReport& sr = report.stage_reports[report.stage_count++];
         sr.name = stage.name();
+        if (stage.defers()) {  // held: finished by the next scan (or finish(), reset())
+            held_scan_ = scan;
+            held_stage_ = i;
+            held_ = true;
+            --report.stage_count;
+            report.pending = true;
+            break;
+        }
         const bool keep = stage.process(scan, sr, report);
         if (!keep) {  // the later stages see the dropped scan (Stage::observeDropped)
-            for (std::size_t j = i + 1; j < stages_.size(); ++j) stages_[j]->observeDropped(scan);
+            for (std::size_t j = i + 1; j < stages_.size(); ++j) {
+                if (held_ && j == held_stage_) t += finishHeld(&scan);
+                stages_[j]->observeDropped(scan);
+            }
         }
         const auto now = Clock::now();
         sr.microseconds = std::chrono::duration<double, std::micro>(now - t).count();
@@ -117,10 +134,64 @@ ScanReport Pipeline::process(Scan& scan) {
             report.microseconds += report.stage_reports[i].microseconds;
     }
     report.points_out = scan.countValid();
+    if (report.pending) held_report_ = report;
     return report;
 }
 
+// Runs the held scan through the holding stage (with `next` as its next scan) and the later
+// ones; its report becomes finished().
+std::chrono::steady_clock::duration Pipeline::finishHeld(const Scan* next) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    held_ = false;
+    ScanReport& report = held_report_;
+    report.pending = false;
+    auto t = Clock::now();
+    for (std::size_t i = held_stage_; i < stages_.size(); ++i) {
+        Stage& stage = *stages_[i];
+        StageReport& sr = report.stage_reports[report.stage_count++];
+        sr.name = stage.name();
+        const bool keep = i == held_stage_ ? stage.finish(held_scan_, sr, report, next)
+                                           : stage.process(held_scan_, sr, report);
+        if (!keep) {
+            for (std::size_t j = i + 1; j < stages_.size(); ++j)
+                stages_[j]->observeDropped(held_scan_);
+        }
+        const auto now = Clock::now();
+        sr.microseconds = std::chrono::duration<double, std::micro>(now - t).count();
+        report.microseconds += sr.microseconds;
+        t = now;
+        if (!keep) {
+            sr.dropped = true;
+            report.keep = false;
+            report.dropped_by = stage.name();
+            break;
+        }
+    }
+    report.points_out = held_scan_.countValid();
+    // Handed out by finished(); held_scan_ takes the old buffers (no allocation once grown).
+    std::swap(held_scan_, finished_scan_);
+    finished_report_ = report;
+    finished_ = true;
+    return Clock::now() - t0;
+}
+
+const Scan* Pipeline::finished(ScanReport& report) const {
+    if (!finished_) return nullptr;
+    report = finished_report_;
+    return &finished_scan_;
+}
+
+bool Pipeline::finish() {
+    finished_ = false;
+    if (!held_) return false;
+    finishHeld(nullptr);
+    return true;
+}
+
 void Pipeline::reset() {
+    finished_ = false;
+    if (held_) finishHeld(nullptr);
     for (auto& s : stages_) s->reset();
 }
 

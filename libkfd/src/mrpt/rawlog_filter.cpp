@@ -12,6 +12,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -73,7 +76,7 @@ LogFormat outputFormat(const std::string& output) {
 class Run {
   public:
     Run(const RawlogFilterOptions& o, RawlogFilterSummary& s)
-        : opts_(o), sum_(s), filter_(o.pipeline) {
+        : opts_(o), sum_(s), filter_(o.pipeline, {}, true) {
         filter_.setLaserOnly(o.laser_only);
     }
 
@@ -99,12 +102,29 @@ class Run {
     void handleFrame(const std::shared_ptr<CSensoryFrame>& sf);
     // A CARMEN output: kept scans as FLASER/RLASER lines, odometry as ODOM lines.
     void handleCarmenEntry(const SourceEntry& e);
-    void writeCarmenScan(const CObservation2DRangeScan& scan, const Pose2D& odo);
+    void writeCarmenScan(const CObservation2DRangeScan::Ptr& scan, const Pose2D& odo);
     void writeCarmenOdometry(const Pose2D& odo, double stamp, bool always);
     // Processes one scan through the door; returns true when kept.
-    bool handleScan(CObservation2DRangeScan& scan);
+    bool handleScan(const CObservation2DRangeScan::Ptr& scan);
     void noteSensor(const CObservation2DRangeScan& scan, const StreamResult& r);
+    void noteNoise(const StreamResult& r);
     void write(const mrpt::serialization::CSerializable& obj);
+    // One scan of latency (next_scan): output waits while the door holds a kept scan.
+    // Runs fn now, or queues it behind the held scan(s) (fn then owns what it writes).
+    template <class Fn>
+    void emit(Fn&& fn) {
+        if (held_scans_ == 0)
+            fn();
+        else
+            deferred_.emplace_back(std::forward<Fn>(fn));
+    }
+    template <class Ptr>
+    void writeShared(const Ptr& obj) {
+        emit([this, obj] { write(*obj); });
+    }
+    // The door's finished scans: their stats rows filled in; the queue runs once none is held.
+    void collectFinished();
+    void runDeferred();
     void flushPendingAction(bool frame_kept);
     void reportProgress(std::uint64_t bytes_read);
 
@@ -125,7 +145,14 @@ class Run {
     bool have_carry_ = false;
     std::optional<Pose2D> odometry_;  // absolute odometry, for the motion guards
     bool saw_frames_ = false, saw_observations_ = false;
-    ScanRateMeter rate_;  // the first sensor's stamps (SensorSummary::rate_hz)
+    ScanRateMeter rate_;          // the first sensor's stamps (SensorSummary::rate_hz)
+    std::size_t held_scans_ = 0;  // kept scans the door holds (pending)
+    std::vector<std::function<void()>> deferred_;  // output waiting for them, in order
+    struct HeldRow {
+        CObservation2DRangeScan::Ptr scan;  // kept alive while the door holds it
+        std::shared_ptr<ScanRecord> row;    // its stats row, filled in once finished
+    };
+    std::map<const CObservation2DRangeScan*, HeldRow> held_rows_;
 };
 
 void Run::write(const mrpt::serialization::CSerializable& obj) {
@@ -151,7 +178,12 @@ void Run::noteSensor(const CObservation2DRangeScan& scan, const StreamResult& r)
     if (scan.sensorLabel != s.label) return;
     s.odometry = s.odometry || r.record.odometry.has_value();
     rate_.add(r.record.stamp);
-    if (r.keep)
+    noteNoise(r);
+}
+
+void Run::noteNoise(const StreamResult& r) {
+    SensorSummary& s = sum_.sensor;
+    if (r.keep && r.scan && r.scan->sensorLabel == s.label)
         if (const auto* d = r.report.find<Denoiser::Result>())
             if (d->variant == DenoiseVariant::Evidence) {
                 const auto& ev = opts_.pipeline.get<DenoiseStage>().evidence;
@@ -162,11 +194,45 @@ void Run::noteSensor(const CObservation2DRangeScan& scan, const StreamResult& r)
             }
 }
 
-bool Run::handleScan(CObservation2DRangeScan& scan) {
+bool Run::handleScan(const CObservation2DRangeScan::Ptr& ptr) {
+    CObservation2DRangeScan& scan = *ptr;
     const StreamResult r = filter_.process(scan, odometry_);
+    collectFinished();  // the scans this one finished come first
     if (r.skipped == ScanSkipReason::None) noteSensor(scan, r);
-    if (csv_.isOpen()) asRawlogError([&] { csv_.write(r.record); });
+    if (r.pending) {  // its row (and everything after it) once the door finishes it
+        ++held_scans_;
+        auto row = std::make_shared<ScanRecord>(r.record);
+        held_rows_[&scan] = HeldRow{ptr, row};
+        if (csv_.isOpen()) emit([this, row] { asRawlogError([&] { csv_.write(*row); }); });
+        return true;
+    }
+    if (csv_.isOpen()) {
+        if (held_scans_ == 0)
+            asRawlogError([&] { csv_.write(r.record); });
+        else
+            emit([this, row = r.record] { asRawlogError([&] { csv_.write(row); }); });
+    }
     return r.keep;
+}
+
+void Run::collectFinished() {
+    StreamResult f;
+    while (filter_.takeFinished(f)) {
+        noteNoise(f);
+        const auto it = held_rows_.find(f.scan);
+        if (it == held_rows_.end()) continue;
+        *it->second.row = f.record;
+        held_rows_.erase(it);
+        --held_scans_;
+    }
+    if (held_scans_ > 0 || deferred_.empty()) return;
+    runDeferred();
+}
+
+void Run::runDeferred() {
+    auto queue = std::move(deferred_);
+    deferred_.clear();
+    for (auto& fn : queue) fn();
 }
 
 void Run::handleActions(const std::shared_ptr<CActionCollection>& acts) {
@@ -216,7 +282,7 @@ void Run::flushPendingAction(bool frame_kept) {
         have_carry_ = false;
         carry_ = CPose2D();
     }
-    write(*acts);
+    writeShared(acts);
 }
 
 void Run::handleFrame(const std::shared_ptr<CSensoryFrame>& sf) {
@@ -228,7 +294,7 @@ void Run::handleFrame(const std::shared_ptr<CSensoryFrame>& sf) {
             continue;
         }
         ++scans;
-        if (handleScan(*scan)) {
+        if (handleScan(scan)) {
             ++it;
         } else {
             it = sf->erase(it);
@@ -237,7 +303,7 @@ void Run::handleFrame(const std::shared_ptr<CSensoryFrame>& sf) {
     const bool frame_kept = !(scans > 0 && sf->size() == 0);
     flushPendingAction(frame_kept);
     if (frame_kept)
-        write(*sf);
+        writeShared(sf);
     else
         ++sum_.objects_dropped;
 }
@@ -340,13 +406,14 @@ void Run::handleEntry(const SourceEntry& e) {
             break;
         case SourceEntry::Kind::Other:
             flushPendingAction(true);
-            write(*e.other);
+            writeShared(e.other);
             break;
         case SourceEntry::Kind::Native:  // another topic of a bag
-            if (bag_) {
-                asRawlogError([&] { bag_->copy(*e.native); }, opts_.output);
-                ++sum_.objects_out;
-            }
+            if (bag_)
+                emit([this, native = e.native] {
+                    asRawlogError([&] { bag_->copy(*native); }, opts_.output);
+                    ++sum_.objects_out;
+                });
             break;
     }
 }
@@ -357,15 +424,17 @@ void Run::handleEntry(const SourceEntry& e) {
 void Run::handleObservation(const SourceEntry& e) {
     auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(e.observation);
     if (!scan) {
-        if (!bag_) write(*e.observation);
-    } else if (!handleScan(*scan)) {
+        if (!bag_) writeShared(e.observation);
+    } else if (!handleScan(scan)) {
         ++sum_.objects_dropped;
     } else if (!bag_) {
-        write(*scan);
+        writeShared(scan);
     } else if (e.native) {
-        sum_.points_marked +=
-            asRawlogError([&] { return bag_->writeScan(*e.native, *scan); }, opts_.output);
-        ++sum_.objects_out;
+        emit([this, native = e.native, scan] {
+            sum_.points_marked +=
+                asRawlogError([&] { return bag_->writeScan(*native, *scan); }, opts_.output);
+            ++sum_.objects_out;
+        });
     }
 }
 
@@ -377,17 +446,17 @@ void Run::handleCarmenEntry(const SourceEntry& e) {
     std::optional<Pose2D> odo = e.odometry;
     if (odo && !finitePose(odo->x, odo->y, odo->phi)) odo.reset();
     if (odo && !carmen_pending_.empty()) {
-        for (const auto& scan : carmen_pending_) writeCarmenScan(*scan, *odo);
+        for (const auto& scan : carmen_pending_) writeCarmenScan(scan, *odo);
         carmen_pending_.clear();
     }
     auto scanOrOdometry = [&](const mrpt::obs::CObservation::Ptr& obs) {
         if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(obs)) {
-            if (!handleScan(*scan)) {
+            if (!handleScan(scan)) {
                 ++sum_.objects_dropped;
                 return false;
             }
             if (odo || carmen_odometry_) {
-                writeCarmenScan(*scan, odo ? *odo : *carmen_odometry_);
+                writeCarmenScan(scan, odo ? *odo : *carmen_odometry_);
             } else {
                 if (carmen_pending_.size() == kCarmenMaxPending)
                     throw RawlogError(
@@ -421,8 +490,10 @@ void Run::handleCarmenEntry(const SourceEntry& e) {
     if (!wrote && odo && first) writeCarmenOdometry(*odo, stampOf(*first), false);
 }
 
-void Run::writeCarmenScan(const CObservation2DRangeScan& scan, const Pose2D& odo) {
-    asRawlogError([&] { carmen_->writeScan(scan, odo); }, opts_.output);
+void Run::writeCarmenScan(const CObservation2DRangeScan::Ptr& scan, const Pose2D& odo) {
+    emit([this, scan, odo] {
+        asRawlogError([&] { carmen_->writeScan(*scan, odo); }, opts_.output);
+    });
     carmen_odometry_ = odo;
 }
 
@@ -430,11 +501,18 @@ void Run::writeCarmenOdometry(const Pose2D& odo, double stamp, bool always) {
     if (!always && carmen_odometry_ && carmen_odometry_->x == odo.x &&
         carmen_odometry_->y == odo.y && carmen_odometry_->phi == odo.phi)
         return;
-    asRawlogError([&] { carmen_->writeOdometry(odo, stamp); }, opts_.output);
+    emit([this, odo, stamp] {
+        asRawlogError([&] { carmen_->writeOdometry(odo, stamp); }, opts_.output);
+    });
     carmen_odometry_ = odo;
 }
 
 void Run::finish() {
+    filter_.finish();  // the last kept scan, when held for its next: finished without it
+    collectFinished();
+    held_scans_ = 0;  // nothing is held any more: whatever waits goes out
+    held_rows_.clear();
+    runDeferred();
     if (!carmen_pending_.empty())
         throw RawlogError("a CARMEN output needs the robot's odometry (a FLASER line holds it): " +
                               opts_.input + " has none (a laser-only log): write a .rawlog" +

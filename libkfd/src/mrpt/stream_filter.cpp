@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <utility>
 
 #include "kfd/core/denoiser.h"
@@ -31,12 +32,35 @@ const char* skippedReason(ScanSkipReason r) {
     return "ok";
 }
 
+// Marks invalid in `obs` the first n beams whose flag in `valid` is 0 (the stages' removals;
+// no beam made valid again). memchr skips the runs of valid beams: most beams of most scans.
+void writeBack(const std::uint8_t* valid, std::size_t n, mrpt::obs::CObservation2DRangeScan& obs) {
+    const std::uint8_t* end = valid + n;
+    for (const void* hit = std::memchr(valid, 0, n); hit;) {
+        const auto* p = static_cast<const std::uint8_t*>(hit);
+        const auto i = static_cast<std::size_t>(p - valid);
+        if (obs.getScanRangeValidity(i)) obs.setScanRangeValidity(i, false);
+        ++p;
+        hit = p < end ? std::memchr(p, 0, static_cast<std::size_t>(end - p)) : nullptr;
+    }
+}
+
 }  // namespace
 
-StreamFilter::StreamFilter(const Pipeline::Params& params, StageFactory extra)
+StreamFilter::StreamFilter(const Pipeline::Params& params, StageFactory extra,
+                           bool one_scan_latency)
     : params_(params), extra_(std::move(extra)) {
     // Validated now, not at the first scan; the first sensor takes this pipeline.
     spare_ = std::make_unique<Pipeline>(params_, defaultStageRegistry());
+    if (!one_scan_latency)
+        for (const auto& stage : spare_->stages())
+            if (stage->defers())
+                throw ParameterError(
+                    "next_scan",
+                    std::string("next_scan = true: the ") + stage->name() +
+                        " stage holds each keyframe until the next scan (one scan of latency), "
+                        "which this tool does not support (kfd-filter and kfd-denoise-eval do); "
+                        "set next_scan = false");
 }
 
 StreamFilter::Sensor& StreamFilter::sensorFor(const std::string& label) {
@@ -52,6 +76,7 @@ StreamFilter::Sensor& StreamFilter::sensorFor(const std::string& label) {
 StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
                                    const std::optional<Pose2D>& odometry) {
     StreamResult res;
+    res.scan = &obs;
     ScanRecord& rec = res.record;
     rec.index = counters_.scans_in++;
     rec.sensor = obs.sensorLabel;
@@ -77,7 +102,8 @@ StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
     std::swap(s.scan, spare_scan_);
     const ScanGeometry g = s.scan.geometry;
     if (s.geometry.beams != 0 && g != s.geometry) {
-        s.pipeline->reset();
+        s.pipeline->reset();  // finishes a pending scan without its next
+        collectFinished(s);
         res.geometry_reset = true;
     }
     s.geometry = g;
@@ -88,14 +114,58 @@ StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
         s.last_stamp = s.scan.timestamp;
     }
     res.report = s.pipeline->process(s.scan);
+    collectFinished(s);  // the sensor's scan before, when this one finished it
     res.keep = rec.kept = res.report.keep;
     // Written back: the beams the stages removed become invalid in the MRPT scan (ranges, beam
     // count and angles kept; no beam made valid again). Only those beams are touched.
-    const std::uint8_t* valid = s.scan.valid.data();
-    for (std::size_t i = 0, n = s.scan.size(); i < n; ++i)
-        if (!valid[i] && obs.getScanRangeValidity(i)) obs.setScanRangeValidity(i, false);
+    writeBack(s.scan.valid.data(), s.scan.size(), obs);
+    if (res.report.pending) {  // recorded once finished
+        res.pending = true;
+        s.held = res;
+        return res;
+    }
     record(res);
     return res;
+}
+
+void StreamFilter::collectFinished(Sensor& s) {
+    if (!s.held.scan) return;  // nothing pending (always so without next_scan)
+    ScanReport report;
+    const Scan* done = s.pipeline->finished(report);
+    if (!done) return;
+    StreamResult res = std::move(s.held);
+    s.held = StreamResult{};
+    res.pending = false;
+    res.report = report;
+    res.keep = res.record.kept = report.keep;
+    mrpt::obs::CObservation2DRangeScan& obs = *res.scan;
+    writeBack(done->valid.data(), std::min(done->size(), obs.getScanSize()), obs);
+    record(res);
+    finished_.push_back(std::move(res));
+}
+
+bool StreamFilter::takeFinished(StreamResult& out) {
+    if (finished_.empty()) return false;
+    out = std::move(finished_.front());
+    finished_.pop_front();
+    return true;
+}
+
+void StreamFilter::finish() {
+    const std::size_t before = finished_.size();
+    for (auto& [label, s] : sensors_)
+        if (s.pipeline->finish()) collectFinished(s);
+    // In input order (several sensors): by the scans' indices.
+    std::sort(finished_.begin() + static_cast<std::ptrdiff_t>(before), finished_.end(),
+              [](const StreamResult& a, const StreamResult& b) {
+                  return a.record.index < b.record.index;
+              });
+}
+
+std::size_t StreamFilter::pendingCount() const {
+    std::size_t n = 0;
+    for (const auto& [label, s] : sensors_) n += s.pipeline->holding() ? 1 : 0;
+    return n;
 }
 
 // The record and the counters of a scan that ran through the pipeline.

@@ -72,36 +72,28 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
                                  const Pipeline::Params& pipeline, bool laser_only) {
     const auto labels = readLabels(labels_csv);
     const auto source = openSource(rawlog);
-    StreamFilter filter(pipeline);
+    StreamFilter filter(pipeline, {}, true);  // handles held scans (next_scan)
     filter.setLaserOnly(laser_only);
     DenoiseQuality q;
-    std::vector<std::uint8_t> before;
-    std::vector<NoiseKind> kind;
-    std::vector<NoiseModel> model;
-    SourceEntry e;
-    auto score = [&](const mrpt::obs::CObservation2DRangeScan::Ptr& scan) {
-        const std::size_t n = scan->getScanSize();
-        before.resize(n);
-        kind.assign(n, NoiseKind::Clean);
-        model.assign(n, NoiseModel::None);
-        for (std::size_t i = 0; i < n; ++i) before[i] = scan->getScanRangeValidity(i);
-        if (const auto it = labels.find(q.scans); it != labels.end())
-            for (const auto& l : it->second) {
-                if (l.beam >= n) throw SimulationError("labels do not fit the rawlog");
-                kind[l.beam] = l.kind;
-                model[l.beam] = l.model;
-            }
-        const auto r = filter.process(*scan, e.odometry);
-        q.microseconds += r.report.microseconds;
-        ++q.scans;
-        if (!r.keep) return;  // dropped: the SLAM never sees it, nothing to score
+    // A scan's flags before the door and its labels, until it is scored (after the door, or
+    // once the door finishes a scan it held for its next: the denoise key next_scan).
+    struct Scored {
+        mrpt::obs::CObservation2DRangeScan::Ptr scan;
+        std::vector<std::uint8_t> before;
+        std::vector<NoiseKind> kind;
+        std::vector<NoiseModel> model;
+    };
+    Scored now;
+    std::map<const mrpt::obs::CObservation2DRangeScan*, Scored> held;
+    auto tally = [&](const Scored& s) {
+        const auto& scan = s.scan;
         ++q.scored;
-        for (std::size_t i = 0; i < n; ++i) {
-            if (!before[i]) continue;
+        for (std::size_t i = 0, n = s.before.size(); i < n; ++i) {
+            if (!s.before[i]) continue;
             ++q.points;
             const bool removed = !scan->getScanRangeValidity(i);
-            const auto ki = static_cast<std::size_t>(kind[i]);
-            if (kind[i] == NoiseKind::Clean) {
+            const auto ki = static_cast<std::size_t>(s.kind[i]);
+            if (s.kind[i] == NoiseKind::Clean) {
                 ++q.clean;
                 q.removed_clean += removed;
                 const double range = scan->getScanRange(i);
@@ -114,13 +106,51 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
                 ++q.noise_by_kind[ki];
                 q.removed_noise += removed;
                 q.removed_by_kind[ki] += removed;
-                const auto mi = static_cast<std::size_t>(model[i]);
+                const auto mi = static_cast<std::size_t>(s.model[i]);
                 ++q.noise_by_model[mi];
                 q.removed_by_model[mi] += removed;
             }
         }
     };
+    auto collect = [&] {
+        StreamResult f;
+        while (filter.takeFinished(f)) {
+            q.microseconds += f.report.microseconds;  // its whole time, held part included
+            const auto it = held.find(f.scan);
+            if (it == held.end()) continue;
+            if (f.keep) tally(it->second);
+            held.erase(it);
+        }
+    };
+    SourceEntry e;
+    auto score = [&](const mrpt::obs::CObservation2DRangeScan::Ptr& scan) {
+        const std::size_t n = scan->getScanSize();
+        now.scan = scan;
+        now.before.resize(n);
+        now.kind.assign(n, NoiseKind::Clean);
+        now.model.assign(n, NoiseModel::None);
+        for (std::size_t i = 0; i < n; ++i) now.before[i] = scan->getScanRangeValidity(i);
+        if (const auto it = labels.find(q.scans); it != labels.end())
+            for (const auto& l : it->second) {
+                if (l.beam >= n) throw SimulationError("labels do not fit the rawlog");
+                now.kind[l.beam] = l.kind;
+                now.model[l.beam] = l.model;
+            }
+        const auto r = filter.process(*scan, e.odometry);
+        ++q.scans;
+        collect();
+        if (r.pending) {  // scored once finished
+            held[scan.get()] = std::move(now);
+            now = Scored{};
+            return;
+        }
+        q.microseconds += r.report.microseconds;
+        if (!r.keep) return;  // dropped: the SLAM never sees it, nothing to score
+        tally(now);
+    };
     while (source->next(e)) e.forEachScan(score);
+    filter.finish();  // the last keyframe, when held for its next scan
+    collect();
     if (q.scans == 0) throw SimulationError("no scans in " + rawlog);
     if (!labels.empty() && labels.rbegin()->first >= q.scans)
         throw SimulationError("labels refer to more scans than the rawlog holds");

@@ -61,6 +61,7 @@ class Denoiser {
         bool capped = false;             // evidence: removal cut to the bound
         bool confirmed = false;  // evidence: above the bound, confirmed by the scan just before
         bool recent = false;     // evidence: the raw scan just before was used
+        bool next = false;       // evidence: the raw scan just after was used
     };
 
     Denoiser() { initialize(Params{}); }
@@ -74,7 +75,16 @@ class Denoiser {
     /// Bounds per scan of n <= kMaxScanBeams beams: O(n) memory (buffers reused); time a few
     /// passes over the beams plus union-find, each beam compared only with the clusters still
     /// open within the angle gap.
-    Result filter(Scan& scan);
+    Result filter(Scan& scan) { return filter(scan, nullptr); }
+    /// The same with the sensor's next scan as evidence (the evidence variant's next_scan,
+    /// EvidenceFilter step 3c); `next` = nullptr: without it. The other variants ignore it.
+    Result filter(Scan& scan, const Scan* next);
+    /// The evidence variant with next_scan and temporal on: a keyframe's filter() wants the
+    /// next scan (kfd::Pipeline holds the keyframe until it comes: one scan of latency).
+    bool wantsNextScan() const {
+        return params_.variant == DenoiseVariant::Evidence && params_.evidence.next_scan &&
+               params_.evidence.temporal;
+    }
     /// A scan not filtered (dropped by the keyframe stage): the evidence variant keeps a copy
     /// as temporal evidence for the next keyframe (EvidenceFilter::observe); the others
     /// ignore it.

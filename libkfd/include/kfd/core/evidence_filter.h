@@ -59,6 +59,19 @@ namespace kfd {
 ///     Its verdict (free or supported) comes first; the keyframes decide what it left unknown
 ///     (and may still call a free return tracked); older raw scans only add support. Without
 ///     a usable alignment (too few pairs, no common odometry frame) it is not used.
+///  3c. The raw scan just after (issue 25, next_scan = true, one scan of latency): the caller
+///     holds the keyframe until the sensor's next scan (dropped or kept) and calls
+///     filter(scan, out, &next) (kfd::Pipeline does this: Stage::defers). The next scan is
+///     converted and aligned like step 3b's newest raw scan (same margins). The exact rule,
+///     per classified return, from the raw scan before (B) and the one after (A):
+///     - supported when B or A supports it;
+///     - else free when B or A saw through it (then tracked when the newest keyframe says so);
+///     - else unknown: the keyframes (and older raw scans) decide, as in step 3.
+///     So a return seen by neither neighbour in space one of them saw through goes (a burst
+///     that came and went); a surface newly revealed in the keyframe and still there in the
+///     next scan stays. Without a next scan (the end of a log, a reset, a geometry change:
+///     filter(scan, out) or next = nullptr) step 3b alone runs. The raw scans' verdict is
+///     dropped together in step 5's first re-run (the keyframes alone).
 ///  4. Removal: every free return not on a line with its neighbours; every segment whose
 ///     classified returns are at least half free; every small segment without a supported
 ///     return. A segment is small when it has fewer points than an object of
@@ -114,6 +127,10 @@ class EvidenceFilter {
         /// +1 to +8 points) at -0.04 to +0.16 points of real returns kept on the clean logs;
         /// 2 gave the same within 0.5 points (docs/RESULTS.md, issue 25).
         std::size_t temporal_scans = 1;
+        /// Step 3c: also confirm a keyframe against the raw scan just after it. Costs one scan
+        /// of latency (kfd::Pipeline holds the keyframe until the next scan; a node publishes
+        /// it one scan later): for offline use and nodes that can afford it. Needs temporal.
+        bool next_scan = false;
     };
 
     struct Result {
@@ -137,6 +154,7 @@ class EvidenceFilter {
         double recent_margin_m = 0.0;    // m: its margin's constant part (3 max(sqrt 2 sigma, s))
         bool recent_overruled = false;   // step 5: it wanted too much; the keyframes alone used
         bool confirmed = false;  // step 5: beyond the bound, confirmed by the raw scan just before
+        bool next = false;       // step 3c: the raw scan just after was used
     };
 
     EvidenceFilter() { initialize(Params{}); }
@@ -147,6 +165,10 @@ class EvidenceFilter {
     /// Filters the scan (clears the valid flag of removed returns); `out` receives the
     /// segments as clusters (label per beam, noise flag per segment).
     Result filter(Scan& scan, Clusters& out);
+    /// The same with the sensor's next scan as a second raw reference (step 3c; `next` as the
+    /// keyframe stage passed it on: dropped or kept, before its own denoising). nullptr or
+    /// next_scan off: filter(scan, out). `next` is only read, during the call.
+    Result filter(Scan& scan, Clusters& out, const Scan* next);
     /// Keeps a copy of a scan not filtered (one the keyframe stage dropped) as a temporal
     /// reference for the next keyframe (step 3b). Copies ranges, flags and odometry into a
     /// ring of temporal_scans preallocated slots: no allocation once they have grown, O(n).
@@ -203,6 +225,10 @@ class EvidenceFilter {
     Projection recentProjection(const Scan& scan, std::size_t age, double sigma, Result& res);
     // Converts raw scan `age` (0 = newest) into recent_ (points, breakpoint links).
     bool convertRaw(const Scan& scan, std::size_t age, double sigma);
+    // Converts raw scan `w` into `r` (convertRaw's work, for any slot).
+    bool convertInto(const RawScan& w, Reference& r, const Scan& scan, double sigma);
+    // Step 3c: the next scan (next_) as a projection, converted into next_ref_.
+    Projection nextProjection(const Scan& scan, double sigma, Result& res);
     void keepRaw(const Scan& scan);
     bool trackedMotion(const Reference& ref, float qx, float qy, float rho, std::size_t k0) const;
     void keepAsReference(const Scan& scan);
@@ -236,6 +262,9 @@ class EvidenceFilter {
     std::size_t raw_count_ = 0;             // raw scans held
     Reference recent_;                      // a raw scan converted for this keyframe
     std::vector<std::uint8_t> recent_ev_;   // per beam: the raw scan just before's verdict
+    const Scan* next_ = nullptr;            // step 3c: the next scan, during filter() only
+    RawScan next_raw_;                      // its copy (reused buffers)
+    Reference next_ref_;                    // converted
     mutable std::vector<float> residuals_;  // refineStep's last iteration |e|
     Pose2D pose_;                           // this scan's refined pose (when have_pose_)
     bool have_pose_ = false;

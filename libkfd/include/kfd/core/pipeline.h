@@ -2,6 +2,7 @@
 // list of stages found by name in a StageRegistry (std only).
 #pragma once
 
+#include <chrono>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -89,7 +90,8 @@ class Pipeline {
     /// Builds the stages. Throws kfd::ParameterError (field "stages") on an unknown or repeated
     /// stage name, and the stage's kfd::ParameterError on invalid stage parameters. Parameters
     /// of registered stages that are set but not listed are validated too, so that a bad value
-    /// is reported even while its stage is switched off.
+    /// is reported even while its stage is switched off. A held scan (see process()) is
+    /// finished by the old stages first, without a next scan (finished() returns it).
     void initialize(const Params& p, const StageRegistry& registry);
     /// Rebuilds from the registry given at construction.
     void initialize(const Params& p) { initialize(p, *registry_); }
@@ -105,7 +107,23 @@ class Pipeline {
     /// <= 2*pi); nothing is changed then. Any range is safe: every stage treats a beam flagged
     /// valid whose range is NaN, infinite or negative as unusable (the distance stage removes
     /// and counts it; the others skip it or mark it invalid), so no scan content is UB.
+    ///
+    /// One scan of latency (a stage that defers, e.g. the denoise stage with next_scan): a scan
+    /// reaching that stage comes back with report.pending (kept; that stage and the later ones
+    /// have not run, `scan` is as the earlier ones left it). The pipeline holds a copy; the next
+    /// process() call finishes it with the new scan as evidence (before the new scan reaches
+    /// that stage) and finished() then returns it. finish() ends a stream: the held scan is
+    /// finished without a next scan. At most one scan is held.
     ScanReport process(Scan& scan);
+    /// The scan held before and finished by the last process(), finish() or reset() call (the
+    /// pipeline's copy, its valid flags final), its report in `report` (pending = false); else
+    /// nullptr. Valid until the next call of one of them.
+    const Scan* finished(ScanReport& report) const;
+    /// Finishes the held scan without a next scan (the end of a log); false when none was held.
+    bool finish();
+    /// A scan is held (the last process() returned pending and nothing finished it yet).
+    bool holding() const { return held_; }
+    /// Forgets all stream state; a held scan is finished first (finished() returns it).
     void reset();
 
     const std::vector<std::unique_ptr<Stage>>& stages() const { return stages_; }
@@ -123,6 +141,13 @@ class Pipeline {
     Params params_;
     const StageRegistry* registry_ = &coreStageRegistry();
     std::vector<std::unique_ptr<Stage>> stages_;
+    // One scan of latency (Stage::defers): the held copy, the stage holding it and its report.
+    // Returns the time it took (not the new scan's).
+    std::chrono::steady_clock::duration finishHeld(const Scan* next);
+    bool held_ = false, finished_ = false;
+    std::size_t held_stage_ = 0;
+    Scan held_scan_, finished_scan_;
+    ScanReport held_report_, finished_report_;
 };
 
 }  // namespace kfd

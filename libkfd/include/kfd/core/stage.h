@@ -57,7 +57,10 @@ class StageReport {
 struct ScanReport {
     static constexpr std::size_t kMaxStages = 12;
 
-    bool keep = true;            // false: a stage dropped the scan
+    bool keep = true;  // false: a stage dropped the scan
+    /// Kept, but held by a stage that needs the sensor's next scan (Stage::defers): that stage
+    /// and the later ones have not run yet; Pipeline::finished() hands the scan back finished.
+    bool pending = false;
     std::string dropped_by;      // name of the stage that dropped it (empty when kept)
     std::size_t points_in = 0;   // valid beams on input
     std::size_t points_out = 0;  // valid beams on output
@@ -114,6 +117,19 @@ class Stage {
     virtual void observeDropped(const Scan& /*scan*/) {}
     /// Forget all stream state (called when the sensor's geometry changes).
     virtual void reset() {}
+    /// True: a scan reaching this stage is finished only once the sensor's next scan reached it
+    /// too (one scan of latency; the evidence denoiser's next_scan, issue 25). The pipeline
+    /// then holds a copy of the scan instead of calling process(), and calls finish() with the
+    /// next scan when that reaches this stage (processed, or observed when an earlier stage
+    /// dropped it), or with nullptr at the end of the stream (Pipeline::finish, reset). Must
+    /// not change after construction.
+    virtual bool defers() const { return false; }
+    /// process() for a held scan; `next`: the sensor's next scan as this stage sees it (only
+    /// read, during the call), or nullptr when there is none.
+    virtual bool finish(Scan& scan, StageReport& report, const ScanReport& chain,
+                        const Scan* /*next*/) {
+        return process(scan, report, chain);
+    }
 };
 
 /// A stage around a denoising algorithm `Algo` (Params, and Result filter(Scan&) with a

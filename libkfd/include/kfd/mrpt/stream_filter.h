@@ -3,6 +3,7 @@
 // scan, state kept per sensor.
 #pragma once
 
+#include <deque>
 #include <functional>
 #include <limits>
 #include <map>
@@ -21,6 +22,12 @@ namespace kfd {
 /// What StreamFilter::process() decided for one scan.
 struct StreamResult {
     bool keep = false;  // a keyframe: the scan goes on; false: dropped or skipped
+    /// Kept, but not finished: a stage waits for the sensor's next scan (the denoise stage's
+    /// next_scan). Its report and record are incomplete and its removals not yet applied; the
+    /// door hands it back finished from takeFinished() (see StreamFilter).
+    bool pending = false;
+    /// The observation this result is about (as given to process()).
+    mrpt::obs::CObservation2DRangeScan* scan = nullptr;
     /// Not None: the scan's geometry is unusable (kfd/mrpt/scan_check.h); no stage ran and the
     /// scan is unchanged but for its bad ranges. Callers leave it out like a dropped scan.
     ScanSkipReason skipped = ScanSkipReason::None;
@@ -42,12 +49,33 @@ struct StreamResult {
 ///
 /// When a sensor's geometry (beam count, aperture or direction) changes, its state is reset
 /// and the scan is treated as the first of a new stream (StreamResult::geometry_reset).
+///
+/// One scan of latency (the denoise key next_scan = true): a kept scan may come back pending
+/// (StreamResult::pending): the caller keeps that observation alive and unchanged, and holds
+/// what it would output after it (to keep its output in order), until the door finishes it:
+/// during the sensor's next process() call, or finish() at the end of a log, reset(), or a
+/// geometry change. Finished scans (their removals now marked in the observation, their final
+/// report and record) are taken in order with takeFinished() after each of those calls:
+///
+///     auto r = kfd.process(*scan, odometryPose);
+///     StreamResult done;
+///     while (kfd.takeFinished(done)) slam.processScan(*done.scan);  // earlier scans first
+///     if (r.keep && !r.pending) slam.processScan(*scan);
+///     ...
+///     kfd.finish();  // the end: then takeFinished() as above
+///
+/// Without it nothing is ever pending and takeFinished() returns false. The counters count a
+/// pending scan once it is finished.
 class StreamFilter {
   public:
     /// Builds stages for a new sensor; lets callers add custom stages (e.g. baselines).
     using StageFactory = std::function<void(Pipeline&)>;
 
-    explicit StreamFilter(const Pipeline::Params& params = {}, StageFactory extra = {});
+    /// `one_scan_latency`: the caller handles pending results (takeFinished(), finish()).
+    /// Without it, a pipeline that holds scans (the denoise key next_scan = true) is refused:
+    /// kfd::ParameterError naming next_scan (a tool that would use a held scan unfinished).
+    explicit StreamFilter(const Pipeline::Params& params = {}, StageFactory extra = {},
+                          bool one_scan_latency = false);
 
     /// The one door: checks the scan (kfd::checkScan, the only place it runs), then runs the
     /// pipeline. A scan with a bad geometry is skipped (StreamResult::skipped says why; nothing
@@ -67,8 +95,19 @@ class StreamFilter {
     void setLaserOnly(bool on) { laser_only_ = on; }
     bool laserOnly() const { return laser_only_; }
 
-    /// Forgets every sensor (the counters stay).
-    void reset() { sensors_.clear(); }
+    /// The next finished scan that was pending, in the order they were finished (with several
+    /// sensors that may differ from the input order: record.index has it); false when none.
+    bool takeFinished(StreamResult& out);
+    /// Finishes every sensor's pending scan without a next scan (the end of a log).
+    void finish();
+    /// Scans pending now (returned pending, not yet finished).
+    std::size_t pendingCount() const;
+
+    /// Forgets every sensor (the counters stay); pending scans are finished first.
+    void reset() {
+        finish();
+        sensors_.clear();
+    }
     std::size_t sensorCount() const { return sensors_.size(); }
     const Pipeline::Params& params() const { return params_; }
     /// The clusters of the last denoised scan of a sensor (nullptr if none).
@@ -80,15 +119,20 @@ class StreamFilter {
         ScanGeometry geometry;
         Scan scan;  // reused buffer
         double last_stamp = std::numeric_limits<double>::quiet_NaN();
+        StreamResult held;  // the pending scan's result (held.scan: its observation)
     };
     Sensor& sensorFor(const std::string& label);
     void record(StreamResult& r);
+    // The sensor's pending scan, when its pipeline finished it: marks its removals in the
+    // observation, records it and queues it for takeFinished().
+    void collectFinished(Sensor& s);
 
     Pipeline::Params params_;
     StageFactory extra_;
     std::unique_ptr<Pipeline> spare_;  // built (and validated) by the constructor
     std::map<std::string, Sensor> sensors_;
-    Scan spare_scan_;  // the next scan's buffer (swapped with its sensor's)
+    Scan spare_scan_;                    // the next scan's buffer (swapped with its sensor's)
+    std::deque<StreamResult> finished_;  // finished pending scans, oldest first
     ScanCounters counters_;
     bool laser_only_ = false;
 };
