@@ -26,9 +26,8 @@ inline float segmentDistance2(float px, float py, float ax, float ay, float bx, 
 // sqrt(1.5): the residual of a beam against its two neighbours' line has variance 1.5 sigma^2.
 constexpr double kResidualScale = 1.2247448713915889;
 
-}  // namespace
-
-float EvidenceFilter::approxAtan2(float y, float x) {
+/// EvidenceFilter::approxAtan2, inlined where it runs per projected return.
+inline float fastAtan2(float y, float x) {
     const float ax = std::abs(x), ay = std::abs(y);
     const float mx = std::max(ax, ay), mn = std::min(ax, ay);
     if (!(mx > 0.0f)) return 0.0f;
@@ -43,6 +42,10 @@ float EvidenceFilter::approxAtan2(float y, float x) {
     if (x < 0.0f) r = 3.14159274f - r;
     return y < 0.0f ? -r : r;
 }
+
+}  // namespace
+
+float EvidenceFilter::approxAtan2(float y, float x) { return fastAtan2(y, x); }
 
 double EvidenceFilter::lineResidual(double a, double r, double b, double cos_res) {
     const double inv = 1.0 / a + 1.0 / b;
@@ -216,15 +219,24 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
     // On a line with both neighbours: |e| <= 3 sqrt(1.5) sigma, written without the division
     // (|r (a + b) - 2 cos(res) a b| <= tol (a + b)).
     const float tol = static_cast<float>(3.0 * kResidualScale * sigma);
-    line_.assign(n, 0);
+    line_.resize(n);
+    link_.resize(n);
     const std::uint8_t* valid = scan.valid.data();
     const float* range = scan.range.data();
-    for (std::size_t i = 1; i + 1 < n; ++i) {
+    const float* x = x_.data();
+    const float* y = y_.data();
+    std::uint8_t* line = line_.data();
+    std::uint8_t* link = link_.data();
+    const std::size_t pairs = n > 0 ? n - 1 : 0;
+    if (n > 0) line[0] = line[n - 1] = 0;
+        // Branch-free passes over every beam (the same arithmetic as a test per beam).
+#pragma omp simd
+    for (std::size_t i = 1; i < pairs; ++i) {
         const float a = range[i - 1], r = range[i], b = range[i + 1];
         const float sum = a + b;
-        line_[i] =
-            static_cast<std::uint8_t>(valid[i - 1] && valid[i] && valid[i + 1] &&
-                                      std::abs(r * sum - 2.0f * cos_res * a * b) <= tol * sum);
+        line[i] =
+            static_cast<std::uint8_t>(valid[i - 1] & valid[i] & valid[i + 1] &
+                                      (std::abs(r * sum - 2.0f * cos_res * a * b) <= tol * sum));
     }
     // Breakpoint distance / r_min per beam step, for steps 1..max_gap + 1 (dtheta < lambda).
     const std::size_t max_step = params_.max_gap_beams + 1;
@@ -234,33 +246,52 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
         factor[k] = static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt));
     }
     const float noise = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
-    link_.assign(n, 0);
+    // Neighbouring returns: one surface within the breakpoint distance or on a line together.
+    const float factor1 = factor[1];
+    if (n > 0) link[n - 1] = 0;
+#pragma omp simd
+    for (std::size_t i = 0; i < pairs; ++i) {
+        const float dx = x[i + 1] - x[i], dy = y[i + 1] - y[i];
+        const float dmax = std::min(range[i], range[i + 1]) * factor1 + noise;
+        link[i] = static_cast<std::uint8_t>(
+            valid[i] & valid[i + 1] &
+            ((dx * dx + dy * dy <= dmax * dmax) | (line[i] & line[i + 1])));
+    }
+    // Segments (at most n): returns across up to max_gap_beams missing beams are tested here.
     out.label.assign(n, -1);
-    out.size.clear();
-    sums_.clear();
+    out.size.resize(n);
+    sums_.resize(n);
+    std::int32_t* label = out.label.data();
+    std::uint32_t* size = out.size.data();
+    float* sums = sums_.data();
+    std::size_t count = 0;
     std::size_t first_valid = 0;
     while (first_valid < n && !valid[first_valid]) ++first_valid;
     std::size_t last = n;  // the previous valid beam
     for (std::size_t i = first_valid; i < n; ++i) {
         if (!valid[i]) continue;
         bool linked = false;
-        if (last < n && i - last <= max_step) {
-            const float dx = x_[i] - x_[last], dy = y_[i] - y_[last];
+        if (i == last + 1) {
+            linked = link[last] != 0;
+        } else if (last < n && i - last <= max_step) {
+            const float dx = x[i] - x[last], dy = y[i] - y[last];
             const float dmax = std::min(range[last], range[i]) * factor[i - last] + noise;
-            linked = dx * dx + dy * dy <= dmax * dmax || (i == last + 1 && line_[i] && line_[last]);
+            linked = dx * dx + dy * dy <= dmax * dmax;
+            link[last] = static_cast<std::uint8_t>(linked);
         }
-        if (linked) {
-            link_[last] = 1;
-        } else {
-            out.size.push_back(0);
-            sums_.push_back(0.0f);
+        if (!linked) {
+            size[count] = 0;
+            sums[count] = 0.0f;
+            ++count;
         }
-        const std::size_t c = out.size.size() - 1;
-        out.label[i] = static_cast<std::int32_t>(c);
-        ++out.size[c];
-        sums_[c] += range[i];
+        const std::size_t c = count - 1;
+        label[i] = static_cast<std::int32_t>(c);
+        ++size[c];
+        sums[c] += range[i];
         last = i;
     }
+    out.size.resize(count);
+    sums_.resize(count);
     // A scanner closing the circle: the last segment continues the first across the seam.
     const ScanGeometry& g = scan.geometry;
     if (out.size.size() > 1 && last < n && first_valid < last) {
@@ -311,7 +342,7 @@ std::uint8_t EvidenceFilter::classify(const Projection& pr, float x, float y,
     const Reference& ref = *pr.ref;
     const std::size_t rn = ref.range.size();
     const float qx = pr.c * x - pr.s * y + pr.tx, qy = pr.s * x + pr.c * y + pr.ty;
-    const float u = (approxAtan2(qy, qx) - first_) * inv_step_;
+    const float u = (fastAtan2(qy, qx) - first_) * inv_step_;
     if (!(u >= 0.0f) || !(u < static_cast<float>(rn - 1))) return kUnknown;  // unseen before
     const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
     const float rho = std::sqrt(qx * qx + qy * qy);
@@ -380,7 +411,7 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
         for (std::size_t i = 0; i < n; i += stride) {
             if (!scan.valid[i]) continue;
             const float qx = c * x_[i] - s * y_[i] + tx, qy = s * x_[i] + c * y_[i] + ty;
-            const float u = (approxAtan2(qy, qx) - first_) * inv_step_;
+            const float u = (fastAtan2(qy, qx) - first_) * inv_step_;
             if (!(u >= 0.0f) || !(u < static_cast<float>(rn - 1))) continue;
             const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
             if (!ref.valid[k0] || !ref.valid[k1] || !ref.link[k0]) continue;
@@ -525,10 +556,17 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     updateTables(geom);
     x_.resize(n);
     y_.resize(n);
-    const float* range = scan.range.data();
-    for (std::size_t i = 0; i < n; ++i) {
-        x_[i] = range[i] * dirs_.cos[i];
-        y_[i] = range[i] * dirs_.sin[i];
+    {
+        const float* range = scan.range.data();
+        const float* cs = dirs_.cos.data();
+        const float* sn = dirs_.sin.data();
+        float* x = x_.data();
+        float* y = y_.data();
+#pragma omp simd
+        for (std::size_t i = 0; i < n; ++i) {
+            x[i] = range[i] * cs[i];
+            y[i] = range[i] * sn[i];
+        }
     }
     // 1.-2. Noise, lines and segments.
     const double sigma = estimateSigma(scan);
