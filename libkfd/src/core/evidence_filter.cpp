@@ -235,7 +235,7 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
         const float a = range[i - 1], r = range[i], b = range[i + 1];
         const float sum = a + b;
         line[i] =
-            static_cast<std::uint8_t>(valid[i - 1] & valid[i] & valid[i + 1] &
+            static_cast<std::uint8_t>((valid[i - 1] != 0) & (valid[i] != 0) & (valid[i + 1] != 0) &
                                       (std::abs(r * sum - 2.0f * cos_res * a * b) <= tol * sum));
     }
     // Breakpoint distance / r_min per beam step, for steps 1..max_gap + 1 (dtheta < lambda).
@@ -254,7 +254,7 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
         const float dx = x[i + 1] - x[i], dy = y[i + 1] - y[i];
         const float dmax = std::min(range[i], range[i + 1]) * factor1 + noise;
         link[i] = static_cast<std::uint8_t>(
-            valid[i] & valid[i + 1] &
+            (valid[i] != 0) & (valid[i + 1] != 0) &
             ((dx * dx + dy * dy <= dmax * dmax) | (line[i] & line[i + 1])));
     }
     // Segments (at most n): returns across up to max_gap_beams missing beams are tested here.
@@ -399,6 +399,18 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
     const std::size_t n = scan.range.size(), rn = ref.range.size();
     if (params_.refine_iterations == 0 || rn < 2) return false;
     const std::size_t stride = std::max<std::size_t>(1, n / params_.refine_samples);
+    // Raw pointers: the stores below cannot alias the vectors' own pointers then.
+    const std::uint8_t* valid = scan.valid.data();
+    const float* px = x_.data();
+    const float* py = y_.data();
+    const std::uint8_t* rvalid = ref.valid.data();
+    const std::uint8_t* rlink = ref.link.data();
+    const float* rx = ref.x.data();
+    const float* ry = ref.y.data();
+    const float u_max = static_cast<float>(rn - 1);
+    const float first = first_, inv_step = inv_step_;
+    residuals_.resize(n / stride + 1);  // within the capacity reserved by initialize()
+    float* residuals = residuals_.data();
     double gate = params_.refine_gate_m;
     bool changed = false;
     for (std::size_t it = 0; it < params_.refine_iterations; ++it) {
@@ -407,30 +419,30 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
         const float tx = static_cast<float>(d.x), ty = static_cast<float>(d.y);
         const float gate_f = static_cast<float>(gate);
         PointToLineSystem<float> sys;
-        if (spread) residuals_.clear();
+        std::size_t kept = 0;
         for (std::size_t i = 0; i < n; i += stride) {
-            if (!scan.valid[i]) continue;
-            const float qx = c * x_[i] - s * y_[i] + tx, qy = s * x_[i] + c * y_[i] + ty;
-            const float u = (fastAtan2(qy, qx) - first_) * inv_step_;
-            if (!(u >= 0.0f) || !(u < static_cast<float>(rn - 1))) continue;
+            if (!valid[i]) continue;
+            const float qx = c * px[i] - s * py[i] + tx, qy = s * px[i] + c * py[i] + ty;
+            const float u = (fastAtan2(qy, qx) - first) * inv_step;
+            if (!(u >= 0.0f) || !(u < u_max)) continue;
             const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
-            if (!ref.valid[k0] || !ref.valid[k1] || !ref.link[k0]) continue;
-            float nx = ref.y[k0] - ref.y[k1], ny = ref.x[k1] - ref.x[k0];
+            if (!rvalid[k0] || !rvalid[k1] || !rlink[k0]) continue;
+            float nx = ry[k0] - ry[k1], ny = rx[k1] - rx[k0];
             const float len2 = nx * nx + ny * ny;
             if (!(len2 > 1e-12f)) continue;
             const float inv = 1.0f / std::sqrt(len2);
             nx *= inv;
             ny *= inv;
-            const float e = nx * (qx - ref.x[k0]) + ny * (qy - ref.y[k0]);
+            const float e = nx * (qx - rx[k0]) + ny * (qy - ry[k0]);
             if (std::abs(e) > gate_f) continue;
             sys.add(nx, ny, qx, qy, e);
-            if (spread) residuals_.push_back(std::abs(e));
+            residuals[kept++] = std::abs(e);
         }
         gate = std::max(0.5 * gate, 0.1);
         if (sys.pairs < 12) break;
         if (spread) {  // the robust spread of the residuals at the step before this update
-            auto mid = residuals_.begin() + static_cast<std::ptrdiff_t>(residuals_.size() / 2);
-            std::nth_element(residuals_.begin(), mid, residuals_.end());
+            float* mid = residuals + kept / 2;
+            std::nth_element(residuals, mid, residuals + kept);
             *spread = 1.4826 * static_cast<double>(*mid);
         }
         if (!sys.step(d)) break;
@@ -472,53 +484,65 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
     free_in_.assign(out.count(), 0);
     supported_in_.assign(out.count(), 0);
     classified_in_.assign(out.count(), 0);
-    unknown_.clear();
+    if (unknown_.size() < n) unknown_.resize(n);  // kept at its largest: no refill per scan
+    const std::int32_t* labels = out.label.data();
+    const std::uint32_t* sizes = out.size.data();
+    const std::uint8_t* line = line_.data();
+    const float* x = x_.data();
+    const float* y = y_.data();
+    std::uint8_t* evidence = evidence_.data();
+    std::uint32_t* free_in = free_in_.data();
+    std::uint32_t* supported_in = supported_in_.data();
+    std::uint32_t* classified_in = classified_in_.data();
+    std::uint32_t* unknown = unknown_.data();
+    std::size_t unknowns = 0;
     for (std::size_t i = 0; i < n; ++i) {
-        const std::int32_t label = out.label[i];
+        const std::int32_t label = labels[i];
         if (label < 0) continue;
         const auto c = static_cast<std::size_t>(label);
-        if (line_[i] && (i & 3u) != 0 && out.size[c] >= 8) continue;
+        if (line[i] && (i & 3u) != 0 && sizes[c] >= 8) continue;
         // The raw scan just before decides first; the keyframe decides what it left unknown,
         // and a return free just before is still tracked when the keyframe saw a moving object
         // here.
         std::uint8_t e = kUnknown;
         if (pt.usable) {
-            e = classify(pt, x_[i], y_[i], true);
-            if (e == kFree && p0.usable && classify(p0, x_[i], y_[i], true) == kTracked)
-                e = kTracked;
+            e = classify(pt, x[i], y[i], true);
+            if (e == kFree && p0.usable && classify(p0, x[i], y[i], true) == kTracked) e = kTracked;
         }
-        if (e == kUnknown && p0.usable) e = classify(p0, x_[i], y_[i], true);
-        evidence_[i] = e;
-        ++classified_in_[c];
+        if (e == kUnknown && p0.usable) e = classify(p0, x[i], y[i], true);
+        evidence[i] = e;
+        ++classified_in[c];
         if (e == kFree) {
-            ++free_in_[c];
+            ++free_in[c];
             ++res.free_points;
         } else if (e == kSupported) {
-            ++supported_in_[c];
+            ++supported_in[c];
             ++res.supported;
         } else if (e == kTracked) {
             ++res.tracked;
         } else {
-            unknown_.push_back(static_cast<std::uint32_t>(i));
+            unknown[unknowns++] = static_cast<std::uint32_t>(i);
         }
     }
     // The keyframe before it (and the older raw scans) can support what the newest could not
     // (a thin object between two beams, a return among dropouts); they never overrule free
     // space.
     auto support = [&](const Projection& p) {
-        for (const std::uint32_t i : unknown_)
+        for (std::size_t j = 0; j < unknowns; ++j) {
+            const std::uint32_t i = unknown[j];
             if (evidence_[i] == kUnknown && classify(p, x_[i], y_[i], false) == kSupported) {
                 evidence_[i] = kSupported;
                 ++supported_in_[static_cast<std::size_t>(out.label[i])];
                 ++res.supported;
             }
+        }
     };
     const Reference& r1 = refs_[1];
-    if (have_pose_ && r1.present && r1.geometry == scan.geometry && !unknown_.empty()) {
+    if (have_pose_ && r1.present && r1.geometry == scan.geometry && unknowns > 0) {
         const Projection p1 = projection(r1, between(r1.pose, pose_), sigma);
         if (p1.usable) support(p1);
     }
-    for (std::size_t age = 1; recent && age < raw_count_ && !unknown_.empty(); ++age) {
+    for (std::size_t age = 1; recent && age < raw_count_ && unknowns > 0; ++age) {
         const Projection pa = recentProjection(scan, age, sigma, res);
         if (pa.usable) support(pa);
     }
