@@ -122,8 +122,9 @@ bool EvidenceFilter::convertRaw(const Scan& scan, std::size_t age, double sigma)
     r.valid.resize(n);
     r.x.resize(n);
     r.y.resize(n);
-    r.link.assign(n, 0);
-    r.evidence.clear();  // no evidence of its own: nothing is tracked against it
+    r.link.resize(n);
+    if (n > 0) r.link[n - 1] = 0;  // the others are all written below
+    r.evidence.clear();            // no evidence of its own: nothing is tracked against it
     r.has_odom = w.has_odom;
     r.odom = r.pose = w.odom;
     // Branch-free passes (this runs once per keyframe over every beam).
@@ -268,6 +269,9 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
     std::size_t first_valid = 0;
     while (first_valid < n && !valid[first_valid]) ++first_valid;
     std::size_t last = n;  // the previous valid beam
+    // The open segment's size and range sum stay in registers until the next one starts.
+    std::uint32_t cur_size = 0;
+    float cur_sum = 0.0f;
     for (std::size_t i = first_valid; i < n; ++i) {
         if (!valid[i]) continue;
         bool linked = false;
@@ -280,15 +284,22 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
             link[last] = static_cast<std::uint8_t>(linked);
         }
         if (!linked) {
-            size[count] = 0;
-            sums[count] = 0.0f;
+            if (count > 0) {
+                size[count - 1] = cur_size;
+                sums[count - 1] = cur_sum;
+            }
             ++count;
+            cur_size = 0;
+            cur_sum = 0.0f;
         }
-        const std::size_t c = count - 1;
-        label[i] = static_cast<std::int32_t>(c);
-        ++size[c];
-        sums[c] += range[i];
+        label[i] = static_cast<std::int32_t>(count - 1);
+        ++cur_size;
+        cur_sum += range[i];
         last = i;
+    }
+    if (count > 0) {
+        size[count - 1] = cur_size;
+        sums[count - 1] = cur_sum;
     }
     out.size.resize(count);
     sums_.resize(count);
