@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "kfd/core/pose.h"
@@ -41,6 +42,35 @@ inline float fastAtan2(float y, float x) {
     if (ay > ax) r = 1.57079637f - r;
     if (x < 0.0f) r = 3.14159274f - r;
     return y < 0.0f ? -r : r;
+}
+
+/// `c ? a : b` by bit masks: GCC (-ftrapping-math) if-converts no floating-point select in an
+/// omp simd loop, but vectorises these.
+inline float pick(bool c, float a, float b) {
+    std::uint32_t ua, ub;
+    std::memcpy(&ua, &a, sizeof ua);
+    std::memcpy(&ub, &b, sizeof ub);
+    const std::uint32_t m = 0u - static_cast<std::uint32_t>(c);
+    const std::uint32_t r = (ua & m) | (ub & ~m);
+    float f;
+    std::memcpy(&f, &r, sizeof f);
+    return f;
+}
+
+/// fastAtan2 without branches (for omp simd loops): the same operations, the same results.
+inline float fastAtan2Select(float y, float x) {
+    const float ax = std::abs(x), ay = std::abs(y);
+    const float mx = pick(ax < ay, ay, ax), mn = pick(ay < ax, ay, ax);  // std::max, std::min
+    const float a = mn / mx, s = a * a;
+    float r = ((((-0.0117212f * s + 0.05265332f) * s - 0.11643287f) * s + 0.19354346f) * s -
+               0.33262347f) *
+                  s +
+              0.99997726f;
+    r *= a;
+    r = pick(ay > ax, 1.57079637f - r, r);
+    r = pick(x < 0.0f, 3.14159274f - r, r);
+    r = pick(y < 0.0f, -r, r);
+    return pick(mx > 0.0f, r, 0.0f);
 }
 
 }  // namespace
@@ -83,6 +113,7 @@ void EvidenceFilter::initialize(const Params& p) {
     params_ = p;
     raw_.assign(p.temporal_scans, RawScan{});
     residuals_.reserve(2 * p.refine_samples + 2);
+    align_.reserve(5 * (2 * p.refine_samples + 2));
     lambda_ = p.incidence_deg * kDeg;
     reset();
 }
@@ -420,8 +451,24 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
     const float* ry = ref.y.data();
     const float u_max = static_cast<float>(rn - 1);
     const float first = first_, inv_step = inv_step_;
-    residuals_.resize(n / stride + 1);  // within the capacity reserved by initialize()
+    // The sampled returns, gathered once; per iteration their projections and bracket
+    // positions in one omp simd pass, then the pairs.
+    const std::size_t cap = n / stride + 1;  // within the capacity reserved by initialize()
+    residuals_.resize(cap);
+    align_.resize(5 * cap);
     float* residuals = residuals_.data();
+    float* sx = align_.data();
+    float* sy = sx + cap;
+    float* qxs = sy + cap;
+    float* qys = qxs + cap;
+    float* us = qys + cap;
+    std::size_t m = 0;
+    for (std::size_t i = 0; i < n; i += stride) {
+        if (!valid[i]) continue;
+        sx[m] = px[i];
+        sy[m] = py[i];
+        ++m;
+    }
     double gate = params_.refine_gate_m;
     bool changed = false;
     for (std::size_t it = 0; it < params_.refine_iterations; ++it) {
@@ -429,15 +476,21 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
                     s = static_cast<float>(std::sin(d.phi));
         const float tx = static_cast<float>(d.x), ty = static_cast<float>(d.y);
         const float gate_f = static_cast<float>(gate);
+#pragma omp simd
+        for (std::size_t j = 0; j < m; ++j) {
+            const float qx = c * sx[j] - s * sy[j] + tx, qy = s * sx[j] + c * sy[j] + ty;
+            qxs[j] = qx;
+            qys[j] = qy;
+            us[j] = (fastAtan2Select(qy, qx) - first) * inv_step;
+        }
         PointToLineSystem<float> sys;
         std::size_t kept = 0;
-        for (std::size_t i = 0; i < n; i += stride) {
-            if (!valid[i]) continue;
-            const float qx = c * px[i] - s * py[i] + tx, qy = s * px[i] + c * py[i] + ty;
-            const float u = (fastAtan2(qy, qx) - first) * inv_step;
+        for (std::size_t j = 0; j < m; ++j) {
+            const float u = us[j];
             if (!(u >= 0.0f) || !(u < u_max)) continue;
             const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
             if (!rvalid[k0] || !rvalid[k1] || !rlink[k0]) continue;
+            const float qx = qxs[j], qy = qys[j];
             float nx = ry[k0] - ry[k1], ny = rx[k1] - rx[k0];
             const float len2 = nx * nx + ny * ny;
             if (!(len2 > 1e-12f)) continue;

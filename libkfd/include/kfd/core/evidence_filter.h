@@ -220,6 +220,7 @@ class EvidenceFilter {
     std::size_t raw_count_ = 0;             // raw scans held
     Reference recent_;                      // a raw scan converted for this keyframe
     mutable std::vector<float> residuals_;  // refineStep's last iteration |e|
+    mutable std::vector<float> align_;      // refineStep's samples, projections, brackets
     Pose2D pose_;                           // this scan's refined pose (when have_pose_)
     bool have_pose_ = false;
 };
