@@ -381,10 +381,14 @@ EvidenceFilter::Projection EvidenceFilter::projection(const Reference& ref, cons
 
 std::uint8_t EvidenceFilter::classify(const Projection& pr, float x, float y,
                                       bool free_test) const {
+    const float qx = pr.c * x - pr.s * y + pr.tx, qy = pr.s * x + pr.c * y + pr.ty;
+    return classifyAt(pr, qx, qy, (fastAtan2(qy, qx) - first_) * inv_step_, free_test);
+}
+
+std::uint8_t EvidenceFilter::classifyAt(const Projection& pr, float qx, float qy, float u,
+                                        bool free_test) const {
     const Reference& ref = *pr.ref;
     const std::size_t rn = ref.range.size();
-    const float qx = pr.c * x - pr.s * y + pr.tx, qy = pr.s * x + pr.c * y + pr.ty;
-    const float u = (fastAtan2(qy, qx) - first_) * inv_step_;
     if (!(u >= 0.0f) || !(u < static_cast<float>(rn - 1))) return kUnknown;  // unseen before
     const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
     const float rho = std::sqrt(qx * qx + qy * qy);
@@ -560,20 +564,47 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
     std::uint32_t* classified_in = classified_in_.data();
     std::uint32_t* unknown = unknown_.data();
     std::size_t unknowns = 0;
+    // The returns to classify with their points, then (one omp simd pass) their projections
+    // and bracket positions in the first reference asked.
+    if (batch_.size() < 5 * n) batch_.resize(5 * n);  // kept at its largest
+    float* bx = batch_.data();
+    float* by = bx + n;
+    float* bqx = by + n;
+    float* bqy = bqx + n;
+    float* bu = bqy + n;
+    std::size_t listed = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const std::int32_t label = labels[i];
         if (label < 0) continue;
-        const auto c = static_cast<std::size_t>(label);
-        if (line[i] && (i & 3u) != 0 && sizes[c] >= 8) continue;
+        if (line[i] && (i & 3u) != 0 && sizes[static_cast<std::size_t>(label)] >= 8) continue;
+        unknown[listed] = static_cast<std::uint32_t>(i);
+        bx[listed] = x[i];
+        by[listed] = y[i];
+        ++listed;
+    }
+    const Projection& first_pr = pt.usable ? pt : p0;
+    {
+        const float pc = first_pr.c, ps = first_pr.s, ptx = first_pr.tx, pty = first_pr.ty;
+        const float first = first_, inv_step = inv_step_;
+#pragma omp simd
+        for (std::size_t j = 0; j < listed; ++j) {
+            const float qx = pc * bx[j] - ps * by[j] + ptx, qy = ps * bx[j] + pc * by[j] + pty;
+            bqx[j] = qx;
+            bqy[j] = qy;
+            bu[j] = (fastAtan2Select(qy, qx) - first) * inv_step;
+        }
+    }
+    for (std::size_t j = 0; j < listed; ++j) {
+        const std::size_t i = unknown[j];
+        const auto c = static_cast<std::size_t>(labels[i]);
         // The raw scan just before decides first; the keyframe decides what it left unknown,
         // and a return free just before is still tracked when the keyframe saw a moving object
         // here.
-        std::uint8_t e = kUnknown;
+        std::uint8_t e = classifyAt(first_pr, bqx[j], bqy[j], bu[j], true);
         if (pt.usable) {
-            e = classify(pt, x[i], y[i], true);
             if (e == kFree && p0.usable && classify(p0, x[i], y[i], true) == kTracked) e = kTracked;
+            if (e == kUnknown && p0.usable) e = classify(p0, x[i], y[i], true);
         }
-        if (e == kUnknown && p0.usable) e = classify(p0, x[i], y[i], true);
         evidence[i] = e;
         ++classified_in[c];
         if (e == kFree) {
