@@ -290,7 +290,7 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
             ((dx * dx + dy * dy <= dmax * dmax) | (line[i] & line[i + 1])));
     }
     // Segments (at most n): returns across up to max_gap_beams missing beams are tested here.
-    out.label.assign(n, -1);
+    out.label.resize(n);  // every beam written below (-1: no return)
     out.size.resize(n);
     sums_.resize(n);
     std::int32_t* label = out.label.data();
@@ -298,13 +298,16 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
     float* sums = sums_.data();
     std::size_t count = 0;
     std::size_t first_valid = 0;
-    while (first_valid < n && !valid[first_valid]) ++first_valid;
+    while (first_valid < n && !valid[first_valid]) label[first_valid++] = -1;
     std::size_t last = n;  // the previous valid beam
     // The open segment's size and range sum stay in registers until the next one starts.
     std::uint32_t cur_size = 0;
     float cur_sum = 0.0f;
     for (std::size_t i = first_valid; i < n; ++i) {
-        if (!valid[i]) continue;
+        if (!valid[i]) {
+            label[i] = -1;
+            continue;
+        }
         bool linked = false;
         if (i == last + 1) {
             linked = link[last] != 0;
