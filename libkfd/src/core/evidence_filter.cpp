@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "kfd/core/pose.h"
@@ -26,9 +27,8 @@ inline float segmentDistance2(float px, float py, float ax, float ay, float bx, 
 // sqrt(1.5): the residual of a beam against its two neighbours' line has variance 1.5 sigma^2.
 constexpr double kResidualScale = 1.2247448713915889;
 
-}  // namespace
-
-float EvidenceFilter::approxAtan2(float y, float x) {
+/// EvidenceFilter::approxAtan2, inlined where it runs per projected return.
+inline float fastAtan2(float y, float x) {
     const float ax = std::abs(x), ay = std::abs(y);
     const float mx = std::max(ax, ay), mn = std::min(ax, ay);
     if (!(mx > 0.0f)) return 0.0f;
@@ -43,6 +43,39 @@ float EvidenceFilter::approxAtan2(float y, float x) {
     if (x < 0.0f) r = 3.14159274f - r;
     return y < 0.0f ? -r : r;
 }
+
+/// `c ? a : b` by bit masks: GCC (-ftrapping-math) if-converts no floating-point select in an
+/// omp simd loop, but vectorises these.
+inline float pick(bool c, float a, float b) {
+    std::uint32_t ua, ub;
+    std::memcpy(&ua, &a, sizeof ua);
+    std::memcpy(&ub, &b, sizeof ub);
+    const std::uint32_t m = 0u - static_cast<std::uint32_t>(c);
+    const std::uint32_t r = (ua & m) | (ub & ~m);
+    float f;
+    std::memcpy(&f, &r, sizeof f);
+    return f;
+}
+
+/// fastAtan2 without branches (for omp simd loops): the same operations, the same results.
+inline float fastAtan2Select(float y, float x) {
+    const float ax = std::abs(x), ay = std::abs(y);
+    const float mx = pick(ax < ay, ay, ax), mn = pick(ay < ax, ay, ax);  // std::max, std::min
+    const float a = mn / mx, s = a * a;
+    float r = ((((-0.0117212f * s + 0.05265332f) * s - 0.11643287f) * s + 0.19354346f) * s -
+               0.33262347f) *
+                  s +
+              0.99997726f;
+    r *= a;
+    r = pick(ay > ax, 1.57079637f - r, r);
+    r = pick(x < 0.0f, 3.14159274f - r, r);
+    r = pick(y < 0.0f, -r, r);
+    return pick(mx > 0.0f, r, 0.0f);
+}
+
+}  // namespace
+
+float EvidenceFilter::approxAtan2(float y, float x) { return fastAtan2(y, x); }
 
 double EvidenceFilter::lineResidual(double a, double r, double b, double cos_res) {
     const double inv = 1.0 / a + 1.0 / b;
@@ -84,6 +117,7 @@ void EvidenceFilter::initialize(const Params& p) {
     params_ = p;
     raw_.assign(p.temporal_scans, RawScan{});
     residuals_.reserve(2 * p.refine_samples + 2);
+    align_.reserve(5 * (2 * p.refine_samples + 2));
     lambda_ = p.incidence_deg * kDeg;
     reset();
 }
@@ -126,8 +160,9 @@ bool EvidenceFilter::convertInto(const RawScan& w, Reference& r, const Scan& sca
     r.valid.resize(n);
     r.x.resize(n);
     r.y.resize(n);
-    r.link.assign(n, 0);
-    r.evidence.clear();  // no evidence of its own: nothing is tracked against it
+    r.link.resize(n);
+    if (n > 0) r.link[n - 1] = 0;  // the others are all written below
+    r.evidence.clear();            // no evidence of its own: nothing is tracked against it
     r.has_odom = w.has_odom;
     r.odom = r.pose = w.odom;
     // Branch-free passes (this runs once per keyframe over every beam).
@@ -252,15 +287,24 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
     // On a line with both neighbours: |e| <= 3 sqrt(1.5) sigma, written without the division
     // (|r (a + b) - 2 cos(res) a b| <= tol (a + b)).
     const float tol = static_cast<float>(3.0 * kResidualScale * sigma);
-    line_.assign(n, 0);
+    line_.resize(n);
+    link_.resize(n);
     const std::uint8_t* valid = scan.valid.data();
     const float* range = scan.range.data();
-    for (std::size_t i = 1; i + 1 < n; ++i) {
+    const float* x = x_.data();
+    const float* y = y_.data();
+    std::uint8_t* line = line_.data();
+    std::uint8_t* link = link_.data();
+    const std::size_t pairs = n > 0 ? n - 1 : 0;
+    if (n > 0) line[0] = line[n - 1] = 0;
+        // Branch-free passes over every beam (the same arithmetic as a test per beam).
+#pragma omp simd
+    for (std::size_t i = 1; i < pairs; ++i) {
         const float a = range[i - 1], r = range[i], b = range[i + 1];
         const float sum = a + b;
-        line_[i] =
-            static_cast<std::uint8_t>(valid[i - 1] && valid[i] && valid[i + 1] &&
-                                      std::abs(r * sum - 2.0f * cos_res * a * b) <= tol * sum);
+        line[i] =
+            static_cast<std::uint8_t>((valid[i - 1] != 0) & (valid[i] != 0) & (valid[i + 1] != 0) &
+                                      (std::abs(r * sum - 2.0f * cos_res * a * b) <= tol * sum));
     }
     // Breakpoint distance / r_min per beam step, for steps 1..max_gap + 1 (dtheta < lambda).
     const std::size_t max_step = params_.max_gap_beams + 1;
@@ -270,33 +314,65 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
         factor[k] = static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt));
     }
     const float noise = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
-    link_.assign(n, 0);
-    out.label.assign(n, -1);
-    out.size.clear();
-    sums_.clear();
+    // Neighbouring returns: one surface within the breakpoint distance or on a line together.
+    const float factor1 = factor[1];
+    if (n > 0) link[n - 1] = 0;
+#pragma omp simd
+    for (std::size_t i = 0; i < pairs; ++i) {
+        const float dx = x[i + 1] - x[i], dy = y[i + 1] - y[i];
+        const float dmax = std::min(range[i], range[i + 1]) * factor1 + noise;
+        link[i] = static_cast<std::uint8_t>(
+            (valid[i] != 0) & (valid[i + 1] != 0) &
+            ((dx * dx + dy * dy <= dmax * dmax) | (line[i] & line[i + 1])));
+    }
+    // Segments (at most n): returns across up to max_gap_beams missing beams are tested here.
+    out.label.resize(n);  // every beam written below (-1: no return)
+    out.size.resize(n);
+    sums_.resize(n);
+    std::int32_t* label = out.label.data();
+    std::uint32_t* size = out.size.data();
+    float* sums = sums_.data();
+    std::size_t count = 0;
     std::size_t first_valid = 0;
-    while (first_valid < n && !valid[first_valid]) ++first_valid;
+    while (first_valid < n && !valid[first_valid]) label[first_valid++] = -1;
     std::size_t last = n;  // the previous valid beam
+    // The open segment's size and range sum stay in registers until the next one starts.
+    std::uint32_t cur_size = 0;
+    float cur_sum = 0.0f;
     for (std::size_t i = first_valid; i < n; ++i) {
-        if (!valid[i]) continue;
+        if (!valid[i]) {
+            label[i] = -1;
+            continue;
+        }
         bool linked = false;
-        if (last < n && i - last <= max_step) {
-            const float dx = x_[i] - x_[last], dy = y_[i] - y_[last];
+        if (i == last + 1) {
+            linked = link[last] != 0;
+        } else if (last < n && i - last <= max_step) {
+            const float dx = x[i] - x[last], dy = y[i] - y[last];
             const float dmax = std::min(range[last], range[i]) * factor[i - last] + noise;
-            linked = dx * dx + dy * dy <= dmax * dmax || (i == last + 1 && line_[i] && line_[last]);
+            linked = dx * dx + dy * dy <= dmax * dmax;
+            link[last] = static_cast<std::uint8_t>(linked);
         }
-        if (linked) {
-            link_[last] = 1;
-        } else {
-            out.size.push_back(0);
-            sums_.push_back(0.0f);
+        if (!linked) {
+            if (count > 0) {
+                size[count - 1] = cur_size;
+                sums[count - 1] = cur_sum;
+            }
+            ++count;
+            cur_size = 0;
+            cur_sum = 0.0f;
         }
-        const std::size_t c = out.size.size() - 1;
-        out.label[i] = static_cast<std::int32_t>(c);
-        ++out.size[c];
-        sums_[c] += range[i];
+        label[i] = static_cast<std::int32_t>(count - 1);
+        ++cur_size;
+        cur_sum += range[i];
         last = i;
     }
+    if (count > 0) {
+        size[count - 1] = cur_size;
+        sums[count - 1] = cur_sum;
+    }
+    out.size.resize(count);
+    sums_.resize(count);
     // A scanner closing the circle: the last segment continues the first across the seam.
     const ScanGeometry& g = scan.geometry;
     if (out.size.size() > 1 && last < n && first_valid < last) {
@@ -344,10 +420,14 @@ EvidenceFilter::Projection EvidenceFilter::projection(const Reference& ref, cons
 
 std::uint8_t EvidenceFilter::classify(const Projection& pr, float x, float y,
                                       bool free_test) const {
+    const float qx = pr.c * x - pr.s * y + pr.tx, qy = pr.s * x + pr.c * y + pr.ty;
+    return classifyAt(pr, qx, qy, (fastAtan2(qy, qx) - first_) * inv_step_, free_test);
+}
+
+std::uint8_t EvidenceFilter::classifyAt(const Projection& pr, float qx, float qy, float u,
+                                        bool free_test) const {
     const Reference& ref = *pr.ref;
     const std::size_t rn = ref.range.size();
-    const float qx = pr.c * x - pr.s * y + pr.tx, qy = pr.s * x + pr.c * y + pr.ty;
-    const float u = (approxAtan2(qy, qx) - first_) * inv_step_;
     if (!(u >= 0.0f) || !(u < static_cast<float>(rn - 1))) return kUnknown;  // unseen before
     const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
     const float rho = std::sqrt(qx * qx + qy * qy);
@@ -404,6 +484,34 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
     const std::size_t n = scan.range.size(), rn = ref.range.size();
     if (params_.refine_iterations == 0 || rn < 2) return false;
     const std::size_t stride = std::max<std::size_t>(1, n / params_.refine_samples);
+    // Raw pointers: the stores below cannot alias the vectors' own pointers then.
+    const std::uint8_t* valid = scan.valid.data();
+    const float* px = x_.data();
+    const float* py = y_.data();
+    const std::uint8_t* rvalid = ref.valid.data();
+    const std::uint8_t* rlink = ref.link.data();
+    const float* rx = ref.x.data();
+    const float* ry = ref.y.data();
+    const float u_max = static_cast<float>(rn - 1);
+    const float first = first_, inv_step = inv_step_;
+    // The sampled returns, gathered once; per iteration their projections and bracket
+    // positions in one omp simd pass, then the pairs.
+    const std::size_t cap = n / stride + 1;  // within the capacity reserved by initialize()
+    residuals_.resize(cap);
+    align_.resize(5 * cap);
+    float* residuals = residuals_.data();
+    float* sx = align_.data();
+    float* sy = sx + cap;
+    float* qxs = sy + cap;
+    float* qys = qxs + cap;
+    float* us = qys + cap;
+    std::size_t m = 0;
+    for (std::size_t i = 0; i < n; i += stride) {
+        if (!valid[i]) continue;
+        sx[m] = px[i];
+        sy[m] = py[i];
+        ++m;
+    }
     double gate = params_.refine_gate_m;
     bool changed = false;
     for (std::size_t it = 0; it < params_.refine_iterations; ++it) {
@@ -411,31 +519,37 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
                     s = static_cast<float>(std::sin(d.phi));
         const float tx = static_cast<float>(d.x), ty = static_cast<float>(d.y);
         const float gate_f = static_cast<float>(gate);
+#pragma omp simd
+        for (std::size_t j = 0; j < m; ++j) {
+            const float qx = c * sx[j] - s * sy[j] + tx, qy = s * sx[j] + c * sy[j] + ty;
+            qxs[j] = qx;
+            qys[j] = qy;
+            us[j] = (fastAtan2Select(qy, qx) - first) * inv_step;
+        }
         PointToLineSystem<float> sys;
-        if (spread) residuals_.clear();
-        for (std::size_t i = 0; i < n; i += stride) {
-            if (!scan.valid[i]) continue;
-            const float qx = c * x_[i] - s * y_[i] + tx, qy = s * x_[i] + c * y_[i] + ty;
-            const float u = (approxAtan2(qy, qx) - first_) * inv_step_;
-            if (!(u >= 0.0f) || !(u < static_cast<float>(rn - 1))) continue;
+        std::size_t kept = 0;
+        for (std::size_t j = 0; j < m; ++j) {
+            const float u = us[j];
+            if (!(u >= 0.0f) || !(u < u_max)) continue;
             const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
-            if (!ref.valid[k0] || !ref.valid[k1] || !ref.link[k0]) continue;
-            float nx = ref.y[k0] - ref.y[k1], ny = ref.x[k1] - ref.x[k0];
+            if (!rvalid[k0] || !rvalid[k1] || !rlink[k0]) continue;
+            const float qx = qxs[j], qy = qys[j];
+            float nx = ry[k0] - ry[k1], ny = rx[k1] - rx[k0];
             const float len2 = nx * nx + ny * ny;
             if (!(len2 > 1e-12f)) continue;
             const float inv = 1.0f / std::sqrt(len2);
             nx *= inv;
             ny *= inv;
-            const float e = nx * (qx - ref.x[k0]) + ny * (qy - ref.y[k0]);
+            const float e = nx * (qx - rx[k0]) + ny * (qy - ry[k0]);
             if (std::abs(e) > gate_f) continue;
             sys.add(nx, ny, qx, qy, e);
-            if (spread) residuals_.push_back(std::abs(e));
+            residuals[kept++] = std::abs(e);
         }
         gate = std::max(0.5 * gate, 0.1);
         if (sys.pairs < 12) break;
         if (spread) {  // the robust spread of the residuals at the step before this update
-            auto mid = residuals_.begin() + static_cast<std::ptrdiff_t>(residuals_.size() / 2);
-            std::nth_element(residuals_.begin(), mid, residuals_.end());
+            float* mid = residuals + kept / 2;
+            std::nth_element(residuals, mid, residuals + kept);
             *spread = 1.4826 * static_cast<double>(*mid);
         }
         if (!sys.step(d)) break;
@@ -481,55 +595,97 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
     free_in_.assign(out.count(), 0);
     supported_in_.assign(out.count(), 0);
     classified_in_.assign(out.count(), 0);
-    unknown_.clear();
+    if (unknown_.size() < n) unknown_.resize(n);  // kept at its largest: no refill per scan
+    const std::int32_t* labels = out.label.data();
+    const std::uint32_t* sizes = out.size.data();
+    const std::uint8_t* line = line_.data();
+    const float* x = x_.data();
+    const float* y = y_.data();
+    std::uint8_t* evidence = evidence_.data();
+    std::uint32_t* free_in = free_in_.data();
+    std::uint32_t* supported_in = supported_in_.data();
+    std::uint32_t* classified_in = classified_in_.data();
+    std::uint32_t* unknown = unknown_.data();
+    std::size_t unknowns = 0;
+    // The returns to classify with their points, then (one omp simd pass) their projections
+    // and bracket positions in the first reference asked.
+    if (batch_.size() < 5 * n) batch_.resize(5 * n);  // kept at its largest
+    float* bx = batch_.data();
+    float* by = bx + n;
+    float* bqx = by + n;
+    float* bqy = bqx + n;
+    float* bu = bqy + n;
+    std::size_t listed = 0;
     for (std::size_t i = 0; i < n; ++i) {
-        const std::int32_t label = out.label[i];
+        const std::int32_t label = labels[i];
         if (label < 0) continue;
-        const auto c = static_cast<std::size_t>(label);
-        if (line_[i] && (i & 3u) != 0 && out.size[c] >= 8) continue;
+        if (line[i] && (i & 3u) != 0 && sizes[static_cast<std::size_t>(label)] >= 8) continue;
+        unknown[listed] = static_cast<std::uint32_t>(i);
+        bx[listed] = x[i];
+        by[listed] = y[i];
+        ++listed;
+    }
+    const Projection& first_pr = pt.usable ? pt : pn.usable ? pn : p0;
+    {
+        const float pc = first_pr.c, ps = first_pr.s, ptx = first_pr.tx, pty = first_pr.ty;
+        const float first = first_, inv_step = inv_step_;
+#pragma omp simd
+        for (std::size_t j = 0; j < listed; ++j) {
+            const float qx = pc * bx[j] - ps * by[j] + ptx, qy = ps * bx[j] + pc * by[j] + pty;
+            bqx[j] = qx;
+            bqy[j] = qy;
+            bu[j] = (fastAtan2Select(qy, qx) - first) * inv_step;
+        }
+    }
+    for (std::size_t j = 0; j < listed; ++j) {
+        const std::size_t i = unknown[j];
+        const auto c = static_cast<std::size_t>(labels[i]);
         // The raw scan just before decides first; the keyframe decides what it left unknown,
         // and a return free just before is still tracked when the keyframe saw a moving object
         // here.
-        std::uint8_t e = kUnknown;
-        if (pt.usable) e = classify(pt, x_[i], y_[i], true);
-        if (pn.usable && e != kSupported) {  // 3c: either raw neighbour's support keeps it
-            const std::uint8_t en = classify(pn, x_[i], y_[i], true);
+        std::uint8_t e = classifyAt(first_pr, bqx[j], bqy[j], bu[j], true);
+        if (pt.usable && pn.usable && e != kSupported) {  // 3c: either raw neighbour's support
+            const std::uint8_t en = classify(pn, x[i], y[i], true);
             if (en != kUnknown) e = en;
         }
-        if (!recent_ev_.empty()) recent_ev_[i] = e;  // the raw neighbours' verdict (step 5)
-        if (e == kFree && p0.usable && classify(p0, x_[i], y_[i], true) == kTracked) e = kTracked;
-        if (e == kUnknown && p0.usable) e = classify(p0, x_[i], y_[i], true);
-        evidence_[i] = e;
-        ++classified_in_[c];
+        if (pt.usable || pn.usable) {
+            if (!recent_ev_.empty()) recent_ev_[i] = e;  // the raw neighbours' verdict (step 5)
+            if (e == kFree && p0.usable && classify(p0, x[i], y[i], true) == kTracked) e = kTracked;
+            if (e == kUnknown && p0.usable) e = classify(p0, x[i], y[i], true);
+        }
+        evidence[i] = e;
+        ++classified_in[c];
         if (e == kFree) {
-            ++free_in_[c];
+            ++free_in[c];
             ++res.free_points;
         } else if (e == kSupported) {
-            ++supported_in_[c];
+            ++supported_in[c];
             ++res.supported;
         } else if (e == kTracked) {
             ++res.tracked;
         } else {
-            unknown_.push_back(static_cast<std::uint32_t>(i));
+            unknown[unknowns++] = static_cast<std::uint32_t>(i);
         }
     }
     // The keyframe before it (and the older raw scans) can support what the newest could not
     // (a thin object between two beams, a return among dropouts); they never overrule free
     // space.
     auto support = [&](const Projection& p) {
-        for (const std::uint32_t i : unknown_)
+        for (std::size_t j = 0; j < unknowns; ++j) {
+            const std::uint32_t i = unknown[j];
             if (evidence_[i] == kUnknown && classify(p, x_[i], y_[i], false) == kSupported) {
                 evidence_[i] = kSupported;
                 ++supported_in_[static_cast<std::size_t>(out.label[i])];
                 ++res.supported;
             }
+        }
     };
     const Reference& r1 = refs_[1];
-    if (have_pose_ && r1.present && r1.geometry == scan.geometry && !unknown_.empty()) {
+    if (have_pose_ && r1.present && r1.geometry == scan.geometry && unknowns > 0) {
         const Projection p1 = projection(r1, between(r1.pose, pose_), sigma);
         if (p1.usable) support(p1);
     }
-    for (std::size_t age = 1; recent && age < raw_count_ && !unknown_.empty(); ++age) {
+    for (std::size_t age = 1; recent && age < raw_count_ && unknowns > 0; ++age) {
         const Projection pa = recentProjection(scan, age, sigma, res);
         if (pa.usable) support(pa);
     }
@@ -580,10 +736,17 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     updateTables(geom);
     x_.resize(n);
     y_.resize(n);
-    const float* range = scan.range.data();
-    for (std::size_t i = 0; i < n; ++i) {
-        x_[i] = range[i] * dirs_.cos[i];
-        y_[i] = range[i] * dirs_.sin[i];
+    {
+        const float* range = scan.range.data();
+        const float* cs = dirs_.cos.data();
+        const float* sn = dirs_.sin.data();
+        float* x = x_.data();
+        float* y = y_.data();
+#pragma omp simd
+        for (std::size_t i = 0; i < n; ++i) {
+            x[i] = range[i] * cs[i];
+            y[i] = range[i] * sn[i];
+        }
     }
     // 1.-2. Noise, lines and segments.
     const double sigma = estimateSigma(scan);

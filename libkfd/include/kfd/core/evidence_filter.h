@@ -218,6 +218,9 @@ class EvidenceFilter {
                           bool recent);
     Projection projection(const Reference& ref, const Pose2D& d, double sigma) const;
     std::uint8_t classify(const Projection& pr, float x, float y, bool free_test) const;
+    // The same for the point (qx, qy) already in the reference's frame, at bracket position u.
+    std::uint8_t classifyAt(const Projection& pr, float qx, float qy, float u,
+                            bool free_test) const;
     // `spread` (optional): 1.4826 x the median |residual| of the last iteration's pairs (m).
     bool refineStep(const Scan& scan, const Reference& ref, Pose2D& d,
                     double* spread = nullptr) const;
@@ -251,6 +254,7 @@ class EvidenceFilter {
     std::vector<std::uint8_t> evidence_;  // per beam: Evidence
     std::vector<float> sums_;             // per segment: range sum
     std::vector<std::uint32_t> unknown_;  // beams classified unknown against the newest keyframe
+    std::vector<float> batch_;            // returns to classify: points, projections, brackets
     std::vector<std::uint32_t> free_in_, supported_in_, classified_in_;  // per segment
     std::vector<std::uint32_t> order_;                                   // segments by size
     std::vector<std::uint8_t> small_;                                    // per segment: small
@@ -266,6 +270,7 @@ class EvidenceFilter {
     RawScan next_raw_;                      // its copy (reused buffers)
     Reference next_ref_;                    // converted
     mutable std::vector<float> residuals_;  // refineStep's last iteration |e|
+    mutable std::vector<float> align_;      // refineStep's samples, projections, brackets
     Pose2D pose_;                           // this scan's refined pose (when have_pose_)
     bool have_pose_ = false;
 };
