@@ -6,13 +6,8 @@
 # Usage: bash scripts/denoise-real.sh [LOG ...]   (default: all six; after demo.sh built)
 # Output: out/denoise-real/LOG-METHOD-{noisy,clean}.txt
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-data="${KFD_DATASETS_DIR:-$root/../shared/datasets}"
-bin="$root/build/apps"
+source "$(dirname "${BASH_SOURCE[0]}")/real-logs.sh"
 out="$root/out/denoise-real"
-for t in kfd-inject kfd-denoise-eval; do
-  [ -x "$bin/$t" ] || { echo "build $t first (bash scripts/demo.sh)" >&2; exit 1; }
-done
 mkdir -p "$out"
 cd "$out"
 echo "scan,timestamp,beam,kind" > empty.csv
@@ -25,13 +20,9 @@ done
 for st in dbscan radius sor shadow; do sed -e "s/^pipeline = .*/pipeline = $st/" "$base" > "$st.ini"; done
 { cat shadow.ini; echo "shadow_neighbors = 1"; } > shadow1.ini
 logs=("$@")
-[ ${#logs[@]} -gt 0 ] || logs=(fr079 aces intel mit-csail mines-exp1 mines-exp2)
+[ ${#logs[@]} -gt 0 ] || logs=("${all_logs[@]}")
 for log in "${logs[@]}"; do
-  case $log in
-    mines-exp1) src="$data/mines-urg/exp1.rawlog" ;;
-    mines-exp2) src="$data/mines-urg/exp2.rawlog" ;;
-    *) src="$data/$log/$log.rawlog" ;;
-  esac
+  src="$(log_path "$log")"
   [ -f "$src" ] || { echo "missing: $src" >&2; continue; }
   echo "== $log" >&2
   [ -f "$log-noisy.rawlog" ] || "$bin/kfd-inject" -q -i "$src" -o "$log-noisy.rawlog" --seed 2 > "$log-inject.txt"

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Markdown tables of scripts/denoise-temporal.sh's results (issue 25).
-Usage: python3 scripts/denoise_temporal_table.py out/denoise-temporal/seed7 [N ...]"""
+"""Markdown tables of scripts/denoise-variants.sh's results (issue 25): per log and variant the
+recall of each noise kind, precision and the real returns kept, then recall per noise model.
+Usage: python3 scripts/denoise_variants_table.py out/denoise-variants/seed11 NAME ..."""
 import pathlib
 import re
 import sys
@@ -19,15 +20,15 @@ def read(path):
 
 def main():
     d = pathlib.Path(sys.argv[1])
-    ns = sys.argv[2:] or ["0", "1"]
+    ns = sys.argv[2:]
     logs = ["fr079", "aces", "intel", "mit-csail", "mines-exp1", "mines-exp2"]
     models = None
-    print("| log | temporal_scans | scored (kept of all) | isolated | clustered | mixed (edge) | all | precision | real kept (noisy) | real kept (clean) |")
+    print("| log | variant | scored (kept of all) | isolated | clustered | mixed (edge) | all | precision | real kept (noisy) | real kept (clean) |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     per_model = []
     for log in logs:
         for n in ns:
-            noisy, clean = d / f"{log}-t{n}-noisy.txt", d / f"{log}-t{n}-clean.txt"
+            noisy, clean = d / f"{log}-{n}-noisy.txt", d / f"{log}-{n}-clean.txt"
             if not noisy.exists() or not clean.exists():
                 continue
             a, c = read(noisy), read(clean)
@@ -39,7 +40,7 @@ def main():
             per_model.append((log, n, {m: v for m, v, _ in ms}))
     if models:
         print()
-        print("| log | temporal_scans | " + " | ".join(models) + " |")
+        print("| log | variant | " + " | ".join(models) + " |")
         print("|---|---|" + "---|" * len(models))
         for log, n, vals in per_model:
             print(f"| {log} | {n} | " + " | ".join(vals.get(m, "-") for m in models) + " |")
