@@ -230,27 +230,31 @@ TEST(RawlogFilter, OutputOpensInRawlogEdit) {
         << text;
 }
 
+// 30 steps of two 180-degree lasers (FRONT, REAR: 361 beams, FRONT 541 from step 20) and an
+// odometry observation each.
+static void writeTwoSensorLog(const std::string& path) {
+    mrpt::io::CFileGZOutputStream f(path);
+    auto arch = mrpt::serialization::archiveFrom(f);
+    for (int k = 0; k < 30; ++k) {
+        for (const char* label : {"FRONT", "REAR"}) {
+            CObservation2DRangeScan s;
+            s.sensorLabel = label;
+            s.timestamp = mrpt::Clock::fromDouble(1000.0 + 0.1 * k);
+            const std::size_t beams = (k >= 20 && label[0] == 'F') ? 541 : 361;
+            s.aperture = static_cast<float>(M_PI);
+            s.resizeScanAndAssign(beams, 4.0f, true);
+            arch << s;
+        }
+        mrpt::obs::CObservationOdometry odo;
+        odo.timestamp = mrpt::Clock::fromDouble(1000.0 + 0.1 * k);
+        arch << odo;
+    }
+}
+
 TEST(RawlogFilter, TwoSensorsAndAGeometryChangeInOneLog) {
     TempDir dir;
     const std::string in = dir / "synthetic.rawlog";
-    {
-        mrpt::io::CFileGZOutputStream f(in);
-        auto arch = mrpt::serialization::archiveFrom(f);
-        for (int k = 0; k < 30; ++k) {
-            for (const char* label : {"FRONT", "REAR"}) {
-                CObservation2DRangeScan s;
-                s.sensorLabel = label;
-                s.timestamp = mrpt::Clock::fromDouble(1000.0 + 0.1 * k);
-                const std::size_t beams = (k >= 20 && label[0] == 'F') ? 541 : 361;
-                s.aperture = static_cast<float>(M_PI);
-                s.resizeScanAndAssign(beams, 4.0f, true);
-                arch << s;
-            }
-            mrpt::obs::CObservationOdometry odo;
-            odo.timestamp = mrpt::Clock::fromDouble(1000.0 + 0.1 * k);
-            arch << odo;
-        }
-    }
+    writeTwoSensorLog(in);
     auto o = optionsFor(in, dir / "out.rawlog");
     const auto s = kfd::RawlogFilter().run(o);
     EXPECT_EQ(s.sensors, 2u);
@@ -266,24 +270,7 @@ TEST(RawlogFilter, TwoSensorsAndAGeometryChangeWithNextScanConserveEverything) {
     // output keeps the input's order and loses nothing.
     TempDir dir;
     const std::string in = dir / "synthetic.rawlog";
-    {
-        mrpt::io::CFileGZOutputStream f(in);
-        auto arch = mrpt::serialization::archiveFrom(f);
-        for (int k = 0; k < 30; ++k) {
-            for (const char* label : {"FRONT", "REAR"}) {
-                CObservation2DRangeScan s;
-                s.sensorLabel = label;
-                s.timestamp = mrpt::Clock::fromDouble(1000.0 + 0.1 * k);
-                const std::size_t beams = (k >= 20 && label[0] == 'F') ? 541 : 361;
-                s.aperture = static_cast<float>(M_PI);
-                s.resizeScanAndAssign(beams, 4.0f, true);
-                arch << s;
-            }
-            mrpt::obs::CObservationOdometry odo;
-            odo.timestamp = mrpt::Clock::fromDouble(1000.0 + 0.1 * k);
-            arch << odo;
-        }
-    }
+    writeTwoSensorLog(in);
     auto o = optionsFor(in, dir / "out.rawlog");
     auto off = o;
     off.output = dir / "off.rawlog";

@@ -134,13 +134,16 @@ void EvidenceFilter::observe(const Scan& scan) {
     if (!raw_.empty() && params_.temporal) keepRaw(scan);
 }
 
+void EvidenceFilter::RawScan::copy(const Scan& scan) {
+    geometry = scan.geometry;
+    range.assign(scan.range.begin(), scan.range.end());
+    valid.assign(scan.valid.begin(), scan.valid.end());
+    has_odom = scan.odometry.has_value();
+    odom = has_odom ? compose(*scan.odometry, scan.sensor_pose) : Pose2D{};
+}
+
 void EvidenceFilter::keepRaw(const Scan& scan) {
-    RawScan& w = raw_[raw_next_];
-    w.geometry = scan.geometry;
-    w.range.assign(scan.range.begin(), scan.range.end());
-    w.valid.assign(scan.valid.begin(), scan.valid.end());
-    w.has_odom = scan.odometry.has_value();
-    w.odom = w.has_odom ? compose(*scan.odometry, scan.sensor_pose) : Pose2D{};
+    raw_[raw_next_].copy(scan);
     raw_next_ = (raw_next_ + 1) % raw_.size();
     raw_count_ = std::min(raw_count_ + 1, raw_.size());
 }
@@ -197,26 +200,33 @@ bool EvidenceFilter::convertInto(const RawScan& w, Reference& r, const Scan& sca
     return true;
 }
 
-EvidenceFilter::Projection EvidenceFilter::recentProjection(const Scan& scan, std::size_t age,
-                                                            double sigma, Result& res) {
+EvidenceFilter::Projection EvidenceFilter::rawProjection(const Scan& scan, const Reference& ref,
+                                                         double sigma, double* base) const {
     Projection pr;
-    if (!convertRaw(scan, age, sigma)) return pr;
     Pose2D d;  // this scan's sensor in the raw scan's frame
-    if (scan.odometry && recent_.has_odom)
-        d = between(recent_.odom, compose(*scan.odometry, scan.sensor_pose));
-    else if (scan.odometry || recent_.has_odom)
+    if (scan.odometry && ref.has_odom)
+        d = between(ref.odom, compose(*scan.odometry, scan.sensor_pose));
+    else if (scan.odometry || ref.has_odom)
         return pr;  // no common frame
-    if (!projection(recent_, d, sigma).usable) return pr;
+    if (!projection(ref, d, sigma).usable) return pr;
     double spread = 0.0;
-    if (!refineStep(scan, recent_, d, &spread)) return pr;  // no alignment: no margin to trust
-    pr = projection(recent_, d, sigma);
+    if (!refineStep(scan, ref, d, &spread)) return pr;  // no alignment: no margin to trust
+    pr = projection(ref, d, sigma);
     // The margin from what was measured: the larger of the two scans' range noise and the
     // alignment's own residual spread (3 standard deviations), plus the odometry-error share
     // of this (short) step; no constant pose error.
-    const double base = 3.0 * std::max(std::sqrt(2.0) * sigma, spread);
-    pr.m0 = static_cast<float>(base + params_.motion_error_fraction * std::hypot(d.x, d.y));
+    *base = 3.0 * std::max(std::sqrt(2.0) * sigma, spread);
+    pr.m0 = static_cast<float>(*base + params_.motion_error_fraction * std::hypot(d.x, d.y));
     pr.m1 = static_cast<float>(params_.motion_error_fraction * std::abs(d.phi));
-    if (age == 0) res.recent_margin_m = base;
+    return pr;
+}
+
+EvidenceFilter::Projection EvidenceFilter::recentProjection(const Scan& scan, std::size_t age,
+                                                            double sigma, Result& res) {
+    if (!convertRaw(scan, age, sigma)) return Projection{};
+    double base = 0.0;
+    const Projection pr = rawProjection(scan, recent_, sigma, &base);
+    if (pr.usable && age == 0) res.recent_margin_m = base;
     return pr;
 }
 
@@ -224,28 +234,11 @@ EvidenceFilter::Projection EvidenceFilter::nextProjection(const Scan& scan, doub
                                                           Result& res) {
     // Step 3c: the next scan, copied and converted like a raw scan of step 3b, aligned the
     // same way and with the same margins.
-    Projection pr;
-    const Scan& next = *next_;
-    RawScan& w = next_raw_;
-    w.geometry = next.geometry;
-    w.range.assign(next.range.begin(), next.range.end());
-    w.valid.assign(next.valid.begin(), next.valid.end());
-    w.has_odom = next.odometry.has_value();
-    w.odom = w.has_odom ? compose(*next.odometry, next.sensor_pose) : Pose2D{};
-    if (!convertInto(w, next_ref_, scan, sigma)) return pr;
-    Pose2D d;  // this scan's sensor in the next scan's frame
-    if (scan.odometry && next_ref_.has_odom)
-        d = between(next_ref_.odom, compose(*scan.odometry, scan.sensor_pose));
-    else if (scan.odometry || next_ref_.has_odom)
-        return pr;  // no common frame
-    if (!projection(next_ref_, d, sigma).usable) return pr;
-    double spread = 0.0;
-    if (!refineStep(scan, next_ref_, d, &spread)) return pr;
-    pr = projection(next_ref_, d, sigma);
-    const double base = 3.0 * std::max(std::sqrt(2.0) * sigma, spread);
-    pr.m0 = static_cast<float>(base + params_.motion_error_fraction * std::hypot(d.x, d.y));
-    pr.m1 = static_cast<float>(params_.motion_error_fraction * std::abs(d.phi));
-    res.next = true;
+    next_raw_.copy(*next_);
+    if (!convertInto(next_raw_, next_ref_, scan, sigma)) return Projection{};
+    double base = 0.0;
+    const Projection pr = rawProjection(scan, next_ref_, sigma, &base);
+    res.next = pr.usable;
     return pr;
 }
 

@@ -202,6 +202,7 @@ class EvidenceFilter {
         std::vector<std::uint8_t> valid;
         bool has_odom = false;
         Pose2D odom;
+        void copy(const Scan& scan);  // ranges, flags, odometry pose (buffers reused)
     };
     // A reference seen from this scan: the step and the margins (m0 + m1 x range).
     struct Projection {
@@ -225,6 +226,10 @@ class EvidenceFilter {
     bool refineStep(const Scan& scan, const Reference& ref, Pose2D& d,
                     double* spread = nullptr) const;
     // Step 3b: the newest raw scan as a projection (usable = false when it cannot be used).
+    // Steps 3b/3c: a converted raw scan aligned from odometry (or zero motion) and its margin
+    // from the alignment (`base`: 3 max(sqrt 2 sigma, s)); usable = false without one.
+    Projection rawProjection(const Scan& scan, const Reference& ref, double sigma,
+                             double* base) const;
     Projection recentProjection(const Scan& scan, std::size_t age, double sigma, Result& res);
     // Converts raw scan `age` (0 = newest) into recent_ (points, breakpoint links).
     bool convertRaw(const Scan& scan, std::size_t age, double sigma);
