@@ -22,6 +22,7 @@ also simulated again with seed K + 1.
   kfd-compare collect OUT       # summary.md, report.md, runs.csv, runs.json, plots/
   kfd-compare diagnose OUT --modes kfd odometry@kfd   # where the drops cost: diagnose.md
   kfd-compare configs OUT --mode kfd --configs A.ini B.ini   # one mode, two configs: configs.md
+  kfd-compare curve OUT --reference none@A --key max_view_change   # every config vs one: curve.md
 
 Logs: a dataset folder name under --datasets (NAME/NAME.rawlog with NAME.relations) or a path
 to any log kfd-icp-slam reads: a .rawlog, a ROS 1 bag or a CARMEN log (NAME.relations and
@@ -503,6 +504,96 @@ def compare_configs(out, mode, config_a, config_b):
     return "\n".join(lines) + "\n"
 
 
+def kfd_key(config_path, key):
+    """The value of KEY in the [KFD] section of a kfd-icp-slam .ini (the last one given; a
+    trailing '# comment' cut), None when the file or the key is missing."""
+    value, section = None, None
+    try:
+        lines = open(config_path).read().splitlines()
+    except OSError:
+        return None
+    for line in lines:
+        line = line.split("#", 1)[0].strip()
+        if line.startswith("[") and line.endswith("]"):
+            section = line[1:-1].strip()
+        elif section == "KFD" and "=" in line:
+            k, v = line.split("=", 1)
+            if k.strip() == key:
+                value = v.strip()
+    return value
+
+
+def compare_curve(out, mode, reference, key=None, factor=kfd_report.FAILURE_FACTOR):
+    """Markdown: MODE under every config of OUT against one reference (REF_MODE@CONFIG, e.g.
+    none@default: a mode that ignores the [KFD] section, run once), paired by repeat, one table
+    per log, a row per config (sorted by name): n, failed runs (report.py's rule, judged against
+    the reference's medians), median drop %, and per error the log gives (local and long
+    relations error, else ATE) the median, the median of the per-run ratios to the reference and
+    W/L with the sign test's p; the median per-run CPU ratio; the worst run. With KEY, a column
+    with that [KFD] key's value read from each config's .ini (as the run's command names it).
+    For a curve over one [KFD] knob (e.g. max_view_change: the drop rate)."""
+    if "@" not in reference:
+        raise CompareError("--reference is MODE@CONFIG (e.g. none@default), got '%s'" % reference)
+    ref_mode, ref_config = reference.split("@", 1)
+    ref_config = config_tag(ref_config)
+    by = {}
+    for r in load_runs(out):
+        by.setdefault((r["log"], r["config"], r["mode"]), {})[r["repeat"]] = r
+    logs = sorted({log for log, c, m in by if c == ref_config and m == ref_mode})
+    if not logs:
+        raise CompareError("no '%s' runs under %s in %s" % (ref_mode, ref_config, out))
+    lines = ["# %s against %s (%s), by config" % (mode, ref_mode, ref_config), "",
+             "Paired by repeat with %s's runs under %s. ratio: median of the per-run ratios "
+             "%s/%s; W/L: runs where %s is lower / higher, p: two-sided exact sign test; CPU: "
+             "user+sys; failed: did not finish, or an error above %g x %s's median (the "
+             "reference row judges %s's runs the same way); worst: the run with the largest "
+             "long error (local without long relations, ATE without relations)."
+             % (ref_mode, ref_config, mode, ref_mode, mode, factor, ref_mode, ref_mode), ""]
+    for log in logs:
+        ref = by[(log, ref_config, ref_mode)]
+        configs = sorted(c for l, c, m in by if l == log and m == mode)
+        if not configs:
+            continue
+        groups = [(c, kfd_report.Group(log, c, {mode: by[(log, c, mode)], ref_mode: ref},
+                                       ref_mode, factor)) for c in configs]
+        judged = groups[0][1].judged
+        head = ["config"] + ([key] if key else []) + ["n", "failed", "dropped %"]
+        for m in judged:
+            head += ["%s (m)" % kfd_report.NAMES[m], "ratio", "W/L (p)"]
+        head += ["CPU ratio", "worst run"]
+        lines += ["## %s" % log, "", "| " + " | ".join(head) + " |",
+                  "|---|" + "---:|" * (len(head) - 2) + "---|"]
+
+        def row(name, g, m_, vs_ref):
+            runs = g.mode_runs(m_)
+            cells = [name]
+            if key:  # the reference row: its mode ignores [KFD]
+                cmd = next((r["command"] for r in runs if r.get("command")), []) \
+                    if vs_ref else []
+                v = kfd_key(cmd[1], key) if len(cmd) > 1 else None
+                cells.append(v if v is not None else "–")
+            cells += [str(len(runs)), "%d/%d" % (g.failed(m_), len(runs)),
+                      fmt(g.summary[m_]["drop"]["median"], 1)]
+            for m in judged:
+                cells.append(fmt(g.summary[m_][m]["median"]))
+                res = g.results.get((m_, ref_mode), {}).get(m) if vs_ref else None
+                cells += ["%.2f" % res["median_ratio"], "%d/%d (%s)" % (
+                    res["wins"], res["losses"], fmt_p(res["p_sign"]))] if res else ["", ""]
+            res = g.results.get((m_, ref_mode), {}).get("cpu") if vs_ref else None
+            cells.append("%.2f" % res["median_ratio"] if res else "")
+            w = g.worst[m_]
+            wk = kfd_report.worst_key(judged)
+            cells.append("r%02d %s m" % (w["repeat"], fmt(w[wk])) if w else "–")
+            return "| " + " | ".join(cells) + " |"
+
+        first = groups[0][1]
+        lines.append(row("%s (%s)" % (ref_mode, ref_config), first, ref_mode, False))
+        for c, g in groups:
+            lines.append(row(c, g, mode, True))
+        lines.append("")
+    return "\n".join(lines)
+
+
 def build_parser():
     """kfd-compare's command line: run, job, collect, diagnose."""
     ap = argparse.ArgumentParser(
@@ -566,6 +657,17 @@ def build_parser():
     k.add_argument("--mode", default="kfd", help="the mode to compare (default: kfd)")
     k.add_argument("--configs", nargs=2, required=True, metavar=("A", "B"),
                    help="the two kfd-icp-slam .ini files (or their names) of the run")
+    v = sub.add_parser("curve", help="one mode under every config against one reference run, "
+                       "paired by repeat", **fmt)
+    v.add_argument("dir", help="a comparison's output folder")
+    v.add_argument("--mode", default="kfd", help="the mode whose configs make the rows")
+    v.add_argument("--reference", required=True, metavar="MODE@CONFIG",
+                   help="the runs every row is paired with (e.g. none@default: a mode that "
+                   "ignores [KFD], run under one config)")
+    v.add_argument("--key", help="a [KFD] key whose value (from each config's .ini) is shown")
+    v.add_argument("--failure-factor", type=float, default=kfd_report.FAILURE_FACTOR,
+                   metavar="F", help="a run fails when an error is above F x the reference's "
+                   "median on its log")
     g = sub.add_parser("diagnose", help="gaps between kept scans and the local error they cost",
                        **fmt)
     g.add_argument("dir", help="a comparison's output folder")
@@ -589,6 +691,12 @@ def main(argv=None):
         if a.command == "configs":
             text = compare_configs(a.dir, a.mode, a.configs[0], a.configs[1])
             with open(os.path.join(a.dir, "configs.md"), "w") as f:
+                f.write(text)
+            sys.stdout.write(text)
+            return 0
+        if a.command == "curve":
+            text = compare_curve(a.dir, a.mode, a.reference, a.key, a.failure_factor)
+            with open(os.path.join(a.dir, "curve.md"), "w") as f:
                 f.write(text)
             sys.stdout.write(text)
             return 0

@@ -33,6 +33,8 @@ NOT_RUN = {
     "kfd-compare --datasets": "an option of kfd-compare run, quoted in a sentence",
     "kfd-compare configs": "needs a finished comparison with two configs (kfd_compare_test runs "
     "it on hand-made runs)",
+    "kfd-compare curve": "needs a finished comparison with several configs (kfd_compare_test "
+    "runs it on hand-made runs)",
     "export ROS_PACKAGE_PATH": "ROS 1 node: needs a ROS master (the ros1 tests run the node)",
     "ROS_PACKAGE_PATH=build/ros roslaunch ": "ROS 1 launch: needs a ROS master (kfd_launch_test "
     "runs both launch files)",
@@ -293,7 +295,7 @@ class UsageMatchesHelp(unittest.TestCase):
         self.usage = open(os.path.join(SRC, "docs/USAGE.md"), encoding="utf-8").read()
         self.helps = {t: help_options([os.path.join(APPS, t)]) for t in TOOLS}
         compare = [os.path.join(SRC, "scripts", "kfd-compare")]
-        for sub in ("run", "job", "collect", "diagnose"):
+        for sub in ("run", "job", "collect", "diagnose", "curve"):
             r = subprocess.run(compare + [sub, "--help"], capture_output=True, text=True)
             if r.returncode == 0:
                 self.helps["kfd-compare " + sub] = help_options(compare + [sub])

@@ -61,6 +61,61 @@ class KfdCompare(unittest.TestCase):
         self.assertEqual(bad.returncode, 1)
         self.assertIn("no log has finished 'kfd' runs under both cfgA and cfgC", bad.stderr)
 
+    def test_curve_pairs_every_config_with_one_reference_run(self):
+        out = os.path.join(self.tmp, "out")
+        ini = {}
+        for name, vc in (("ref", "0.75"), ("lo", "0.40"), ("hi", "1.20")):
+            ini[name] = os.path.join(self.tmp, name + ".ini")
+            with open(ini[name], "w") as f:  # a later key wins; comments are cut
+                f.write("[ICP]\nmax_view_change = 9\n[KFD]\nmax_view_change = 0.5\n"
+                        "max_view_change = %s   # the knob\n" % vc)
+
+        def runs(config, mode, local, drop, cpu, finished=True):
+            for k, v in enumerate(local):
+                d = os.path.join(out, "runs", "L", config, mode, "r%02d" % k)
+                os.makedirs(d)
+                run = {"log": "L", "config": config, "mode": mode, "repeat": k,
+                       "finished": True, "local": v, "long": 2 * v, "drop": drop, "cpu": cpu,
+                       "command": ["kfd-icp-slam", ini[config], "L.rawlog"]}
+                if not finished and k == 0:
+                    run = {"log": "L", "config": config, "mode": mode, "repeat": k,
+                           "finished": False, "error": "killed"}
+                with open(os.path.join(d, "run.json"), "w") as f:
+                    json.dump(run, f)
+
+        none = [0.10] * 8
+        runs("ref", "none", none, 0.0, 10.0)
+        runs("ref", "kfd", [0.12] * 7 + [0.08], 60.0, 5.0)  # 1 win, 7 losses
+        runs("lo", "kfd", [0.10] * 6 + [0.09, 0.50], 30.0, 8.0)  # r07: 5 x none's median
+        runs("hi", "kfd", [0.20] * 4, 80.0, 2.0, finished=False)  # r00 did not finish
+        runs("ref", "odometry@kfd", [0.3] * 8, 60.0, 5.0)  # another mode: not a row
+        r = compare("curve", out, "--reference", "none@ref.ini", "--key", "max_view_change")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        rows = [line for line in r.stdout.splitlines() if line.startswith("| ")]
+        self.assertIn("| config | max_view_change | n | failed | dropped % | local error (m) | "
+                      "ratio | W/L (p) | long error (m) | ratio | W/L (p) | CPU ratio | "
+                      "worst run |", rows[0])
+        # none's row first (its mode ignores [KFD]), then the configs by name, paired by repeat
+        self.assertEqual(rows[1], "| none (ref) | – | 8 | 0/8 | 0.0 | 0.100 |  |  | 0.200 |  "
+                         "|  |  | r00 0.200 m |")
+        self.assertEqual(rows[2].split(" | ")[:8], ["| hi", "1.20", "4", "1/4", "80.0",
+                                                    "0.200", "2.00", "0/3 (0.25)"])
+        lo = rows[3].split(" | ")
+        self.assertEqual(lo[:8], ["| lo", "0.40", "8", "1/8", "30.0", "0.100", "1.00",
+                                  "1/1 (1.00)"])  # six ties
+        self.assertEqual(lo[-2:], ["0.80", "r07 1.000 m |"])
+        ref = rows[4].split(" | ")
+        self.assertEqual(ref[:8], ["| ref", "0.75", "8", "0/8", "60.0", "0.120", "1.20",
+                                   "1/7 (0.07)"])
+        self.assertEqual(ref[-2], "0.50")
+        self.assertEqual(open(os.path.join(out, "curve.md")).read(), r.stdout)
+        bad = compare("curve", out, "--reference", "none@other")
+        self.assertEqual(bad.returncode, 1)
+        self.assertIn("no 'none' runs under other", bad.stderr)
+        bad = compare("curve", out, "--reference", "none")
+        self.assertEqual(bad.returncode, 1)
+        self.assertIn("--reference is MODE@CONFIG", bad.stderr)
+
     def test_small_run_reports_every_log_mode_and_pair(self):
         csail = os.path.join(DATASETS, "mit-csail", "mit-csail.rawlog")
         if not os.path.exists(csail):
