@@ -235,18 +235,25 @@ TEST(EvidenceFilter, WhenTheScanJustBeforeWantsTooMuchTheKeyframesAloneDecide) {
     }
 }
 
-// The keyframe 1 m back, the scan dropped 2 cm before the next keyframe (`recent`), and that
-// keyframe with a burst of beams [first, last] 0.3 m in front of the wall.
-EvidenceFilter::Result burstAfter(const EvidenceFilter::Params& p, const Scan& recent,
-                                  std::size_t first, std::size_t last, Scan& out) {
+// The keyframe room(), then the scan `before` dropped, then `key` filtered (with `after` as
+// its next scan when given).
+EvidenceFilter::Result keyframeAfter(const EvidenceFilter::Params& p, const Scan& before, Scan& key,
+                                     const Scan* after = nullptr) {
     EvidenceFilter f(p);
     Clusters c;
     Scan start = room();
     f.filter(start, c);
-    f.observe(recent);
+    f.observe(before);
+    return f.filter(key, c, after);
+}
+
+// The keyframe 1 m back, the scan dropped 2 cm before the next keyframe (`recent`), and that
+// keyframe with a burst of beams [first, last] 0.3 m in front of the wall.
+EvidenceFilter::Result burstAfter(const EvidenceFilter::Params& p, const Scan& recent,
+                                  std::size_t first, std::size_t last, Scan& out) {
     out = roomAfter(1.0);
     test::setRange(out, first, last, 2.7);
-    return f.filter(out, c);
+    return keyframeAfter(p, recent, out);
 }
 
 TEST(EvidenceFilter, ABurstAboveTheBoundIsRemovedWholeWhenTheScanJustBeforeConfirmsIt) {
@@ -350,17 +357,12 @@ TEST(EvidenceFilter, ABurstOnlyInTheKeyframeIsRemovedWithTheScanJustAfter) {
     // has dropouts there (no verdict); the keyframe 1 m back supports the burst (its wide
     // margin). Without the next scan it stays; the scan 2 cm after sees through it.
     for (const bool next : {false, true}) {
-        EvidenceFilter f(withNext(next));
-        Clusters c;
-        Scan first = room();
-        f.filter(first, c);
         Scan before = roomAfter(0.98);
         for (std::size_t i = 175; i <= 185; ++i) before.valid[i] = 0;
-        f.observe(before);
         Scan key = roomAfter(1.0);
         test::setRange(key, 178, 182, 2.72f);  // its own segment (0.19 m breakpoint)
         const Scan after = roomAfter(1.02);
-        const auto r = f.filter(key, c, &after);
+        const auto r = keyframeAfter(withNext(next), before, key, &after);
         EXPECT_TRUE(r.recent);
         EXPECT_EQ(r.next, next);
         for (std::size_t i = 178; i <= 182; ++i) EXPECT_EQ(key.valid[i], next ? 0 : 1) << i;
@@ -377,14 +379,9 @@ TEST(EvidenceFilter, ASurfaceThatAppearsInTheKeyframeAndStaysInTheNextScanIsKept
         return s;
     };
     for (const bool next : {false, true}) {
-        EvidenceFilter f(withNext(next));
-        Clusters c;
-        Scan first = room();
-        f.filter(first, c);
-        f.observe(roomAfter(0.98));
         Scan key = withSurface(roomAfter(1.0));
         const Scan after = withSurface(roomAfter(1.02));
-        const auto r = f.filter(key, c, &after);
+        const auto r = keyframeAfter(withNext(next), roomAfter(0.98), key, &after);
         EXPECT_TRUE(r.recent);
         EXPECT_EQ(r.next, next);
         for (std::size_t i = 175; i <= 186; ++i) EXPECT_EQ(key.valid[i], next ? 1 : 0) << i;

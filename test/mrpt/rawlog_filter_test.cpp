@@ -313,15 +313,16 @@ TEST(RawlogFilter, NextScanKeepsTheSameScansInTheSameOrderOnTheBundledLog) {
         }
     }
     EXPECT_LT(differ, a.points_in / 100);  // the denoiser's verdicts differ on a few returns
-    auto firstColumn = [](const std::string& path) {
+    // Each line's first field (up to `sep`): the CSV's index, the CARMEN line's kind.
+    auto firstFields = [](const std::string& path, char sep) {
         std::ifstream f(path);
         std::vector<std::string> v;
         std::string line;
-        while (std::getline(f, line)) v.push_back(line.substr(0, line.find(',')));
+        while (std::getline(f, line)) v.push_back(line.substr(0, line.find(sep)));
         return v;
     };
-    const auto ia = firstColumn(on.stats_csv);
-    EXPECT_EQ(ia, firstColumn(off.stats_csv));
+    const auto ia = firstFields(on.stats_csv, ',');
+    EXPECT_EQ(ia, firstFields(off.stats_csv, ','));
     EXPECT_EQ(ia.size(), a.scans_in + 1);  // a header and one row per scan
 
     // A CARMEN output: the same kinds of line in the same order.
@@ -330,15 +331,8 @@ TEST(RawlogFilter, NextScanKeepsTheSameScansInTheSameOrderOnTheBundledLog) {
     on.stats_csv = off.stats_csv = "";
     kfd::RawlogFilter().run(on);
     kfd::RawlogFilter().run(off);
-    auto kinds = [](const std::string& path) {
-        std::ifstream f(path);
-        std::vector<std::string> v;
-        std::string line;
-        while (std::getline(f, line)) v.push_back(line.substr(0, line.find(' ')));
-        return v;
-    };
-    const auto ka = kinds(on.output);
-    EXPECT_EQ(ka, kinds(off.output));
+    const auto ka = firstFields(on.output, ' ');
+    EXPECT_EQ(ka, firstFields(off.output, ' '));
     EXPECT_GT(ka.size(), a.scans_kept);
 }
 

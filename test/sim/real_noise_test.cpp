@@ -179,15 +179,21 @@ TEST(RealNoiseInjector, BadParametersAreErrors) {
 // labelled beam is counted under its model, a clean score removes nothing labelled.
 namespace {
 
-TEST(NoisyLog, LabelsMatchTheInjectedBeamsAndScoreBackPerModel) {
-    namespace fs = std::filesystem;
-    const std::string office = std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog";
-    kfd::test::TempDir dir("kfd_noisy_");
-    kfd::NoisyLogOptions o;
-    o.input = office;
+const std::string kOffice = std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog";
+
+// The bundled log with kfd-inject's noise, seed 3, as DIR/noisy.rawlog (options in `o`).
+kfd::NoisyLogSummary noisyOffice(const kfd::test::TempDir& dir, kfd::NoisyLogOptions& o) {
+    o.input = kOffice;
     o.output = dir / "noisy.rawlog";
     o.seed = 3;
-    const auto s = kfd::writeNoisyLog(o);
+    return kfd::writeNoisyLog(o);
+}
+
+TEST(NoisyLog, LabelsMatchTheInjectedBeamsAndScoreBackPerModel) {
+    namespace fs = std::filesystem;
+    kfd::test::TempDir dir("kfd_noisy_");
+    kfd::NoisyLogOptions o;
+    const auto s = noisyOffice(dir, o);
     EXPECT_EQ(s.scans, 600u);
     EXPECT_EQ(s.labels, dir / "noisy.labels.csv");
     EXPECT_GT(s.by_kind[1] + s.by_kind[2] + s.by_kind[3], 1000u);
@@ -225,9 +231,9 @@ TEST(NoisyLog, LabelsMatchTheInjectedBeamsAndScoreBackPerModel) {
     }
     EXPECT_EQ(calls.back(), std::make_pair(1.0, s.scans));
     o.on_progress = nullptr;
-    o.output = office;
+    o.output = kOffice;
     EXPECT_ANY_THROW(kfd::writeNoisyLog(o));
-    EXPECT_TRUE(fs::exists(office));
+    EXPECT_TRUE(fs::exists(kOffice));
 }
 
 }  // namespace
@@ -237,13 +243,9 @@ namespace {
 // kfd-denoise-eval with next_scan (issue 25): a held keyframe is scored once finished (the
 // last one at the end of the log); the same scans are scored and every labelled beam counted.
 TEST(NoisyLog, WithNextScanTheSameScansAreScoredOnceFinished) {
-    const std::string office = std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog";
     kfd::test::TempDir dir("kfd_noisy_next_");
     kfd::NoisyLogOptions o;
-    o.input = office;
-    o.output = dir / "noisy.rawlog";
-    o.seed = 3;
-    const auto s = kfd::writeNoisyLog(o);
+    const auto s = noisyOffice(dir, o);
     kfd::Pipeline::Params off =
         kfd::loadConfigFile(std::string(KFD_SOURCE_DIR) + "/share/kfd/default.ini");
     kfd::Pipeline::Params on = off;

@@ -66,18 +66,9 @@ std::vector<StageKey> DenoiseStage::keys() {
         keys::count<P>("max_small_points", "max_small_points",
                        "evidence: segments of at most this many points may be small", 0, 1000,
                        [](P& p) -> std::size_t& { return p.evidence.max_small_points; }),
-        keys::custom<P>(
-            "temporal", "temporal", "evidence: compare with the previous keyframe (needs odometry)",
-            "true, false",
-            [](P& p, const std::string& text) {
-                if (text == "true" || text == "1")
-                    p.evidence.temporal = true;
-                else if (text == "false" || text == "0")
-                    p.evidence.temporal = false;
-                else
-                    throw ParameterError("temporal", "temporal must be true or false");
-            },
-            [](const P& p) { return std::string(p.evidence.temporal ? "true" : "false"); }),
+        keys::boolean<P>("temporal", "temporal",
+                         "evidence: compare with the previous keyframe (needs odometry)",
+                         [](P& p) -> bool& { return p.evidence.temporal; }),
         keys::real<P>("pose_trans_error_m", "pose_trans_error_m",
                       "evidence: odometry translation error of one keyframe step (m)", 0, 10, false,
                       [](P& p) -> double& { return p.evidence.pose_trans_error_m; }),
@@ -102,21 +93,10 @@ std::vector<StageKey> DenoiseStage::keys() {
                        "evidence: raw scans kept before a keyframe (the dropped ones) as "
                        "temporal evidence with margins from their alignment; 0 = keyframes only",
                        0, 16, [](P& p) -> std::size_t& { return p.evidence.temporal_scans; }),
-        keys::custom<P>(
-            "next_scan", "next_scan",
-            "evidence: also confirm a keyframe against the scan just after it (one scan of "
-            "latency: the keyframe is output when the next scan arrives)",
-            "true, false",
-            [](P& p, const std::string& text) {
-                if (text == "true" || text == "1")
-                    p.evidence.next_scan = true;
-                else if (text == "false" || text == "0")
-                    p.evidence.next_scan = false;
-                else
-                    throw ParameterError("next_scan",
-                                         "next_scan must be true or false, not '" + text + "'");
-            },
-            [](const P& p) { return std::string(p.evidence.next_scan ? "true" : "false"); })};
+        keys::boolean<P>("next_scan", "next_scan",
+                         "evidence: also confirm a keyframe against the scan just after it (one "
+                         "scan of latency: the keyframe is output when the next scan arrives)",
+                         [](P& p) -> bool& { return p.evidence.next_scan; })};
 }
 
 }  // namespace kfd

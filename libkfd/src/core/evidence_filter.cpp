@@ -27,18 +27,22 @@ inline float segmentDistance2(float px, float py, float ax, float ay, float bx, 
 // sqrt(1.5): the residual of a beam against its two neighbours' line has variance 1.5 sigma^2.
 constexpr double kResidualScale = 1.2247448713915889;
 
+/// atan(a) / a for a in [0, 1]: a minimax polynomial (atan to ~1e-5 rad).
+inline float atanUnit(float a) {
+    const float s = a * a;
+    return ((((-0.0117212f * s + 0.05265332f) * s - 0.11643287f) * s + 0.19354346f) * s -
+            0.33262347f) *
+               s +
+           0.99997726f;
+}
+
 /// EvidenceFilter::approxAtan2, inlined where it runs per projected return.
 inline float fastAtan2(float y, float x) {
     const float ax = std::abs(x), ay = std::abs(y);
     const float mx = std::max(ax, ay), mn = std::min(ax, ay);
     if (!(mx > 0.0f)) return 0.0f;
-    const float a = mn / mx, s = a * a;
-    // Minimax polynomial for atan on [0, 1] (error ~1e-5 rad).
-    float r = ((((-0.0117212f * s + 0.05265332f) * s - 0.11643287f) * s + 0.19354346f) * s -
-               0.33262347f) *
-                  s +
-              0.99997726f;
-    r *= a;
+    const float a = mn / mx;
+    float r = atanUnit(a) * a;
     if (ay > ax) r = 1.57079637f - r;
     if (x < 0.0f) r = 3.14159274f - r;
     return y < 0.0f ? -r : r;
@@ -61,16 +65,26 @@ inline float pick(bool c, float a, float b) {
 inline float fastAtan2Select(float y, float x) {
     const float ax = std::abs(x), ay = std::abs(y);
     const float mx = pick(ax < ay, ay, ax), mn = pick(ay < ax, ay, ax);  // std::max, std::min
-    const float a = mn / mx, s = a * a;
-    float r = ((((-0.0117212f * s + 0.05265332f) * s - 0.11643287f) * s + 0.19354346f) * s -
-               0.33262347f) *
-                  s +
-              0.99997726f;
-    r *= a;
+    const float a = mn / mx;
+    float r = atanUnit(a) * a;
     r = pick(ay > ax, 1.57079637f - r, r);
     r = pick(x < 0.0f, 3.14159274f - r, r);
     r = pick(y < 0.0f, -r, r);
     return pick(mx > 0.0f, r, 0.0f);
+}
+
+/// Points (x, y) moved by the rotation (c, s) and translation (tx, ty) into a reference's
+/// frame (qx, qy), and their bracket positions u = (bearing - first) * inv_step in its beams:
+/// one omp simd pass.
+inline void projectPoints(std::size_t m, const float* x, const float* y, float c, float s, float tx,
+                          float ty, float first, float inv_step, float* qx, float* qy, float* u) {
+#pragma omp simd
+    for (std::size_t j = 0; j < m; ++j) {
+        const float px = c * x[j] - s * y[j] + tx, py = s * x[j] + c * y[j] + ty;
+        qx[j] = px;
+        qy[j] = py;
+        u[j] = (fastAtan2Select(py, px) - first) * inv_step;
+    }
 }
 
 }  // namespace
@@ -512,13 +526,7 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
                     s = static_cast<float>(std::sin(d.phi));
         const float tx = static_cast<float>(d.x), ty = static_cast<float>(d.y);
         const float gate_f = static_cast<float>(gate);
-#pragma omp simd
-        for (std::size_t j = 0; j < m; ++j) {
-            const float qx = c * sx[j] - s * sy[j] + tx, qy = s * sx[j] + c * sy[j] + ty;
-            qxs[j] = qx;
-            qys[j] = qy;
-            us[j] = (fastAtan2Select(qy, qx) - first) * inv_step;
-        }
+        projectPoints(m, sx, sy, c, s, tx, ty, first, inv_step, qxs, qys, us);
         PointToLineSystem<float> sys;
         std::size_t kept = 0;
         for (std::size_t j = 0; j < m; ++j) {
@@ -619,17 +627,8 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
         ++listed;
     }
     const Projection& first_pr = pt.usable ? pt : pn.usable ? pn : p0;
-    {
-        const float pc = first_pr.c, ps = first_pr.s, ptx = first_pr.tx, pty = first_pr.ty;
-        const float first = first_, inv_step = inv_step_;
-#pragma omp simd
-        for (std::size_t j = 0; j < listed; ++j) {
-            const float qx = pc * bx[j] - ps * by[j] + ptx, qy = ps * bx[j] + pc * by[j] + pty;
-            bqx[j] = qx;
-            bqy[j] = qy;
-            bu[j] = (fastAtan2Select(qy, qx) - first) * inv_step;
-        }
-    }
+    projectPoints(listed, bx, by, first_pr.c, first_pr.s, first_pr.tx, first_pr.ty, first_,
+                  inv_step_, bqx, bqy, bu);
     for (std::size_t j = 0; j < listed; ++j) {
         const std::size_t i = unknown[j];
         const auto c = static_cast<std::size_t>(labels[i]);

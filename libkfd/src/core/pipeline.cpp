@@ -78,6 +78,25 @@ void Pipeline::add(std::unique_ptr<Stage> stage) {
     stages_.push_back(std::move(stage));
 }
 
+namespace {
+
+// A stage's end: its time since `t` (then `t` moves on) and, when it dropped the scan, the
+// report says so. Returns `keep`.
+bool endStage(const Stage& stage, bool keep, StageReport& sr, ScanReport& report,
+              std::chrono::steady_clock::time_point& t) {
+    const auto now = std::chrono::steady_clock::now();
+    sr.microseconds = std::chrono::duration<double, std::micro>(now - t).count();
+    t = now;
+    if (!keep) {
+        sr.dropped = true;
+        report.keep = false;
+        report.dropped_by = stage.name();
+    }
+    return keep;
+}
+
+}  // namespace
+
 ScanReport Pipeline::process(Scan& scan) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
@@ -117,15 +136,7 @@ ScanReport Pipeline::process(Scan& scan) {
                 stages_[j]->observeDropped(scan);
             }
         }
-        const auto now = Clock::now();
-        sr.microseconds = std::chrono::duration<double, std::micro>(now - t).count();
-        t = now;
-        if (!keep) {
-            sr.dropped = true;
-            report.keep = false;
-            report.dropped_by = stage.name();
-            break;
-        }
+        if (!endStage(stage, keep, sr, report, t)) break;
     }
     if (stages_.empty()) {
         report.microseconds = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
@@ -157,16 +168,9 @@ std::chrono::steady_clock::duration Pipeline::finishHeld(const Scan* next) {
             for (std::size_t j = i + 1; j < stages_.size(); ++j)
                 stages_[j]->observeDropped(held_scan_);
         }
-        const auto now = Clock::now();
-        sr.microseconds = std::chrono::duration<double, std::micro>(now - t).count();
+        const bool kept = endStage(stage, keep, sr, report, t);
         report.microseconds += sr.microseconds;
-        t = now;
-        if (!keep) {
-            sr.dropped = true;
-            report.keep = false;
-            report.dropped_by = stage.name();
-            break;
-        }
+        if (!kept) break;
     }
     report.points_out = held_scan_.countValid();
     // Handed out by finished(); held_scan_ takes the old buffers (no allocation once grown).

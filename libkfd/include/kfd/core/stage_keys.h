@@ -55,6 +55,25 @@ StageKey count(std::string name, std::string field, std::string help, double lo,
     return k;
 }
 
+/// A true/false key ("1"/"0" accepted) bound to the bool that `at` returns;
+/// kfd::ParameterError(field) "FIELD must be true or false, not 'TEXT'" otherwise.
+template <class P, class At>
+StageKey boolean(std::string name, std::string field, std::string help, At at) {
+    StageKey k{std::move(name), std::move(field), std::move(help), "true, false", {}, {}};
+    k.set = [f = k.field, at](void* p, const std::string& text) {
+        if (text == "true" || text == "1")
+            at(*static_cast<P*>(p)) = true;
+        else if (text == "false" || text == "0")
+            at(*static_cast<P*>(p)) = false;
+        else
+            throw ParameterError(f, f + " must be true or false, not '" + text + "'");
+    };
+    k.get = [at](const void* p) {
+        return std::string(at(*const_cast<P*>(static_cast<const P*>(p))) ? "true" : "false");
+    };
+    return k;
+}
+
 /// A key with its own parser and printer.
 template <class P>
 StageKey custom(std::string name, std::string field, std::string help, std::string range,
