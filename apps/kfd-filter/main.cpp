@@ -156,8 +156,9 @@ void printKeys() {
         w_range = std::max(w_range, static_cast<int>(k.range.size()));
     }
     std::printf(
-        "default: the value of a key a configuration file (-c) leaves out; kfd: the value without "
-        "-c\n(share/kfd/default.ini). Units and meanings in the last column.\n");
+        "kfd: kfd's default (share/kfd/default.ini), the value without -c and of a key a\n"
+        "configuration file leaves out; stage: the stage's own (Pipeline::Params{}, a C++ "
+        "caller's).\nUnits and meanings in the last column.\n");
     auto row = [&](const std::string& name, const std::string& def, const std::string& kfd,
                    const std::string& range, const std::string& help) {
         std::printf("%-*s  %-*s  %-*s  %-*s  %s\n", w_name, name.c_str(), w_default, def.c_str(),
@@ -165,9 +166,9 @@ void printKeys() {
     };
     for (const auto& k : keys)
         if (k.name == "pipeline")
-            std::printf("\npipeline: %s, of %s\n  default %s\n  kfd     %s\n\n", k.help.c_str(),
+            std::printf("\npipeline: %s, of %s\n  stage   %s\n  kfd     %s\n\n", k.help.c_str(),
                         k.range.c_str(), k.default_value.c_str(), k.kfd_value.c_str());
-    row("key", "default", "kfd", "range", "meaning");
+    row("key", "stage", "kfd", "range", "meaning");
     for (const auto& k : keys)
         if (k.name != "pipeline") row(k.name, k.default_value, k.kfd_value, k.range, k.help);
 }

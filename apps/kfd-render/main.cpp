@@ -76,21 +76,32 @@ int main(int argc, char** argv) {
             long number = 0;  // 0-based among the log's 2D scans
         };
         std::deque<Seen> recent, chosen;
+        std::optional<Seen> after;  // the scan just after the chosen one (next_scan)
+        bool want_after = false;
         double best = 1e300;
         long n = 0;
         kfd::SourceEntry entry;
-        while (!(index >= 0 && !chosen.empty()) && source->next(entry)) {
+        while (!(index >= 0 && !chosen.empty() && !want_after) && source->next(entry)) {
             kfd::throwIfCancelled();
             entry.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
+                if (want_after) {
+                    after = Seen{s, entry.odometry, n};
+                    want_after = false;
+                }
                 recent.push_back({s, entry.odometry, n});
                 if (recent.size() > static_cast<std::size_t>(history) + 1) recent.pop_front();
-                if (index >= 0 && n == index) chosen = recent;
+                const auto choose = [&] {
+                    chosen = recent;
+                    after.reset();
+                    want_after = true;
+                };
+                if (index >= 0 && n == index) choose();
                 ++n;
                 if (index < 0) {
                     const double d = std::abs(kfd::stampOf(*s) - stamp);
                     if (d < best) {
                         best = d;
-                        chosen = recent;
+                        choose();
                     }
                 }
             });
@@ -105,10 +116,25 @@ int main(int argc, char** argv) {
         // history scan the door skips is no previous keyframe; the chosen one must be usable.
         kfd::Pipeline::Params drawn = p;
         drawn.stages = {"distance", "denoise"};
-        kfd::StreamFilter door(drawn);
+        kfd::StreamFilter door(drawn, {}, true);
         door.setLaserOnly(laser_only);
         kfd::StreamResult r;
         for (const Seen& seen : chosen) r = door.process(*seen.scan, seen.odometry);
+        if (r.pending) {
+            // next_scan: the chosen scan is finished by the scan after it (the log's last one
+            // without it); that one is then held, so the door's last clusters are the chosen's.
+            const auto* drawn_scan = chosen.back().scan.get();
+            const auto take = [&] {
+                for (kfd::StreamResult done; door.takeFinished(done);)
+                    if (done.scan == drawn_scan) r = std::move(done);
+                return !r.pending;
+            };
+            if (after) door.process(*after->scan, after->odometry);
+            if (!take()) {
+                door.finish();
+                take();
+            }
+        }
         if (r.skipped != kfd::ScanSkipReason::None) {
             char t[64];
             std::snprintf(t, sizeof(t), "%.6f", kfd::stampOf(*chosen.back().scan));

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -357,6 +358,24 @@ TEST(CliApps, FilterVersionAndEarlyExits) {
     EXPECT_EQ(r.status, 0);
     EXPECT_EQ(r.out.rfind("[KFD]", 0), 0u) << r.out;
 }
+
+#ifdef KFD_RENDER_EXE
+// next_scan (issue 25) in kfd-render: the drawn scan is denoised with the scan after it as
+// evidence; the log's last scan, without one, is drawn too.
+TEST(CliApps, RenderDrawsAScanWithNextScanTheLogsLastToo) {
+    kfd::test::TempDir d("kfd_cli_");
+    std::ofstream(d / "next.ini") << "[KFD]\nnext_scan = true\n";
+    const std::string office = std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog";
+    for (const char* pick : {"--index 40", "--time 1e12"}) {
+        fs::remove(d / "r.png");
+        const Result r = runApp(KFD_RENDER_EXE, "-i '" + office + "' " + pick + " -o '" +
+                                                    d / "r.png" + "' -c '" + d / "next.ini" + "'");
+        EXPECT_EQ(r.status, 0) << pick << ": " << r.err;
+        EXPECT_GT(fs::file_size(d / "r.png"), 1000u) << pick;
+        EXPECT_NE(r.out.find("noise point"), std::string::npos) << r.out;
+    }
+}
+#endif
 
 // kfd-compare reads the mode list from here (python/kfd_tools/compare.py): one line a
 // mode, "name<TAB>stages<TAB>description", before the required CONFIG.ini is asked for.

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -45,6 +46,56 @@ TEST(Config, EveryShippedConfigLoads) {
         ++n;
     }
     EXPECT_GE(n, 4u);  // default.ini, default.yaml and the two paper presets
+}
+
+// The lines of toIni(a) that differ from toIni(b).
+std::vector<std::string> differingLines(const kfd::Pipeline::Params& a,
+                                        const kfd::Pipeline::Params& b) {
+    std::vector<std::string> out;
+    std::istringstream x(kfd::toIni(a)), y(kfd::toIni(b));
+    for (std::string l, m; std::getline(x, l) && std::getline(y, m);)
+        if (l != m) out.push_back(l);
+    return out;
+}
+
+// A file changes only the keys it sets: the others keep kfd's defaults (what runs without a
+// file), in .ini and YAML, kfd_node's ~config included (it reads files the same way).
+TEST(Config, AFileChangesOnlyTheKeysItSets) {
+    const auto ini = fromIniText("[KFD]\nnext_scan = true\n");
+    EXPECT_EQ(differingLines(ini, kfd::kfdDefaults()),
+              (std::vector<std::string>{"next_scan = true"}));
+    EXPECT_EQ(ini.stages, kfd::kfdDefaults().stages);  // odometry_check kept
+    const auto yaml = kfd::loadYamlText("kfd:\n  window: 3\n");
+    EXPECT_EQ(differingLines(yaml, kfd::kfdDefaults()), (std::vector<std::string>{"window = 3"}));
+    // Over the stages' own defaults when asked (what kfdDefaults() itself does).
+    const kfd::Pipeline::Params plain;
+    mrpt::config::CConfigFileMemory cfg(std::string("[KFD]\nnext_scan = true\n"));
+    EXPECT_EQ(kfd::loadIni(cfg, "KFD", &plain).stages, plain.stages);
+}
+
+// Every shipped preset sets the keys whose kfd default differs from the stage's own, so it
+// reads the same over either (the paper presets are the paper's whatever the base).
+TEST(Config, EveryShippedPresetReadsTheSameOverEitherBase) {
+    const kfd::Pipeline::Params plain;
+    std::size_t n = 0;
+    for (const std::string& dir :
+         {std::string(KFD_SHARE_DIR), std::string(KFD_SOURCE_DIR) + "/share/kfd-icp-slam"})
+        for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+            SCOPED_TRACE(entry.path().string());
+            const std::string text = kfd::test::fileBytes(entry.path().string());
+            kfd::Pipeline::Params a, b;
+            if (entry.path().extension() == ".yaml") {
+                a = kfd::loadYamlText(text, "", &plain);
+                b = kfd::loadYamlText(text);
+            } else {
+                mrpt::config::CConfigFileMemory cfg(text);
+                a = kfd::loadIni(cfg, "KFD", &plain);
+                b = kfd::loadIni(cfg, "KFD");
+            }
+            EXPECT_EQ(kfd::toIni(a), kfd::toIni(b));
+            ++n;
+        }
+    EXPECT_GE(n, 9u);
 }
 
 TEST(Config, PaperPresetsHoldThePublishedValues) {
@@ -101,11 +152,11 @@ TEST(Config, EveryShippedNonPaperPresetUsesTheViewSelectorAndTheEvidenceDenoiser
     EXPECT_GE(seen, 9u);
 }
 
-TEST(Config, MissingKeysKeepTheBuiltInDefaults) {
+TEST(Config, MissingKeysKeepKfdsDefaults) {
     const auto p = fromIniText("[KFD]\nwindow = 3\n");
     EXPECT_EQ(p.get<kfd::KeyframeStage>().window, 3u);
     EXPECT_EQ(kfd::toIni(p), kfd::toIni([] {
-                  kfd::Pipeline::Params d;
+                  kfd::Pipeline::Params d = kfd::kfdDefaults();
                   d.get<kfd::KeyframeStage>().window = 3;
                   return d;
               }()));
@@ -307,8 +358,8 @@ TEST(Config, KeyTableIsDerivedFromTheStageRegistry) {
     EXPECT_EQ(kfd::configKeys(kfd::coreStageRegistry()).size(), core_keys);
 }
 
-// --list-keys's two defaults: the Params structs' (a configuration file that leaves the key
-// out) and kfd's (no configuration: share/kfd/default.ini), read from the structs themselves.
+// --list-keys's two defaults: the Params structs' (a C++ caller's) and kfd's (no configuration,
+// and a key a configuration file leaves out: share/kfd/default.ini), read from the structs.
 TEST(Config, EveryKeyCarriesItsParamsDefaultAndKfdsDefault) {
     std::map<std::string, kfd::ConfigKeyInfo> by_name;
     for (const auto& k : kfd::configKeys()) by_name[k.name] = k;

@@ -5,7 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <boost/make_shared.hpp>
+
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "kfd/mrpt/config.h"
 #include "ros1/laser_scans.h"
@@ -183,18 +189,135 @@ TEST(LiveFilter, RemovedBeamsArePlusInfWhenAsked) { expectMarked(kfd::RemovedMar
 
 namespace {
 
-// next_scan (issue 25) holds each keyframe for one scan; the node does not publish a scan one
-// scan later yet, so it refuses the key at start (kfd_node prints the error and exits).
-TEST(LiveFilter, NextScanIsRefusedAtStartNamingTheKey) {
+// next_scan (issue 25): each keyframe waits for its frame's next scan, then comes out of
+// takeReady() marked, in order, before the call's own publish.
+LiveFilter::Params nextScan() {
     LiveFilter::Params p = defaults();
     p.pipeline.get<kfd::DenoiseStage>().evidence.next_scan = true;
-    try {
-        LiveFilter f(p);
-        FAIL() << "accepted";
-    } catch (const kfd::ParameterError& e) {
-        EXPECT_EQ(e.field(), "next_scan");
-        EXPECT_NE(std::string(e.what()).find("one scan of latency"), std::string::npos);
+    return p;
+}
+
+// The stamps a node would publish, in order, for scans of a robot moving along +x (`frames`
+// lasers interleaved), with the node's calls: process, takeReady, the call's own publish;
+// finish() at the end.
+std::vector<std::pair<std::string, double>> published(LiveFilter& f, int n, int frames = 1) {
+    std::vector<std::pair<std::string, double>> out;
+    const auto take = [&] {
+        for (sensor_msgs::LaserScan::Ptr m; f.takeReady(m);)
+            out.emplace_back(m->header.frame_id, m->header.stamp.toSec());
+    };
+    for (int i = 0; i < n; ++i)
+        for (int k = 0; k < frames; ++k) {
+            const double t = 1.0 + 0.1 * i + 0.01 * k;
+            auto m = roomScan(t, "laser" + std::to_string(k), 181, 0.04 * i);
+            const auto r = f.process(m, t, std::nullopt, false);
+            take();
+            if (r.publish) out.emplace_back(m.header.frame_id, m.header.stamp.toSec());
+        }
+    f.finish();
+    take();
+    return out;
+}
+
+TEST(LiveFilter, NextScanHoldsAKeyframeUntilTheFramesNextScan) {
+    LiveFilter f(nextScan());
+    auto a = roomScan(1.0);
+    const auto r = f.process(a, 1.0, std::nullopt, false);
+    EXPECT_TRUE(r.pending);
+    EXPECT_FALSE(r.publish);
+    EXPECT_EQ(f.heldCount(), 1u);
+    EXPECT_EQ(f.counters().scans_kept, 0u);  // counted once published
+    sensor_msgs::LaserScan::Ptr m;
+    EXPECT_FALSE(f.takeReady(m));
+    auto b = roomScan(1.1);
+    f.process(b, 1.1, std::nullopt, false);
+    ASSERT_TRUE(f.takeReady(m));
+    EXPECT_DOUBLE_EQ(m->header.stamp.toSec(), 1.0);
+    EXPECT_EQ(m->ranges.size(), a.ranges.size());
+    EXPECT_EQ(f.counters().scans_kept, 1u);
+    EXPECT_FALSE(f.takeReady(m));
+}
+
+TEST(LiveFilter, NextScanPublishesTheSameScansInTheSameOrder) {
+    for (int frames : {1, 2}) {
+        LiveFilter off(defaults()), on(nextScan());
+        const auto a = published(off, 40, frames), b = published(on, 40, frames);
+        EXPECT_GT(a.size(), 2u);
+        EXPECT_LT(a.size(), 40u * frames);  // some dropped: the order is not trivial
+        EXPECT_EQ(a, b) << frames << " frame(s)";
+        EXPECT_EQ(on.counters().scans_kept, off.counters().scans_kept);
+        EXPECT_EQ(on.heldCount(), 0u);  // the last keyframe was finished, not lost
     }
+}
+
+// Three scans of a room with no return where a burst of 12 returns at 0.7 m comes in the fourth
+// scan only (nothing before it saw through the burst), then two scans without it: the burst scan as
+// published (null if not), how many beams the filter counted removed, and the burst scan's message
+// as the caller holds it.
+struct BurstRun {
+    sensor_msgs::LaserScan::Ptr published;
+    std::size_t points_removed = 0;
+    sensor_msgs::LaserScan given;
+};
+BurstRun burstRun(const LiveFilter::Params& p) {
+    LiveFilter f(p);
+    BurstRun run;
+    const auto take = [&] {
+        for (sensor_msgs::LaserScan::Ptr m; f.takeReady(m);)
+            if (m->header.stamp.toSec() == run.given.header.stamp.toSec()) run.published = m;
+    };
+    for (int i = 0; i < 5; ++i) {
+        const double t = 1.0 + 0.1 * i;
+        auto m = roomScan(t, "laser", 181, 0.3 * std::min(i, 3));
+        for (std::size_t b = 76; b < 96 && i < 3; ++b) m.ranges[b] = 0.0f;  // no return
+        for (std::size_t b = 80; b < 92 && i == 3; ++b) m.ranges[b] = 0.7f;
+        const auto r = f.process(m, t, std::nullopt, false);
+        if (i == 3) run.given = m;
+        take();
+        if (r.publish && i == 3) run.published = boost::make_shared<sensor_msgs::LaserScan>(m);
+    }
+    f.finish();
+    take();
+    run.points_removed = f.counters().points_removed;
+    return run;
+}
+
+std::size_t nanIn(const sensor_msgs::LaserScan& m, std::size_t from, std::size_t to) {
+    std::size_t n = 0;
+    for (std::size_t i = from; i < to; ++i) n += std::isnan(m.ranges[i]) ? 1 : 0;
+    return n;
+}
+
+TEST(LiveFilter, NextScanMarksABurstTheNextScanSeesThrough) {
+    const BurstRun on = burstRun(nextScan());
+    ASSERT_TRUE(on.published);
+    EXPECT_EQ(nanIn(*on.published, 80, 92), 12u);
+    EXPECT_EQ(nanIn(on.given, 0, 181), 0u);  // the caller's message is untouched: a copy
+    EXPECT_GE(on.points_removed, 12u);
+    const BurstRun off = burstRun(defaults());
+    ASSERT_TRUE(off.published);
+    EXPECT_EQ(nanIn(*off.published, 80, 92), 0u);  // without the next scan it stays
+}
+
+TEST(LiveFilter, NextScanHeldKeyframeIsPublishedBeforeATimeJumpResets) {
+    LiveFilter f(nextScan());
+    auto a = roomScan(50.0);
+    f.process(a, 50.0, std::nullopt, false);
+    ASSERT_EQ(f.heldCount(), 1u);
+    auto loop = roomScan(10.0);  // the bag started again
+    const auto r = f.process(loop, 10.0, std::nullopt, false);
+    EXPECT_TRUE(r.reset);
+    EXPECT_TRUE(r.pending);  // the new stream's first keyframe, held in turn
+    sensor_msgs::LaserScan::Ptr m;
+    ASSERT_TRUE(f.takeReady(m));
+    EXPECT_DOUBLE_EQ(m->header.stamp.toSec(), 50.0);
+    EXPECT_FALSE(f.takeReady(m));
+    EXPECT_FALSE(f.onClock(20.0));
+    EXPECT_TRUE(f.onClock(5.0));  // the simulated clock going back
+    ASSERT_TRUE(f.takeReady(m));
+    EXPECT_DOUBLE_EQ(m->header.stamp.toSec(), 10.0);
+    EXPECT_EQ(f.heldCount(), 0u);
+    EXPECT_EQ(f.counters().scans_kept, 2u);
 }
 
 }  // namespace

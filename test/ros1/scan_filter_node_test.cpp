@@ -12,8 +12,10 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "kfd/mrpt/config.h"
 #include "ros1/laser_scans.h"
@@ -39,7 +41,8 @@ int freePort() {
 class ScanFilterNodeTest : public ::testing::Test {
   protected:
     static void SetUpTestSuite() {
-        const std::string home = ::testing::TempDir() + "kfd_ros_home_" + std::to_string(getpid());
+        home_ = ::testing::TempDir() + "kfd_ros_home_" + std::to_string(getpid());
+        const std::string& home = home_;
         const std::string uri = "http://127.0.0.1:" + std::to_string(port_ = freePort());
         setenv("ROS_MASTER_URI", uri.c_str(), 1);
         setenv("ROS_IP", "127.0.0.1", 1);
@@ -72,6 +75,8 @@ class ScanFilterNodeTest : public ::testing::Test {
             kill(-core_, SIGKILL);
             waitpid(core_, nullptr, 0);
         }
+        std::error_code ignored;  // roscore's logs: nothing of them is wanted after the tests
+        std::filesystem::remove_all(home_, ignored);
     }
     // A node whose private namespace is /NAME, its parameters set first.
     static std::unique_ptr<ScanFilterNode> node(const std::string& name,
@@ -91,6 +96,7 @@ class ScanFilterNodeTest : public ::testing::Test {
     static sensor_msgs::LaserScan::ConstPtr scanAt(double t) {
         return boost::make_shared<sensor_msgs::LaserScan>(roomScan(t));
     }
+    static inline std::string home_;
     static inline pid_t core_ = -1;
     static inline int port_ = 0;
 };
@@ -252,6 +258,42 @@ TEST_F(ScanFilterNodeTest, PublishesKeptScansAndStats) {
     EXPECT_EQ(kv["scans_in"], "1");
     EXPECT_EQ(kv["scans_kept"], "1");
     EXPECT_EQ(kv["odom_missing"], "0");  // ~odom none: nothing expected
+}
+
+// ~next_scan: true (one scan of latency): a keyframe is published when its frame's next scan
+// comes, and the last one when the node finishes (shutting down), not lost.
+TEST_F(ScanFilterNodeTest, NextScanPublishesEachKeyframeOneScanLater) {
+    ros::param::set("/nextnode/odom", std::string("none"));
+    ros::param::set("/nextnode/next_scan", true);
+    auto n = node("nextnode");
+    ros::NodeHandle nh("/nextnode_ns");
+    std::vector<double> stamps;
+    auto sub = nh.subscribe<sensor_msgs::LaserScan>("scan_filtered", 10,
+                                                    [&](const sensor_msgs::LaserScan::ConstPtr& m) {
+                                                        stamps.push_back(m->header.stamp.toSec());
+                                                    });
+    for (int i = 0; i < 100 && sub.getNumPublishers() == 0; ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const auto spinFor = [&](std::size_t want) {
+        for (int i = 0; i < 100 && stamps.size() < want; ++i) {
+            ros::spinOnce();
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+    };
+    n->onScan(scanAt(1.0));
+    spinFor(1);
+    EXPECT_TRUE(stamps.empty());  // held for the next scan
+    EXPECT_EQ(n->counters().scans_kept, 0u);
+    n->onScan(scanAt(1.1));
+    spinFor(1);
+    ASSERT_EQ(stamps.size(), 1u);
+    EXPECT_DOUBLE_EQ(stamps[0], 1.0);
+    n->onScan(boost::make_shared<sensor_msgs::LaserScan>(roomScan(1.2, "laser", 181, 1.0)));
+    n->finish();  // the moved scan's keyframe, without its next scan
+    spinFor(2);
+    ASSERT_EQ(stamps.size(), 2u);
+    EXPECT_DOUBLE_EQ(stamps[1], 1.2);
+    EXPECT_EQ(n->counters().scans_kept, 2u);
 }
 
 TEST_F(ScanFilterNodeTest, ABagLoopingResetsWithAWarning) {

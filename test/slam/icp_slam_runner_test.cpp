@@ -8,6 +8,7 @@
 #include <mrpt/opengl/CPlanarLaserScan.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -399,25 +400,152 @@ TEST(IcpSlamRunner, BadInputIsAClearError) {
     EXPECT_THROW(runAndReport(o), kfd::ConfigError);
 }
 
-// next_scan (issue 25) holds each keyframe for one scan, which the SLAM loop does not
-// support: the run refuses the key before anything runs, naming it.
-TEST(IcpSlamRunner, NextScanIsRefusedNamingTheKey) {
-    TempDir dir;
+namespace {
+
+// kConfig with its [KFD] section's `key = value` set (replaced, or added at its top), written
+// to `path`.
+std::string configWithKfdKeys(const std::string& path,
+                              const std::vector<std::pair<std::string, std::string>>& keys) {
     std::string ini = text(kConfig);
-    const auto at = ini.find("[KFD]\n");
-    ASSERT_NE(at, std::string::npos);
-    ini.insert(at + 6, "next_scan = true\n");
-    std::ofstream(dir / "next.ini") << ini;
-    auto o = options(std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog", dir / "out",
-                     kfd::PrefilterMode::Kfd);
-    o.config_file = dir / "next.ini";
-    try {
-        runAndReport(o);
-        FAIL() << "accepted";
-    } catch (const kfd::ParameterError& e) {
-        EXPECT_EQ(e.field(), "next_scan");
-        EXPECT_NE(std::string(e.what()).find("one scan of latency"), std::string::npos);
+    const auto section = ini.find("[KFD]\n");
+    if (section == std::string::npos) ADD_FAILURE() << "no [KFD] section in " << kConfig;
+    for (const auto& [key, value] : keys) {
+        if (section == std::string::npos) break;
+        const std::string line = key + " = " + value + "\n";
+        const auto at = ini.find("\n" + key + " =", section);
+        if (at == std::string::npos)
+            ini.insert(section + 6, line);
+        else
+            ini.replace(at + 1, ini.find('\n', at + 1) - at, line);
     }
+    std::ofstream(path) << ini;
+    return path;
+}
+
+// scans.csv's column `name`, one entry per scan.
+std::vector<std::string> csvColumn(const std::vector<std::vector<std::string>>& rows,
+                                   const std::string& name) {
+    std::vector<std::string> out;
+    if (rows.empty()) return out;
+    const auto col = std::find(rows[0].begin(), rows[0].end(), name) - rows[0].begin();
+    if (static_cast<std::size_t>(col) == rows[0].size()) {
+        ADD_FAILURE() << "no column " << name;
+        return out;
+    }
+    for (std::size_t i = 1; i < rows.size(); ++i)
+        out.push_back(static_cast<std::size_t>(col) < rows[i].size() ? rows[i][col] : "?");
+    return out;
+}
+
+// The pre-filter's own decision per scan (scans.csv): kept, and not a dropped scan that went to
+// ICP for a recovery or a re-match (those depend on ICP, which the denoise removals change).
+std::vector<bool> doorKept(const std::vector<std::vector<std::string>>& rows) {
+    const auto kept = csvColumn(rows, "kept"), reason = csvColumn(rows, "reason");
+    std::vector<bool> out;
+    for (std::size_t i = 0; i < kept.size(); ++i)
+        out.push_back(kept[i] == "1" && reason[i].rfind("icp_", 0) != 0);
+    return out;
+}
+
+const std::string kOffice = std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog";
+
+// kfd mode on `log` with the configuration `off` into dir/off, then `on` into dir/on.
+std::pair<kfd::IcpSlamSummary, kfd::IcpSlamSummary> runOffOn(const std::string& log,
+                                                             const TempDir& dir,
+                                                             const std::string& off,
+                                                             const std::string& on) {
+    auto o = options(log, dir / "off", kfd::PrefilterMode::Kfd);
+    o.config_file = off;
+    o.write_map = false;
+    auto a = runAndReport(o);
+    o.output_dir = dir / "on";
+    o.config_file = on;
+    return {std::move(a), runAndReport(o)};
+}
+
+}  // namespace
+
+// next_scan (issue 25) holds each keyframe until the sensor's next scan: kfd-icp-slam's step
+// waits for it and runs ICP one step later. The pre-filter's decisions do not depend on it,
+// every scan still gets one pose and one row, and the counters count every pending scan once
+// finished. On the observations layout (the bundled log) and the actions-and-frames one.
+TEST(IcpSlamRunner, NextScanKeepsTheSameScansWithOnePoseAndRowPerScan) {
+    TempDir dir;
+    const std::string off = configWithKfdKeys(dir / "off.ini", {{"next_scan", "false"}});
+    const std::string on = configWithKfdKeys(dir / "on.ini", {{"next_scan", "true"}});
+    std::vector<std::string> logs = {kOffice};
+    if (fs::exists(kSena)) logs.push_back(kSena);
+    for (const std::string& log : logs) {
+        SCOPED_TRACE(log);
+        const auto [a, b] = runOffOn(log, dir, off, on);
+        const auto rows_a = csvRows(dir / "off/scans.csv"), rows_b = csvRows(dir / "on/scans.csv");
+        ASSERT_EQ(b.scans_in, a.scans_in);
+        EXPECT_GT(b.scans_in, 100u);
+        EXPECT_EQ(b.scans_skipped, a.scans_skipped);
+        EXPECT_EQ(b.scans_kept - b.scans_kept_for_recovery - b.scans_rematched,
+                  a.scans_kept - a.scans_kept_for_recovery - a.scans_rematched);
+        EXPECT_LT(b.scans_kept, b.scans_in);  // the keyframe stage dropped some
+        EXPECT_EQ(doorKept(rows_b), doorKept(rows_a));
+        EXPECT_EQ(csvColumn(rows_b, "index"), csvColumn(rows_a, "index"));
+        EXPECT_EQ(csvColumn(rows_b, "timestamp"), csvColumn(rows_a, "timestamp"));
+        EXPECT_EQ(kfd::readTum(dir / "on/trajectory.tum").size(), b.scans_in);
+        EXPECT_EQ(b.entries, a.entries);  // every step ran, the waiting ones too
+        EXPECT_EQ(lines(dir / "on/log_estimated_path.txt"),
+                  lines(dir / "off/log_estimated_path.txt"));
+        // The summary and the rows agree: each pending scan counted and recorded once, final.
+        const auto kept = csvColumn(rows_b, "kept"), removed = csvColumn(rows_b, "removed_noise");
+        const auto door = doorKept(rows_b);
+        ASSERT_EQ(kept.size(), b.scans_in);
+        std::size_t kept_rows = 0, removed_noise = 0;
+        for (std::size_t i = 0; i < kept.size(); ++i) {
+            kept_rows += kept[i] == "1";
+            if (door[i]) removed_noise += std::stoul(removed[i]);
+        }
+        EXPECT_EQ(kept_rows, b.scans_kept);
+        EXPECT_EQ(removed_noise, b.points_removed_noise);
+        EXPECT_GT(b.points_removed_noise, 0u);
+        fs::remove_all(dir / "off");
+        fs::remove_all(dir / "on");
+    }
+}
+
+// With only the denoise stage every scan is kept and pending until the next one: the last one
+// of the log waits for the end (finish()). It must reach ICP, get its pose and row, and count,
+// in the run and in the pre-pass that matches a drop rate.
+TEST(IcpSlamRunner, NextScanRunsTheLastPendingScanOfTheLog) {
+    TempDir dir;
+    const std::string off =
+        configWithKfdKeys(dir / "off.ini", {{"next_scan", "false"}, {"pipeline", "denoise"}});
+    const std::string on =
+        configWithKfdKeys(dir / "on.ini", {{"next_scan", "true"}, {"pipeline", "denoise"}});
+    const auto [a, b] = runOffOn(kOffice, dir, off, on);
+    EXPECT_EQ(b.pipeline.stages, std::vector<std::string>{"denoise"});
+    EXPECT_EQ(b.scans_in, a.scans_in);
+    EXPECT_EQ(b.scans_kept, a.scans_kept);
+    EXPECT_EQ(b.scans_kept, b.scans_in);
+    EXPECT_EQ(b.icp_runs, a.icp_runs);
+    const auto traj = kfd::readTum(dir / "on/trajectory.tum");
+    ASSERT_EQ(traj.size(), b.scans_in);
+    const auto rows = csvRows(dir / "on/scans.csv");
+    ASSERT_EQ(rows.size(), b.scans_in + 1);
+    EXPECT_EQ(csvColumn(rows, "index").back(), std::to_string(b.scans_in - 1));
+    EXPECT_EQ(csvColumn(rows, "kept").back(), "1");
+    // Every row is the scan's final record: a pending one has no clusters yet (the denoise
+    // stage had not run); the clusters do not depend on next_scan (the removals do).
+    EXPECT_EQ(csvColumn(rows, "clusters"), csvColumn(csvRows(dir / "off/scans.csv"), "clusters"));
+    EXPECT_NE(csvColumn(rows, "clusters").back(), "0");
+    // The pre-pass of --match-drop-of: the same target with and without next_scan.
+    auto o = options(kOffice, dir / "dec_off", kfd::PrefilterMode::Decimate);
+    o.write_map = false;
+    o.match_drop_of = kfd::PrefilterMode::Kfd;
+    o.config_file = off;
+    const auto c = runAndReport(o);
+    o.output_dir = dir / "dec_on";
+    o.config_file = on;
+    const auto d = runAndReport(o);
+    ASSERT_TRUE(c.target_drop_pct && d.target_drop_pct);
+    EXPECT_EQ(*d.target_drop_pct, *c.target_drop_pct);
+    EXPECT_EQ(d.scans_kept, c.scans_kept);
 }
 
 TEST(IcpSlamRunner, ModesAreNamedStageListsOfTheRegistry) {

@@ -115,7 +115,8 @@ void checkIniText(const std::string& text, const std::string& section) {
 
 void checkYamlText(const std::string& text) { detail::checkYaml(text); }
 
-Pipeline::Params loadYamlText(const std::string& text, const std::string& origin) {
+Pipeline::Params loadYamlText(const std::string& text, const std::string& origin,
+                              const Pipeline::Params* base) {
     checkYamlText(text);
     mrpt::containers::yaml doc;
     try {
@@ -123,7 +124,7 @@ Pipeline::Params loadYamlText(const std::string& text, const std::string& origin
     } catch (const std::exception& e) {
         throw ConfigError("", "cannot parse YAML " + origin + ": " + e.what());
     }
-    return loadYaml(doc);
+    return loadYaml(doc, base);
 }
 
 namespace {
@@ -210,7 +211,8 @@ void validateConfig(const Pipeline::Params& p, const StageRegistry& registry) {
     }
 }
 
-Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg, const std::string& section) {
+Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+                         const Pipeline::Params* base) {
     if (!cfg.sectionExists(section))
         throw ConfigError("", "no [" + section + "] section in the configuration");
     if (const auto text = iniTextOf(cfg)) checkIniText(*text, section);
@@ -224,18 +226,18 @@ Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg, const std::st
         throw ConfigError("", "cannot read [" + section + "]: " + mrptMessage(e.what()));
     }
     const StageRegistry& registry = defaultStageRegistry();
-    Pipeline::Params p;
+    Pipeline::Params p = base ? *base : kfdDefaults();
     for (const auto& [name, value] : values) applyConfigKey(p, name, value, registry);
     validateConfig(p, registry);
     return p;
 }
 
-Pipeline::Params loadYaml(const mrpt::containers::yaml& doc) {
+Pipeline::Params loadYaml(const mrpt::containers::yaml& doc, const Pipeline::Params* base) {
     if (!doc.isMap()) throw ConfigError("", "the YAML document must be a map of kfd keys");
     const mrpt::containers::yaml root = doc.has("kfd") ? doc["kfd"] : doc;
     if (!root.isMap()) throw ConfigError("kfd", "must be a map of kfd keys");
     const StageRegistry& registry = defaultStageRegistry();
-    Pipeline::Params p;
+    Pipeline::Params p = base ? *base : kfdDefaults();
     for (const auto& kv : root.asMap()) {
         const std::string name = std::string(kv.first.internalAsStr());
         applyConfigKey(p, name, scalarText(mrpt::containers::yaml(kv.second), name), registry);

@@ -59,8 +59,8 @@ StreamFilter::StreamFilter(const Pipeline::Params& params, StageFactory extra,
                     "next_scan",
                     std::string("next_scan = true: the ") + stage->name() +
                         " stage holds each keyframe until the next scan (one scan of latency), "
-                        "which this tool does not support (kfd-filter and kfd-denoise-eval do); "
-                        "set next_scan = false");
+                        "which this caller does not handle (it constructs the door without "
+                        "one_scan_latency, which kfd's tools all give); set next_scan = false");
 }
 
 StreamFilter::Sensor& StreamFilter::sensorFor(const std::string& label) {

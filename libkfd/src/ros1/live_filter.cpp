@@ -1,5 +1,9 @@
 #include "kfd/ros1/live_filter.h"
 
+#include <boost/make_shared.hpp>
+
+#include <algorithm>
+
 #include "kfd/mrpt/default_stages.h"
 #include "kfd/mrpt/laser_scan.h"
 
@@ -10,11 +14,45 @@ std::string frameLabel(const std::string& frame_id) {
     return b == std::string::npos ? std::string() : frame_id.substr(b);
 }
 
-LiveFilter::LiveFilter(const Params& p) : params_(p), door_(p.pipeline) {}
+LiveFilter::LiveFilter(const Params& p) : params_(p), door_(p.pipeline, {}, true) {}
 
 void LiveFilter::reset() {
-    door_.reset();
+    door_.reset();  // finishes held keyframes first
+    collectFinished();
     last_stamp_.clear();
+}
+
+void LiveFilter::finish() {
+    door_.finish();
+    collectFinished();
+}
+
+bool LiveFilter::takeReady(sensor_msgs::LaserScan::Ptr& out) {
+    if (ready_.empty()) return false;
+    out = std::move(ready_.front());
+    ready_.pop_front();
+    return true;
+}
+
+std::size_t LiveFilter::markKept(sensor_msgs::LaserScan& m,
+                                 const mrpt::obs::CObservation2DRangeScan& o) {
+    const std::size_t removed = markRemovedBeams(m, o, params_.removed);
+    ++counters_.scans_kept;
+    counters_.points_removed += removed;
+    return removed;
+}
+
+void LiveFilter::collectFinished() {
+    for (StreamResult done; door_.takeFinished(done);) {
+        const auto it = std::find_if(held_.begin(), held_.end(),
+                                     [&](const Held& h) { return h.obs.get() == done.scan; });
+        if (it == held_.end()) continue;  // not ours (cannot happen: every pending one is held)
+        Held h = std::move(*it);
+        held_.erase(it);
+        if (!done.keep) continue;
+        markKept(*h.message, *h.obs);
+        ready_.push_back(std::move(h.message));
+    }
 }
 
 bool LiveFilter::onClock(double now) {
@@ -47,13 +85,17 @@ LiveResult LiveFilter::process(sensor_msgs::LaserScan& m, double stamp,
     if (odom_expected && !odometry) ++counters_.odom_missing;
     auto obs = laserScanToObservation(m, stamp, label, mount);
     r.stream = door_.process(*obs, odometry);
+    collectFinished();  // the frame's held keyframe, when this scan finished it
     if (r.stream.geometry_reset) ++counters_.geometry_resets;
     if (r.stream.skipped != ScanSkipReason::None) ++counters_.scans_skipped;
     if (!r.stream.keep) return r;
-    r.removed = markRemovedBeams(m, *obs, params_.removed);
+    if (r.stream.pending) {  // published once finished: a copy as received
+        r.pending = true;
+        held_.push_back({std::move(obs), boost::make_shared<sensor_msgs::LaserScan>(m)});
+        return r;
+    }
+    r.removed = markKept(m, *obs);
     r.publish = true;
-    ++counters_.scans_kept;
-    counters_.points_removed += r.removed;
     return r;
 }
 

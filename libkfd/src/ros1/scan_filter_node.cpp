@@ -85,7 +85,20 @@ ScanFilterNode::~ScanFilterNode() {
     if (odom_spinner_) odom_spinner_->stop();
     odom_sub_.shutdown();
     scan_sub_.shutdown();
+    if (ros::ok()) finish();
     if (ros::ok()) publishStats();
+}
+
+std::size_t ScanFilterNode::finish() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    filter_.finish();  // a keyframe held for its next scan is not lost
+    return publishReady();
+}
+
+std::size_t ScanFilterNode::publishReady() {
+    std::size_t n = 0;
+    for (sensor_msgs::LaserScan::Ptr done; filter_.takeReady(done); ++n) scan_pub_.publish(done);
+    return n;
 }
 
 LiveCounters ScanFilterNode::counters() const {
@@ -267,6 +280,7 @@ void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
     if (r.out_of_order)
         ROS_WARN_THROTTLE(5.0, "kfd: scan of frame '%s' at %.3f s is out of order: dropped",
                           in->header.frame_id.c_str(), stamp.toSec());
+    publishReady();  // held keyframes (next_scan) finished by a reset or this scan, before it
     if (r.publish) scan_pub_.publish(out);
     const auto end = std::chrono::steady_clock::now();
     latency_.add(std::chrono::duration<double, std::micro>(end - start).count());

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <string_view>
@@ -165,13 +166,14 @@ void forEachRunScan(const std::string& rawlog, const SourceOptions& options, std
     while (nextEntry(*source, e)) {
         throwIfCancelled();
         if (!steps.feed(e, step) || skipper.skip(step)) continue;
-        auto visit = [&](mrpt::obs::CObservation& o) {
-            if (auto* scan = dynamic_cast<CObservation2DRangeScan*>(&o)) fn(*scan, e.odometry);
+        auto visit = [&](const mrpt::obs::CObservation::Ptr& o) {
+            if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(o))
+                fn(scan, e.odometry);
         };
         if (step.observation)
-            visit(*step.observation);
+            visit(step.observation);
         else
-            for (const auto& o : *step.frame) visit(*o);
+            for (const auto& o : *step.frame) visit(o);
     }
 }
 
@@ -182,24 +184,37 @@ std::vector<ScanStamp> scanOdometry(const std::string& rawlog, const SourceOptio
                                     std::size_t skip_scans, bool laser_only) {
     std::vector<ScanStamp> out;
     forEachRunScan(rawlog, options, skip_scans,
-                   [&](const CObservation2DRangeScan& scan, std::optional<Pose2D> odo) {
+                   [&](const CObservation2DRangeScan::Ptr& scan, std::optional<Pose2D> odo) {
                        if (laser_only) odo.reset();
                        checkOdometry(odo);
-                       out.push_back({stampOf(scan), odo});
+                       out.push_back({stampOf(*scan), odo});
                    });
     return out;
 }
 
 // The drop rate (%) of a pre-filter over the log, as the real run would see it (the same
-// skipped start, the same door, odometry or none): the pre-filter alone, no ICP.
+// skipped start, the same door, odometry or none): the pre-filter alone, no ICP. With the
+// denoise key next_scan a kept scan may come back pending (its keep decision is final): it is
+// kept alive until the door finishes it, and the counters are complete after finish().
 double pipelineDropPct(const std::string& rawlog, const SourceOptions& options,
                        const Pipeline::Params& pipeline, std::size_t skip_scans, bool laser_only) {
-    StreamFilter filter(pipeline);
+    StreamFilter filter(pipeline, {}, /*one_scan_latency=*/true);
     filter.setLaserOnly(laser_only);
+    std::vector<CObservation2DRangeScan::Ptr> held;  // pending in the door (one per sensor)
+    const auto release = [&] {
+        StreamResult done;
+        while (filter.takeFinished(done))
+            held.erase(std::remove_if(held.begin(), held.end(),
+                                      [&](const auto& p) { return p.get() == done.scan; }),
+                       held.end());
+    };
     forEachRunScan(rawlog, options, skip_scans,
-                   [&](CObservation2DRangeScan& scan, std::optional<Pose2D> odo) {
-                       filter.process(scan, odo);
+                   [&](const CObservation2DRangeScan::Ptr& scan, std::optional<Pose2D> odo) {
+                       if (filter.process(*scan, odo).pending) held.push_back(scan);
+                       release();
                    });
+    filter.finish();
+    release();
     return filter.counters().notKeptPercent();
 }
 
@@ -243,7 +258,7 @@ class Run {
         prepare();
         matchDropRate();
         readGroundTruth();
-        StreamFilter prefilter(sum_.pipeline);
+        StreamFilter prefilter(sum_.pipeline, {}, /*one_scan_latency=*/true);  // next_scan
         prefilter.setLaserOnly(opts_.laser_only);
         prefilter_ = &prefilter;
         initBuilder();
@@ -265,7 +280,30 @@ class Run {
     void initBuilder();
     void openOutputs();
     void loop();
-    void step(IcpSlamStep& step, const SourceEntry& e);
+    // A step in two phases. The pre-filter phase (prefilterStep: the door for its scans) may
+    // leave a kept scan pending (the denoise key next_scan); the step then waits in waiting_,
+    // and the steps after it behind it, until the door finishes that scan (the sensor's next
+    // scan, or finish() at the end of the log). The builder phase (runStep: the map builder,
+    // its verdict, the re-match, the step's outputs) runs for the waiting steps in input order
+    // once nothing before them is pending. Without next_scan nothing is pending: every step
+    // runs its builder phase right after its pre-filter phase, as before.
+    struct DoorScan {
+        CObservation2DRangeScan::Ptr scan;  // kept alive (and unchanged) while pending
+        bool keep = false, pending = false;
+        ScanSkipReason skipped = ScanSkipReason::None;
+        ScanRecord record;  // final once the door finished it
+    };
+    struct WaitingStep {
+        IcpSlamStep step;
+        std::vector<DoorScan> scans;  // the step's 2D scans, in the step's order
+        std::size_t pending = 0;      // of them, still pending in the door
+    };
+    std::deque<WaitingStep> waiting_;  // oldest first
+    void prefilterStep(const IcpSlamStep& step, const SourceEntry& e);
+    void collectFinished();
+    void runReadySteps();
+    void runStep(WaitingStep& w);
+    void step(WaitingStep& w);
     template <class Process>
     void timed(Process&& process);
     template <class Process>
@@ -273,7 +311,7 @@ class Run {
     void feedOdometry(const mrpt::poses::CPose2D& odometry);
     void rematch(const IcpSlamStep& step);
     bool toMapFrame(mrpt::obs::CObservationOdometry& odo);
-    bool prefilterScan(const CObservation2DRangeScan::Ptr& scan, const SourceEntry& e);
+    bool admitScan(DoorScan& d);
     mrpt::obs::CActionCollection* actionFor(const IcpSlamStep& step);
     void writeStep(double builder_ms);
     void closeOutputs();
@@ -591,17 +629,19 @@ void Run::loop() {
             continue;
         }
         if (skipper.skip(st)) continue;
-        const double builder_s0 = builder_s_;
-        logs_->beginStep(st.observation, st.action.get(), st.frame.get());
-        step(st, e);
-        noteIcp();
-        rematch(st);
-        writeStep(1e3 * (builder_s_ - builder_s0));
-        ++step_no_;
-        ++sum_.entries;
-        if (opts_.on_progress && step_no_ % 500 == 0)
+        prefilterStep(st, e);
+        const std::size_t steps_before = step_no_;
+        runReadySteps();
+        if (opts_.on_progress && step_no_ / 500 != steps_before / 500)
             progress(static_cast<double>(source_->bytesRead()) / total_bytes);
     }
+    // The end of the log: the door finishes the scans it holds (next_scan), and the steps
+    // waiting for them run; the door's counters are then complete.
+    prefilter_->finish();
+    collectFinished();
+    runReadySteps();
+    if (!waiting_.empty())  // the door finished every scan it held: a broken invariant
+        throw std::logic_error("kfd-icp-slam: a step still waits for the pre-filter at the end");
     if (sum_.entries == 0 && skipper.skipped() == 0)
         throw SlamError("no entries in " + sum_.rawlog + ": not a rawlog?", sum_.rawlog);
     sum_.scans_skipped_start = skipper.skipped();
@@ -647,15 +687,75 @@ void Run::match(bool after_drops, Process&& process) {
     builder_.ICP_options.minICPgoodnessToAccept = min_goodness_;
 }
 
-// One step: its scans through the door (every mode, `none` included), the kept ones and the
-// odometry to the map builder.
-void Run::step(IcpSlamStep& st, const SourceEntry& e) {
+// A step's pre-filter phase: its scans through the door (every mode, `none` included), in
+// order; the step waits in waiting_ for its builder phase. The scans the door finishes now
+// (held before, next_scan) go to their waiting steps.
+void Run::prefilterStep(const IcpSlamStep& st, const SourceEntry& e) {
+    waiting_.push_back(WaitingStep{st, {}, 0});
+    WaitingStep& w = waiting_.back();  // a deque: push_back keeps references
+    const auto door = [&](const mrpt::obs::CObservation::Ptr& o) {
+        auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(o);
+        if (!scan) return;
+        StreamResult r = prefilter_->process(*scan, e.odometry);
+        w.scans.push_back({scan, r.keep, r.pending, r.skipped, std::move(r.record)});
+        w.pending += r.pending ? 1 : 0;
+        collectFinished();  // e.g. the sensor's scan before this one
+    };
+    if (st.observation)
+        door(st.observation);
+    else
+        for (const auto& o : *st.frame) door(o);
+}
+
+// The scans the door finished (pending before): their final decision and record, in their
+// waiting step.
+void Run::collectFinished() {
+    StreamResult done;
+    while (prefilter_->takeFinished(done)) {
+        for (WaitingStep& w : waiting_)
+            for (DoorScan& d : w.scans)
+                if (d.pending && d.scan.get() == done.scan) {
+                    d.pending = false;
+                    d.keep = done.keep;
+                    d.record = std::move(done.record);
+                    --w.pending;
+                }
+    }
+}
+
+// The builder phase of the waiting steps, in input order, up to the first one still pending.
+void Run::runReadySteps() {
+    while (!waiting_.empty() && waiting_.front().pending == 0) {
+        WaitingStep w = std::move(waiting_.front());
+        waiting_.pop_front();
+        runStep(w);
+    }
+}
+
+// A step's builder phase: the map builder, ICP's verdict, a re-match, the step's outputs.
+void Run::runStep(WaitingStep& w) {
+    const IcpSlamStep& st = w.step;
+    const double builder_s0 = builder_s_;
+    logs_->beginStep(st.observation, st.action.get(), st.frame.get());
+    step(w);
+    noteIcp();
+    rematch(st);
+    writeStep(1e3 * (builder_s_ - builder_s0));
+    ++step_no_;
+    ++sum_.entries;
+}
+
+// One step's scans as the door decided them (admitScan), the kept ones and the odometry to the
+// map builder.
+void Run::step(WaitingStep& w) {
     step_scans_.clear();
     held_this_step_ = 0;
+    IcpSlamStep& st = w.step;
+    auto next = w.scans.begin();  // the step's scans, in the order of the pre-filter phase
     if (st.observation) {
         bool process = true;
-        if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(st.observation)) {
-            process = prefilterScan(scan, e);
+        if (dynamic_cast<CObservation2DRangeScan*>(st.observation.get())) {
+            process = admitScan(*next++);
         } else if (auto* odo =
                        dynamic_cast<mrpt::obs::CObservationOdometry*>(st.observation.get())) {
             process = !opts_.laser_only && toMapFrame(*odo);
@@ -670,8 +770,7 @@ void Run::step(IcpSlamStep& st, const SourceEntry& e) {
         return;
     }
     for (auto it = st.frame->begin(); it != st.frame->end();) {
-        auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(*it);
-        if (scan && !prefilterScan(scan, e))
+        if (dynamic_cast<CObservation2DRangeScan*>(it->get()) && !admitScan(*next++))
             it = st.frame->erase(it);
         else
             ++it;
@@ -767,9 +866,10 @@ bool Run::toMapFrame(mrpt::obs::CObservationOdometry& odo) {
     return true;
 }
 
-// A scan through the door; true when it goes on to ICP. Its record waits for the step's pose.
-bool Run::prefilterScan(const CObservation2DRangeScan::Ptr& scan, const SourceEntry& e) {
-    StreamResult r = prefilter_->process(*scan, e.odometry);
+// A scan as the door decided it (final); true when it goes on to ICP. Its record waits for the
+// step's pose. Applied in the step's builder phase: the recovery reads the builder's state.
+bool Run::admitScan(DoorScan& r) {
+    const CObservation2DRangeScan::Ptr& scan = r.scan;
     if (!r.keep && recovering_ && r.skipped == ScanSkipReason::None) {
         // Dropped by the pre-filter while ICP is recovering from a rejected correction: it
         // goes to the map builder all the same (as cleaned by the stages that ran).

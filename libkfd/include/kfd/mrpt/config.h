@@ -32,11 +32,12 @@ struct ConfigKeyInfo {
     std::string name;
     std::string help;
     std::string range;
-    /// The value a configuration file that leaves the key out gets: the stage's Params default
-    /// (the loaders read a file over Pipeline::Params{}).
+    /// The stage's own default (Pipeline::Params{}): what a C++ caller building its
+    /// parameters in code starts from.
     std::string default_value;
     /// kfd's default (kfdDefaults(), share/kfd/default.ini): the value without any
-    /// configuration (kfd-filter without -c, kfd-icp-slam without [KFD]).
+    /// configuration (kfd-filter without -c, kfd-icp-slam without [KFD]) and the value of a key
+    /// a configuration file leaves out (the loaders read a file over kfdDefaults()).
     std::string kfd_value;
 };
 /// Every key the loaders accept, in documentation order: "pipeline", then the keys of every
@@ -56,13 +57,16 @@ void applyConfigKey(Pipeline::Params& p, const std::string& key, const std::stri
 /// naming the user's key for the stage's kfd::ParameterError.
 void validateConfig(const Pipeline::Params& p, const StageRegistry& registry);
 
-/// Reads the keys of `section` (default "KFD") over the defaults of Pipeline::Params. When
+/// Reads the keys of `section` (default "KFD") over `base`: kfd's defaults (kfdDefaults(),
+/// share/kfd/default.ini) when null, so that a file setting one key changes only that key of
+/// what runs without a file (kfdDefaults() itself reads over Pipeline::Params{}). When
 /// `cfg` is a CConfigFile its file's text is checked first (checkIniText; a
 /// CConfigFileMemory has already merged duplicate keys: check its text with checkIniText).
 /// Unknown keys and out-of-range values throw ConfigError naming the key. Other sections are
 /// ignored, so the [KFD] section can live inside an icp-slam .ini.
 Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg,
-                         const std::string& section = "KFD");
+                         const std::string& section = "KFD",
+                         const Pipeline::Params* base = nullptr);
 
 /// Largest configuration text the YAML loader reads (1 MiB); kfd's keys need a few hundred
 /// bytes.
@@ -90,11 +94,13 @@ void checkYamlText(const std::string& text);
 
 /// checkYamlText(text), then MRPT's YAML parser, then loadYaml. `origin` names the text in
 /// messages (e.g. "file x.yaml").
-Pipeline::Params loadYamlText(const std::string& text, const std::string& origin = "");
+Pipeline::Params loadYamlText(const std::string& text, const std::string& origin = "",
+                              const Pipeline::Params* base = nullptr);
 
 /// Reads a YAML map of the same keys. If the document has a top-level `kfd:` map, that map is
 /// used; otherwise the top level itself.
-Pipeline::Params loadYaml(const mrpt::containers::yaml& doc);
+Pipeline::Params loadYaml(const mrpt::containers::yaml& doc,
+                          const Pipeline::Params* base = nullptr);
 
 /// Loads a .ini/.cfg (section [KFD]) or .yaml/.yml file by extension (YAML through
 /// loadYamlText; .ini keys set twice are a ConfigError, see checkIniText; so is

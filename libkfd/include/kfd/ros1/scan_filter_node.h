@@ -35,7 +35,7 @@ class ScanFilterNode {
     /// `nh` (`scan`, `odom`, `scan_filtered`, /diagnostics) and `pnh` (~stats).
     ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh);
     ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeConfig& config);
-    /// Publishes ~stats once more.
+    /// finish(), and publishes ~stats once more.
     ~ScanFilterNode();
 
     /// One scan (the `scan` subscriber's callback; tests call it directly).
@@ -48,6 +48,10 @@ class ScanFilterNode {
     diagnostic_msgs::DiagnosticStatus stats() const;
     /// Publishes stats() on ~stats and /diagnostics.
     void publishStats();
+    /// Finishes a keyframe held for its next scan (next_scan) and publishes it: the node
+    /// shutting down (kfd_node's main before ROS stops; the destructor too). The scans
+    /// published.
+    std::size_t finish();
 
     const NodeConfig& config() const { return config_; }
     /// The transforms the node looks up (odom_frame -> base_frame, base_frame -> laser); tests
@@ -60,6 +64,7 @@ class ScanFilterNode {
     static std::map<std::string, XmlRpc::XmlRpcValue> privateParams(const ros::NodeHandle& pnh);
 
   private:
+    std::size_t publishReady();  // LiveFilter::takeReady's messages on scan_filtered; mutex_ held
     std::optional<Pose2D> tfAtTheEdges(const ros::Time& stamp);
     bool newestTfAfter(const ros::Time& stamp) const;  // odom -> base known after stamp
     std::optional<ros::Time> newestTf() const;         // the newest odom -> base stamp

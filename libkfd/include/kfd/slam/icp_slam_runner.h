@@ -202,7 +202,10 @@ class SlamOptionError : public SlamError {
 /// propagated with odometry for dropped scans). Every scan enters through the one door
 /// (StreamFilter::process), in every mode (`none` included): a bad geometry skips it (counted,
 /// never reaches ICP), bad ranges are marked invalid, and a non-finite odometry reading is left
-/// out of the map builder's input. A log with no scan the door could use (none at all, none
+/// out of the map builder's input. With the denoise key next_scan = true a kept scan waits for
+/// the sensor's next scan (StreamFilter's pending scans): its step, and the steps after it, go
+/// to the map builder, in order, once the door has finished it (ICP one step later; the last at
+/// the end of the log). A log with no scan the door could use (none at all, none
 /// after skip_scans, or every one skipped) is a SlamError naming the log and the skip reasons
 /// (kfd::noUsableScan), and nothing is written. An exception of MRPT's map builder becomes a
 /// SlamError naming the step, its scan's stamp and the log, with MRPT's message
