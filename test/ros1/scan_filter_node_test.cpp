@@ -96,6 +96,19 @@ class ScanFilterNodeTest : public ::testing::Test {
     static sensor_msgs::LaserScan::ConstPtr scanAt(double t) {
         return boost::make_shared<sensor_msgs::LaserScan>(roomScan(t));
     }
+    // Waits (at most 5 s) until `sub` is connected to a publisher.
+    static void waitForPublisher(const ros::Subscriber& sub) {
+        for (int i = 0; i < 100 && sub.getNumPublishers() == 0; ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    // Spins the callbacks until done() or `tries` times 20 ms.
+    template <class Done>
+    static void spinUntil(Done&& done, int tries) {
+        for (int i = 0; i < tries && !done(); ++i) {
+            ros::spinOnce();
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+    }
     static inline std::string home_;
     static inline pid_t core_ = -1;
     static inline int port_ = 0;
@@ -240,13 +253,9 @@ TEST_F(ScanFilterNodeTest, PublishesKeptScansAndStats) {
     int received = 0;
     auto sub = nh.subscribe<sensor_msgs::LaserScan>(
         "scan_filtered", 10, [&](const sensor_msgs::LaserScan::ConstPtr&) { ++received; });
-    for (int i = 0; i < 100 && sub.getNumPublishers() == 0; ++i)
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    waitForPublisher(sub);
     n->onScan(scanAt(1.0));
-    for (int i = 0; i < 200 && received == 0; ++i) {
-        ros::spinOnce();
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
+    spinUntil([&] { return received > 0; }, 200);
     EXPECT_EQ(received, 1);
     const auto s = n->stats();
     std::map<std::string, std::string> kv;
@@ -272,13 +281,9 @@ TEST_F(ScanFilterNodeTest, NextScanPublishesEachKeyframeOneScanLater) {
                                                     [&](const sensor_msgs::LaserScan::ConstPtr& m) {
                                                         stamps.push_back(m->header.stamp.toSec());
                                                     });
-    for (int i = 0; i < 100 && sub.getNumPublishers() == 0; ++i)
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    waitForPublisher(sub);
     const auto spinFor = [&](std::size_t want) {
-        for (int i = 0; i < 100 && stamps.size() < want; ++i) {
-            ros::spinOnce();
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        }
+        spinUntil([&] { return stamps.size() >= want; }, 100);
     };
     n->onScan(scanAt(1.0));
     spinFor(1);

@@ -118,7 +118,8 @@ class KfdLaunch(live.RosCase):
                           lambda: "kfd to start (graph %s; %s)" % (self.graph(),
                                                                    self.log_of("roslaunch")))
             time.sleep(1.0)  # the recorder connects to the filter's publishers
-            play = self.start("play", ["rosbag", "play", "--clock", "-q", "-d", "2", bag])
+            play = self.start("play", ["rosbag", "play", "--clock", "-q", "-d",
+                                       str(live.PLAY_DELAY_S), bag])
             play.wait(timeout=120)
             self.assertEqual(play.returncode, 0, self.log_of("play"))
         else:

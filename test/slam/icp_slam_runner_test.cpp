@@ -69,6 +69,30 @@ std::vector<std::vector<std::string>> csvRows(const std::string& path) {
     return out;
 }
 
+// kConfig with keys of its [`section`] set, written to `path`: each "KEY = VALUE" replaces
+// the key's line in that section, or is added at the section's top when it has none.
+std::string configWith(const std::string& path, const std::string& section,
+                       const std::vector<std::pair<std::string, std::string>>& keys) {
+    std::string ini = text(kConfig);
+    const std::string header = "[" + section + "]\n";
+    const auto begin = ini.find(header);
+    if (begin == std::string::npos) {
+        ADD_FAILURE() << "no " << header << " in " << kConfig;
+        return path;
+    }
+    for (const auto& [key, value] : keys) {
+        const std::string line = key + " = " + value + "\n";
+        const auto end = std::min(ini.find("\n[", begin), ini.size());
+        const auto at = ini.find("\n" + key + " ", begin);
+        if (at == std::string::npos || at >= end)
+            ini.insert(begin + header.size(), line);
+        else
+            ini.replace(at + 1, ini.find('\n', at + 1) - at, line);
+    }
+    std::ofstream(path) << ini;
+    return path;
+}
+
 // A run and its report, as kfd-icp-slam does.
 kfd::IcpSlamSummary runAndReport(const kfd::IcpSlamOptions& o) {
     const auto result = kfd::IcpSlamRunner().run(o);
@@ -402,26 +426,6 @@ TEST(IcpSlamRunner, BadInputIsAClearError) {
 
 namespace {
 
-// kConfig with its [KFD] section's `key = value` set (replaced, or added at its top), written
-// to `path`.
-std::string configWithKfdKeys(const std::string& path,
-                              const std::vector<std::pair<std::string, std::string>>& keys) {
-    std::string ini = text(kConfig);
-    const auto section = ini.find("[KFD]\n");
-    if (section == std::string::npos) ADD_FAILURE() << "no [KFD] section in " << kConfig;
-    for (const auto& [key, value] : keys) {
-        if (section == std::string::npos) break;
-        const std::string line = key + " = " + value + "\n";
-        const auto at = ini.find("\n" + key + " =", section);
-        if (at == std::string::npos)
-            ini.insert(section + 6, line);
-        else
-            ini.replace(at + 1, ini.find('\n', at + 1) - at, line);
-    }
-    std::ofstream(path) << ini;
-    return path;
-}
-
 // scans.csv's column `name`, one entry per scan.
 std::vector<std::string> csvColumn(const std::vector<std::vector<std::string>>& rows,
                                    const std::string& name) {
@@ -471,8 +475,8 @@ std::pair<kfd::IcpSlamSummary, kfd::IcpSlamSummary> runOffOn(const std::string& 
 // finished. On the observations layout (the bundled log) and the actions-and-frames one.
 TEST(IcpSlamRunner, NextScanKeepsTheSameScansWithOnePoseAndRowPerScan) {
     TempDir dir;
-    const std::string off = configWithKfdKeys(dir / "off.ini", {{"next_scan", "false"}});
-    const std::string on = configWithKfdKeys(dir / "on.ini", {{"next_scan", "true"}});
+    const std::string off = configWith(dir / "off.ini", "KFD", {{"next_scan", "false"}});
+    const std::string on = configWith(dir / "on.ini", "KFD", {{"next_scan", "true"}});
     std::vector<std::string> logs = {kOffice};
     if (fs::exists(kSena)) logs.push_back(kSena);
     for (const std::string& log : logs) {
@@ -515,9 +519,9 @@ TEST(IcpSlamRunner, NextScanKeepsTheSameScansWithOnePoseAndRowPerScan) {
 TEST(IcpSlamRunner, NextScanRunsTheLastPendingScanOfTheLog) {
     TempDir dir;
     const std::string off =
-        configWithKfdKeys(dir / "off.ini", {{"next_scan", "false"}, {"pipeline", "denoise"}});
+        configWith(dir / "off.ini", "KFD", {{"next_scan", "false"}, {"pipeline", "denoise"}});
     const std::string on =
-        configWithKfdKeys(dir / "on.ini", {{"next_scan", "true"}, {"pipeline", "denoise"}});
+        configWith(dir / "on.ini", "KFD", {{"next_scan", "true"}, {"pipeline", "denoise"}});
     const auto [a, b] = runOffOn(kOffice, dir, off, on);
     EXPECT_EQ(b.pipeline.stages, std::vector<std::string>{"denoise"});
     EXPECT_EQ(b.scans_in, a.scans_in);
@@ -889,24 +893,6 @@ TEST(IcpSlamRunner, ARejectedCorrectionIsReMatchedThroughTheDroppedScans) {
 
 namespace {
 
-// kConfig with [MappingApplication] keys set (each "KEY = VALUE" replaces the key's line, or is
-// added to the section when the file has none).
-std::string configWith(const fs::path& dir,
-                       const std::vector<std::pair<std::string, std::string>>& keys) {
-    std::string ini = text(kConfig);
-    for (const auto& [key, value] : keys) {
-        const auto at = ini.find("\n" + key + " ");
-        const std::string line = key + " = " + value;
-        if (at == std::string::npos)
-            ini.insert(ini.find("\n", ini.find("[MappingApplication]")) + 1, line + "\n");
-        else
-            ini.replace(at + 1, ini.find('\n', at + 1) - at - 1, line);
-    }
-    const std::string path = dir / "icp.ini";
-    std::ofstream(path) << ini;
-    return path;
-}
-
 // A text file's rows split at blanks and tabs.
 std::vector<std::vector<std::string>> rows(const std::string& path) {
     std::vector<std::vector<std::string>> out;
@@ -950,11 +936,12 @@ TEST(IcpSlamLogs, OutputKeysWriteIcpSlamsFilesInItsFormats) {
     TempDir dir;
     const std::string rawlog = simulatedLog(dir.path, 4.0);
     auto o = options(rawlog, dir / "out", kfd::PrefilterMode::Kfd);
-    o.config_file = configWith(dir.path, {{"LOG_FREQUENCY", "7"},
-                                          {"SAVE_POSE_LOG", "1"},
-                                          {"SAVE_3D_SCENE", "true"},
-                                          {"SHOW_LASER_SCANS_3D", "true"},
-                                          {"occupancyGrid_count", "1"}});
+    o.config_file = configWith(dir / "icp.ini", "MappingApplication",
+                               {{"LOG_FREQUENCY", "7"},
+                                {"SAVE_POSE_LOG", "1"},
+                                {"SAVE_3D_SCENE", "true"},
+                                {"SHOW_LASER_SCANS_3D", "true"},
+                                {"occupancyGrid_count", "1"}});
     const auto s = runAndReport(o);
     EXPECT_TRUE(s.notices.empty());
     const std::size_t steps = s.entries;  // icp-slam's steps: a scan or an odometry reading
@@ -1045,7 +1032,8 @@ TEST(IcpSlamLogs, WithTheKeysOffOnlyThePerStepLogsAreWritten) {
     for (const char* prefix : {"mapbuild_posepdf_", "buildingmap_", "_finalmap"})
         EXPECT_TRUE(filesStarting(dir / "out", prefix).empty()) << prefix;
     // SAVE_3D_SCENE and SAVE_POSE_LOG need LOG_FREQUENCY > 0: a notice each, nothing written.
-    o.config_file = configWith(dir.path, {{"SAVE_POSE_LOG", "1"}, {"SAVE_3D_SCENE", "1"}});
+    o.config_file = configWith(dir / "icp.ini", "MappingApplication",
+                               {{"SAVE_POSE_LOG", "1"}, {"SAVE_3D_SCENE", "1"}});
     o.output_dir = dir / "out0";
     const auto zero = runAndReport(o);
     ASSERT_EQ(zero.notices.size(), 2u);
@@ -1060,8 +1048,9 @@ TEST(IcpSlamLogs, WithTheKeysOffOnlyThePerStepLogsAreWritten) {
 TEST(IcpSlamLogs, ALiveWindowIsAWarningNamingTheKey) {
     TempDir dir;
     const std::string rawlog = simulatedLog(dir.path, 2.0);
-    const std::string config = configWith(dir.path, {{"SHOW_PROGRESS_3D_REAL_TIME", "true"},
-                                                     {"SHOW_PROGRESS_3D_REAL_TIME_DELAY_MS", "5"}});
+    const std::string config = configWith(
+        dir / "icp.ini", "MappingApplication",
+        {{"SHOW_PROGRESS_3D_REAL_TIME", "true"}, {"SHOW_PROGRESS_3D_REAL_TIME_DELAY_MS", "5"}});
     const std::string cmd = std::string("'") + KFD_ICP_SLAM_EXE + "' -q --no-map '" + config +
                             "' '" + rawlog + "' -o '" + (dir / "out") + "' > '" + (dir / "stdout") +
                             "' 2> '" + (dir / "stderr") + "'";

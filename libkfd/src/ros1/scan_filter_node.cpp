@@ -85,8 +85,10 @@ ScanFilterNode::~ScanFilterNode() {
     if (odom_spinner_) odom_spinner_->stop();
     odom_sub_.shutdown();
     scan_sub_.shutdown();
-    if (ros::ok()) finish();
-    if (ros::ok()) publishStats();
+    if (ros::ok()) {
+        finish();
+        publishStats();
+    }
 }
 
 std::size_t ScanFilterNode::finish() {
