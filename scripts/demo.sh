@@ -17,7 +17,7 @@ render=0
 if [ -n "${KFD_DEMO_APPS:-}" ]; then
   [ -x "$apps/kfd-render" ] && render=1
 else
-  bash "$root/scripts/install-deps.sh"
+  bash "$root/scripts/ci/install-deps.sh"
   cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
   targets=(kfd-filter kfd-icp-slam)
   # kfd-render exists when CMake found OSMesa (the list read whole: grep -q would close the

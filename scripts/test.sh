@@ -3,7 +3,7 @@
 # Warnings are errors when CI is set (as on the CI machine).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-bash "$root/scripts/install-deps.sh"
+bash "$root/scripts/ci/install-deps.sh"
 werror=OFF
 [ -n "${CI:-}" ] && werror=ON
 cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKFD_BUILD_TESTS=ON \
@@ -16,6 +16,6 @@ ctest --output-on-failure -j"$(nproc)" || status=$?
 # missing), with the reason each gave: a green run with skips says so last.
 log=Testing/Temporary/LastTest.log
 if [ -f "$log" ]; then
-  bash "$root/scripts/list-skips.sh" "$log"
+  bash "$root/scripts/ci/list-skips.sh" "$log"
 fi
 exit $status

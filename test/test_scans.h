@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "kfd/core/clusters.h"
-#include "kfd/core/error.h"
-#include "kfd/core/scan.h"
+#include "kfd/paper/clusters.h"
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 namespace test {

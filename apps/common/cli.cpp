@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <memory>
 
-#include "kfd/core/cancel.h"
-#include "kfd/core/format.h"
+#include "kfd/os/cancel.h"
+#include "kfd/pipeline/format.h"
 
 namespace kfd::app {
 

@@ -15,8 +15,8 @@
 #include <utility>
 #include <vector>
 
-#include "kfd/core/error.h"
-#include "kfd/core/output_paths.h"
+#include "kfd/os/output_paths.h"
+#include "kfd/pipeline/error.h"
 
 namespace kfd::app {
 

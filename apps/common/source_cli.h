@@ -6,8 +6,8 @@
 #include <string>
 
 #include "common/cli.h"
-#include "kfd/mrpt/source.h"
-#include "kfd/mrpt/source_listing.h"
+#include "kfd/io/source.h"
+#include "kfd/io/source_listing.h"
 
 namespace kfd::app {
 

@@ -3,8 +3,8 @@
 #include <vector>
 
 #include "common/cli.h"
-#include "kfd/core/cancel.h"
-#include "kfd/mrpt/png_output.h"
+#include "kfd/io/png_output.h"
+#include "kfd/os/cancel.h"
 #include "kfd/plot/bar_chart.h"
 
 int main(int argc, char** argv) {

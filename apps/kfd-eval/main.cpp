@@ -7,9 +7,9 @@
 
 #include "common/cli.h"
 #include "common/ground_truth_cli.h"
-#include "kfd/core/format.h"
 #include "kfd/eval/ate.h"
 #include "kfd/eval/relations.h"
+#include "kfd/pipeline/format.h"
 
 int main(int argc, char** argv) {
     kfd::app::Cli cli(

@@ -8,10 +8,10 @@
 
 #include "common/cli.h"
 #include "common/source_cli.h"
-#include "kfd/core/format.h"
-#include "kfd/core/window_helper.h"
+#include "kfd/io/rawlog_filter.h"
 #include "kfd/mrpt/config.h"
-#include "kfd/mrpt/rawlog_filter.h"
+#include "kfd/paper/window_helper.h"
+#include "kfd/pipeline/format.h"
 
 namespace {
 

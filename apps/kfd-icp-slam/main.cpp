@@ -7,7 +7,7 @@
 #include "common/cli.h"
 #include "common/ground_truth_cli.h"
 #include "common/source_cli.h"
-#include "kfd/core/format.h"
+#include "kfd/pipeline/format.h"
 #include "kfd/report/slam_report.h"
 #include "kfd/slam/icp_slam_runner.h"
 

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "common/cli.h"
-#include "kfd/core/format.h"
+#include "kfd/pipeline/format.h"
 #include "kfd/sim/noisy_log.h"
 
 int main(int argc, char** argv) {

@@ -10,15 +10,15 @@
 
 #include "common/cli.h"
 #include "common/source_cli.h"
-#include "kfd/core/cancel.h"
-#include "kfd/core/denoiser.h"
-#include "kfd/core/format.h"
+#include "kfd/algorithms/denoiser.h"
+#include "kfd/io/open_source.h"
+#include "kfd/io/png_output.h"
+#include "kfd/io/source.h"
 #include "kfd/mrpt/config.h"
-#include "kfd/mrpt/open_source.h"
-#include "kfd/mrpt/png_output.h"
 #include "kfd/mrpt/scan_adapter.h"
-#include "kfd/mrpt/source.h"
 #include "kfd/mrpt/stream_filter.h"
+#include "kfd/os/cancel.h"
+#include "kfd/pipeline/format.h"
 #include "kfd/render/cluster_figure.h"
 
 int main(int argc, char** argv) {

@@ -27,7 +27,7 @@
 #include <mrpt/io/CFileGZInputStream.h>
 
 #include "bad_logs.h"
-#include "kfd/mrpt/open_source.h"
+#include "kfd/io/open_source.h"
 #include "test_bags.h"
 #include "test_files.h"
 

@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "common/cli.h"
-#include "kfd/core/evidence_filter.h"
-#include "kfd/core/keyframe_selector.h"
-#include "kfd/core/stage_keys.h"
+#include "kfd/algorithms/evidence_filter.h"
+#include "kfd/algorithms/keyframe_selector.h"
+#include "kfd/pipeline/stage_keys.h"
 #include "test_files.h"
 
 namespace {

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "kfd/baselines/stages.h"
-#include "kfd/core/pipeline.h"
+#include "kfd/pipeline/pipeline.h"
 
 namespace kfd::test {
 

@@ -9,7 +9,7 @@
 
 #include "kfd/baselines/decimate_stage.h"
 #include "kfd/baselines/stages.h"
-#include "kfd/core/stage_registry.h"
+#include "kfd/pipeline/stage_registry.h"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "baselines/all_stages.h"
-#include "kfd/core/pipeline.h"
+#include "kfd/pipeline/pipeline.h"
 #include "test_scans.h"
 
 namespace kfd {

@@ -22,12 +22,12 @@
 #include <string>
 #include <vector>
 
-#include "kfd/core/evidence_filter.h"
-#include "kfd/core/fuse_stage.h"
-#include "kfd/core/pipeline.h"
+#include "kfd/algorithms/evidence_filter.h"
+#include "kfd/io/open_source.h"
 #include "kfd/mrpt/config.h"
-#include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_adapter.h"
+#include "kfd/pipeline/pipeline.h"
+#include "kfd/stages/fuse_stage.h"
 
 extern "C" {
 __attribute__((noinline)) void kfd_fx_dropped(kfd::FuseStage& f, const kfd::Scan& s) {

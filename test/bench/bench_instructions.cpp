@@ -7,7 +7,7 @@
 //
 // Each case first runs one untimed cycle over its scans (buffers sized, window filled), then
 // calls its kfd_ir_ function N times; instructions per scan = inclusive cost / N. Restoring the
-// valid flags between calls happens outside the counted functions. scripts/bench.sh does
+// valid flags between calls happens outside the counted functions. scripts/bench/bench.sh does
 // all of this. Without valgrind the program just runs the cases (a smoke test).
 #include <cstdio>
 #include <cstdlib>
@@ -16,16 +16,16 @@
 #include <vector>
 
 #include "bench_scans.h"
+#include "kfd/algorithms/denoiser.h"
+#include "kfd/algorithms/keyframe_selector.h"
 #include "kfd/baselines/dbscan.h"
 #include "kfd/baselines/radius_outlier.h"
 #include "kfd/baselines/statistical_outlier.h"
-#include "kfd/core/correlation.h"
-#include "kfd/core/denoiser.h"
-#include "kfd/core/distance_filter.h"
-#include "kfd/core/histogram.h"
-#include "kfd/core/keyframe_selector.h"
-#include "kfd/core/pipeline.h"
 #include "kfd/mrpt/stream_filter.h"
+#include "kfd/paper/correlation.h"
+#include "kfd/paper/distance_filter.h"
+#include "kfd/paper/histogram.h"
+#include "kfd/pipeline/pipeline.h"
 
 namespace kb = kfd::bench;
 

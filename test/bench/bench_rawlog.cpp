@@ -24,9 +24,9 @@
 
 #include <unistd.h>
 
+#include "kfd/io/rawlog_filter.h"
+#include "kfd/io/rawlog_source.h"
 #include "kfd/mrpt/config.h"
-#include "kfd/mrpt/rawlog_filter.h"
-#include "kfd/mrpt/rawlog_source.h"
 
 #ifndef KFD_DATASETS_DIR
 #define KFD_DATASETS_DIR "../shared/datasets"

@@ -12,10 +12,10 @@
 #include <stdexcept>
 #include <vector>
 
-#include "kfd/core/distance_filter.h"
-#include "kfd/core/keyframe_selector.h"
-#include "kfd/core/pipeline.h"
-#include "kfd/core/scan.h"
+#include "kfd/algorithms/keyframe_selector.h"
+#include "kfd/paper/distance_filter.h"
+#include "kfd/pipeline/pipeline.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 namespace bench {

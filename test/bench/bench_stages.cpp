@@ -11,15 +11,15 @@
 #include <vector>
 
 #include "bench_scans.h"
+#include "kfd/algorithms/denoiser.h"
+#include "kfd/algorithms/keyframe_selector.h"
 #include "kfd/baselines/dbscan.h"
 #include "kfd/baselines/radius_outlier.h"
 #include "kfd/baselines/statistical_outlier.h"
-#include "kfd/core/correlation.h"
-#include "kfd/core/denoiser.h"
-#include "kfd/core/distance_filter.h"
-#include "kfd/core/histogram.h"
-#include "kfd/core/keyframe_selector.h"
-#include "kfd/core/pipeline.h"
+#include "kfd/paper/correlation.h"
+#include "kfd/paper/distance_filter.h"
+#include "kfd/paper/histogram.h"
+#include "kfd/pipeline/pipeline.h"
 
 namespace {
 

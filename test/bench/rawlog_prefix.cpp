@@ -1,6 +1,6 @@
 // kfd_bench_rawlog_prefix IN OUT PERCENT: writes the first PERCENT % of IN's top-level objects
 // to OUT (gzip), so kfd-filter's peak memory can be measured on logs of growing size that are
-// cut at object boundaries. Used by scripts/bench.sh.
+// cut at object boundaries. Used by scripts/bench/bench.sh.
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/registerAllClasses.h>
 #include <mrpt/serialization/CArchive.h>
@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "kfd/mrpt/rawlog_source.h"
+#include "kfd/io/rawlog_source.h"
 
 namespace {
 

@@ -11,8 +11,8 @@
 
 #include <rosbag/bag.h>
 
-#include "kfd/core/error.h"
-#include "kfd/mrpt/bag_source.h"
+#include "kfd/io/bag_source.h"
+#include "kfd/pipeline/error.h"
 
 // Every rosbag::Bag loads rosbag_storage's encryptor plugin through class_loader, and the last
 // one destroyed unloads it again: dlopen + dlclose of a library whose deps reach ~180 others

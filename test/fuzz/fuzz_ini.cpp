@@ -7,8 +7,8 @@
 #include <fstream>
 #include <string>
 
-#include "kfd/core/error.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/pipeline/error.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     static const std::string path = "/tmp/kfd-fuzz-ini-" + std::to_string(getpid()) + ".ini";

@@ -15,10 +15,10 @@
 #include <cstdint>
 #include <limits>
 
-#include "kfd/core/error.h"
-#include "kfd/core/pipeline.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/default_stages.h"
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/pipeline.h"
 
 namespace {
 

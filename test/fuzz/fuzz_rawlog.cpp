@@ -8,8 +8,8 @@
 #include <fstream>
 #include <string>
 
-#include "kfd/core/error.h"
-#include "kfd/mrpt/rawlog_source.h"
+#include "kfd/io/rawlog_source.h"
+#include "kfd/pipeline/error.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     static const std::string path = "/tmp/kfd-fuzz-rawlog-" + std::to_string(getpid()) + ".rawlog";

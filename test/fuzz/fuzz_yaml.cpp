@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string>
 
-#include "kfd/core/error.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/pipeline/error.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     const std::string text(reinterpret_cast<const char*>(data), size);

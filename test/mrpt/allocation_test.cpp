@@ -11,10 +11,10 @@
 #include <new>
 #include <random>
 
-#include "kfd/core/pipeline.h"
-#include "kfd/core/scan_fusion.h"
+#include "kfd/algorithms/scan_fusion.h"
 #include "kfd/mrpt/default_stages.h"
 #include "kfd/mrpt/stream_filter.h"
+#include "kfd/pipeline/pipeline.h"
 
 namespace {
 std::atomic<std::size_t> g_allocations{0};

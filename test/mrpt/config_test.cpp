@@ -12,12 +12,12 @@
 #include <utility>
 #include <vector>
 
-#include "kfd/core/evidence_filter.h"
-#include "kfd/core/keyframe_selector.h"
-#include "kfd/core/keyframe_stage.h"
-#include "kfd/core/stage_keys.h"
+#include "kfd/algorithms/evidence_filter.h"
+#include "kfd/algorithms/keyframe_selector.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/default_stages.h"
+#include "kfd/pipeline/stage_keys.h"
+#include "kfd/stages/keyframe_stage.h"
 #include "test_files.h"
 
 namespace {

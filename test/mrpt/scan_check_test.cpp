@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "bad_logs.h"
-#include "kfd/mrpt/rawlog_filter.h"
+#include "kfd/io/rawlog_filter.h"
 #include "kfd/mrpt/scan_check.h"
 #include "kfd/mrpt/stream_filter.h"
 #include "test_files.h"

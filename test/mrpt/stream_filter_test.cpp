@@ -6,9 +6,9 @@
 #include <filesystem>
 #include <string>
 
-#include "kfd/core/evidence_filter.h"
+#include "kfd/algorithms/evidence_filter.h"
+#include "kfd/io/open_source.h"
 #include "kfd/mrpt/config.h"
-#include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/stream_filter.h"
 
@@ -199,6 +199,67 @@ TEST(StreamFilter, FrozenOdometryIsDecidedAsLaserOnly) {
     EXPECT_EQ(confirmed, above_bound);
     EXPECT_GE(frozen.counters().scans_denoise_confirmed, above_bound);
     EXPECT_GT(above_bound, 0u);
+}
+
+// One definition of kfd's defaults (issue 34): a default-constructed filter runs
+// share/kfd/default.ini, so on a laser-only stream (no odometry given) it keeps and cleans the
+// same scans as a filter built from that file; Pipeline::Params{} (the stages' own defaults,
+// without the odometry check) is a different configuration and differs on this log.
+// kfd's defaults have one definition (share/kfd/default.ini, kfdDefaults()): a default-constructed
+// filter runs it, laser only and with a frozen odometry; the stages' own Params defaults (no
+// odometry check) trust the frozen odometry, so the comparison can tell them apart.
+namespace {
+
+struct DefaultsRun {
+    std::size_t scans = 0, kept = 0, same_points = 0, differ_from_stage_defaults = 0;
+};
+
+DefaultsRun runDefaults(bool frozen_odometry) {
+    const std::string log = std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog";
+    kfd::StreamFilter plain,
+        from_file(kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.ini")),
+        stage_defaults(kfd::Pipeline::Params{});
+    auto source = kfd::openSource(log);
+    kfd::SourceEntry e;
+    DefaultsRun run;
+    while (source->next(e)) {
+        // A stuck wheel encoder: odometry that never moves while the scans do.
+        const std::optional<kfd::Pose2D> odometry =
+            frozen_odometry ? std::optional<kfd::Pose2D>(kfd::Pose2D{}) : std::nullopt;
+        e.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
+            auto a = *s, b = *s, c = *s;
+            const auto ra = plain.process(a, odometry);
+            const auto rb = from_file.process(b, odometry);
+            const auto rc = stage_defaults.process(c, odometry);
+            ++run.scans;
+            EXPECT_EQ(ra.keep, rb.keep) << "scan " << run.scans;
+            run.kept += ra.keep;
+            bool same = true;
+            for (std::size_t i = 0; i < a.getScanSize(); ++i)
+                same = same && a.getScanRangeValidity(i) == b.getScanRangeValidity(i);
+            run.same_points += ra.keep && same;
+            run.differ_from_stage_defaults +=
+                ra.keep != rc.keep || ra.report.points_out != rc.report.points_out;
+        });
+    }
+    EXPECT_EQ(plain.counters().points_removed_noise, from_file.counters().points_removed_noise);
+    return run;
+}
+
+}  // namespace
+
+TEST(StreamFilter, ADefaultConstructedFilterRunsTheDefaultConfigOnALaserOnlyLog) {
+    const DefaultsRun run = runDefaults(false);
+    ASSERT_GT(run.scans, 500u);
+    EXPECT_GT(run.kept, 10u);
+    EXPECT_EQ(run.same_points, run.kept);
+}
+
+TEST(StreamFilter, ADefaultConstructedFilterRunsTheOdometryCheckOnAFrozenOdometry) {
+    const DefaultsRun run = runDefaults(true);
+    ASSERT_GT(run.scans, 500u);
+    EXPECT_EQ(run.same_points, run.kept);
+    EXPECT_GT(run.differ_from_stage_defaults, 0u);
 }
 
 // One scan of latency (the denoise key next_scan, issue 25).

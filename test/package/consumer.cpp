@@ -1,5 +1,5 @@
-#include <kfd/core/window_helper.h>
 #include <kfd/mrpt/stream_filter.h>
+#include <kfd/paper/window_helper.h>
 
 int main() {
     kfd::StreamFilter filter;

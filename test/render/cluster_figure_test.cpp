@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include "kfd/core/denoiser.h"
+#include "kfd/algorithms/denoiser.h"
 #include "kfd/render/cluster_figure.h"
 #include "test_scans.h"
 

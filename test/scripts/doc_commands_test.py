@@ -26,7 +26,10 @@ BUNDLED = "rawlogs/office-mit-0.752.rawlog"
 NOT_RUN = {
     "bash scripts/demo.sh": "the demo_script test runs it on a clean copy of the tree",
     "bash scripts/test.sh": "it is the test suite",
-    "bash scripts/bench.sh": "benchmarks (minutes of callgrind; docs/RESULTS.md)",
+    "bash scripts/bench/bench.sh": "benchmarks (minutes of callgrind; docs/RESULTS.md)",
+    "cmake -S examples/filter_log": "the library example: package_consumer builds it against an "
+    "installed tree and runs it",
+    "cmake --build build-example": "the library example (package_consumer runs it)",
     "parallel ": "runs kfd-compare's emitted jobs (kfd_compare_test runs them with GNU parallel)",
     "xargs ": "runs kfd-compare's emitted jobs (as parallel does)",
     "sh -c ": "a Slurm array task's line (runs one emitted job)",

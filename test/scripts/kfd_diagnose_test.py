@@ -20,7 +20,7 @@ N = 60
 def write_run(folder, kept, x_of):
     os.makedirs(folder)
     with open(os.path.join(folder, "scans.csv"), "w") as f:
-        # kfd-icp-slam's scans.csv (the per-scan columns of kfd/mrpt/scan_csv.h)
+        # kfd-icp-slam's scans.csv (the per-scan columns of kfd/io/scan_csv.h)
         f.write("index,timestamp,sensor,kept,reason,p_common,p_threshold,references,points_in,"
                 "removed_range,clusters,noise_clusters,removed_noise,points_out,microseconds,"
                 "view_change,changed_fraction,degeneracy,corridor,denoise_bound,odometry_check,icp_goodness,odom_x,odom_y,"

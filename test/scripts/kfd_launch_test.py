@@ -1,5 +1,5 @@
 """kfd's launch files with the real ROS 1 parts (issue 24, "the node and nodelet run from the
-launch files"), on kfd_node_live_test.py's harness (a roscore of its own on 127.0.0.1 and a free
+launch files"), on the live harness (test/support/python/kfd_ros1_harness.py) (a roscore of its own on 127.0.0.1 and a free
 port, every process killed at the end): `roslaunch kfd_ros kfd_bag.launch` with the node and
 with the nodelet in the launch's own manager, `roslaunch kfd_ros kfd.launch manager:=...` into a
 nodelet manager already running (the test plays the bag), each on the bag kfd_bench_fast_bag
@@ -18,9 +18,8 @@ import time
 import unittest
 import xmlrpc.client
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import kfd_node_live_test as live  # noqa: E402 (the harness)
-from kfd_node_live_test import _kill_group, scans_of  # noqa: E402
+import kfd_ros1_harness as live  # test/support/python (PYTHONPATH: test/CMakeLists.txt)
+from kfd_ros1_harness import _kill_group, scans_of
 
 ROS_PKGS = FAST_BAG_EXE = NODELET_EXE = None
 MANAGER = "kfd_manager"

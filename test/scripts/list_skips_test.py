@@ -1,4 +1,4 @@
-"""scripts/list-skips.sh (the end of scripts/test.sh): over a hand-made excerpt of ctest's
+"""scripts/ci/list-skips.sh (the end of scripts/test.sh): over a hand-made excerpt of ctest's
 LastTest.log it lists each test that skipped itself (GoogleTest's GTEST_SKIP, Python unittest's
 skipTest) with the reason it gave, says how many, and counts no test that ran."""
 import os
@@ -7,7 +7,7 @@ import sys
 import tempfile
 import unittest
 
-SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts",
+SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts", "ci",
                       "list-skips.sh")
 
 # One gtest skip with its message, one gtest pass, one unittest skip, one unittest pass, and the

@@ -1,5 +1,5 @@
-"""scripts/removed_returns.py on hand-made CARMEN logs: three scans of a wall 2 m ahead (the
-robot still), the middle one with a return at 1 m where the others see the wall. Removing that
+"""scripts/experiments/removed_returns.py on hand-made CARMEN logs: three scans of a wall 2 m
+ahead (the robot still), the middle one with a return at 1 m where the others see the wall. Removing that
 return is "seen_through"; removing a wall return is "repeated"; a return whose neighbours have
 none there is "unknown"; the kept returns' sample and the totals add up."""
 import os
@@ -9,7 +9,7 @@ import tempfile
 import unittest
 
 SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts",
-                      "removed_returns.py")
+                      "experiments", "removed_returns.py")
 BEAMS = 11  # 180 degrees, 18 degrees per beam
 
 

@@ -5,8 +5,8 @@
 #include <sstream>
 #include <string>
 
+#include "kfd/io/rawlog_filter.h"
 #include "kfd/mrpt/config.h"
-#include "kfd/mrpt/rawlog_filter.h"
 #include "kfd/sim/simulator.h"
 #include "test_files.h"
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "kfd/eval/trajectory.h"
-#include "kfd/mrpt/rawlog_source.h"
+#include "kfd/io/rawlog_source.h"
 #include "kfd/sim/denoise_quality.h"
 #include "kfd/sim/simulator.h"
 #include "test_files.h"

@@ -17,16 +17,16 @@
 #include <sstream>
 
 #include "kfd/baselines/decimate_stage.h"
-#include "kfd/core/cancel.h"
-#include "kfd/core/format.h"
-#include "kfd/core/keyframe_stage.h"
 #include "kfd/eval/trajectory.h"
+#include "kfd/io/rawlog_filter.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/default_stages.h"
-#include "kfd/mrpt/rawlog_filter.h"
+#include "kfd/os/cancel.h"
+#include "kfd/pipeline/format.h"
 #include "kfd/report/slam_report.h"
 #include "kfd/sim/simulator.h"
 #include "kfd/slam/icp_slam_runner.h"
+#include "kfd/stages/keyframe_stage.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;

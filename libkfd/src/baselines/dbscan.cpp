@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "kfd/core/error.h"
+#include "kfd/pipeline/error.h"
 
 namespace kfd {
 

@@ -1,8 +1,8 @@
 #include "kfd/baselines/motion_filter.h"
 
 #include <cmath>
-#include "kfd/core/error.h"
-#include "kfd/core/pose.h"
+#include "kfd/algorithms/pose.h"
+#include "kfd/pipeline/error.h"
 
 namespace kfd {
 

@@ -1,7 +1,7 @@
 #include "kfd/baselines/radius_outlier.h"
 
 #include <cmath>
-#include "kfd/core/error.h"
+#include "kfd/pipeline/error.h"
 
 namespace kfd {
 

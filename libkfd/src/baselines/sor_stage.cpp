@@ -1,6 +1,6 @@
 #include "kfd/baselines/sor_stage.h"
 
-#include "kfd/core/stage_keys.h"
+#include "kfd/pipeline/stage_keys.h"
 
 namespace kfd {
 

@@ -4,7 +4,7 @@
 #include <limits>
 #include <string>
 
-#include "kfd/core/error.h"
+#include "kfd/pipeline/error.h"
 
 namespace kfd {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "kfd/core/format.h"
+#include "kfd/pipeline/format.h"
 
 namespace kfd {
 namespace {

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "kfd/core/format.h"
-#include "kfd/core/output_paths.h"
+#include "kfd/os/output_paths.h"
+#include "kfd/pipeline/format.h"
 
 namespace kfd {
 

@@ -11,8 +11,8 @@
 #include <optional>
 #include <sstream>
 
-#include "kfd/core/stage_keys.h"
 #include "kfd/mrpt/default_stages.h"
+#include "kfd/pipeline/stage_keys.h"
 #include "yaml_check.h"
 
 namespace kfd {

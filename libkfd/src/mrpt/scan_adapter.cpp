@@ -5,7 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "kfd/mrpt/source.h"
+#include "kfd/io/source.h"
 
 namespace kfd {
 

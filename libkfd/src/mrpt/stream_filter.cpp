@@ -6,13 +6,13 @@
 #include <cstring>
 #include <utility>
 
-#include "kfd/core/denoiser.h"
-#include "kfd/core/distance_filter.h"
-#include "kfd/core/format.h"
-#include "kfd/core/keyframe_selector.h"
+#include "kfd/algorithms/denoiser.h"
+#include "kfd/algorithms/keyframe_selector.h"
+#include "kfd/io/source.h"
 #include "kfd/mrpt/default_stages.h"
 #include "kfd/mrpt/scan_check.h"
-#include "kfd/mrpt/source.h"
+#include "kfd/paper/distance_filter.h"
+#include "kfd/pipeline/format.h"
 
 namespace kfd {
 namespace {

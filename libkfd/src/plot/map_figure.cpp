@@ -6,8 +6,8 @@
 #include <string>
 #include <tuple>
 
-#include "kfd/core/format.h"
 #include "kfd/eval/ate.h"
+#include "kfd/pipeline/format.h"
 
 namespace kfd {
 namespace {

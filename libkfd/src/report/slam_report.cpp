@@ -14,11 +14,11 @@
 
 #include "kfd/baselines/decimate_stage.h"
 #include "kfd/baselines/motion_stage.h"
-#include "kfd/core/cancel.h"
-#include "kfd/core/format.h"
-#include "kfd/core/output_paths.h"
-#include "kfd/mrpt/gz_output.h"
-#include "kfd/mrpt/png_output.h"
+#include "kfd/io/gz_output.h"
+#include "kfd/io/png_output.h"
+#include "kfd/os/cancel.h"
+#include "kfd/os/output_paths.h"
+#include "kfd/pipeline/format.h"
 #include "kfd/plot/map_figure.h"
 
 namespace kfd {

@@ -8,8 +8,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "kfd/mrpt/open_source.h"
-#include "kfd/mrpt/source.h"
+#include "kfd/io/open_source.h"
+#include "kfd/io/source.h"
 #include "kfd/mrpt/stream_filter.h"
 #include "kfd/sim/world.h"
 

@@ -7,13 +7,13 @@
 #include <random>
 #include <vector>
 
-#include "kfd/core/cancel.h"
-#include "kfd/core/output_paths.h"
-#include "kfd/mrpt/gz_output.h"
-#include "kfd/mrpt/open_source.h"
+#include "kfd/io/gz_output.h"
+#include "kfd/io/open_source.h"
+#include "kfd/io/source.h"
 #include "kfd/mrpt/scan_adapter.h"
-#include "kfd/mrpt/source.h"
 #include "kfd/mrpt/stream_filter.h"
+#include "kfd/os/cancel.h"
+#include "kfd/os/output_paths.h"
 #include "kfd/sim/world.h"
 
 namespace kfd {

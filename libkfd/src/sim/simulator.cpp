@@ -10,11 +10,11 @@
 #include <filesystem>
 #include <random>
 
-#include "kfd/core/cancel.h"
-#include "kfd/core/output_paths.h"
 #include "kfd/eval/trajectory.h"
-#include "kfd/mrpt/gz_output.h"
+#include "kfd/io/gz_output.h"
 #include "kfd/mrpt/scan_adapter.h"
+#include "kfd/os/cancel.h"
+#include "kfd/os/output_paths.h"
 
 namespace kfd {
 namespace {

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "kfd/mrpt/rawlog_source.h"
+#include "kfd/io/rawlog_source.h"
 
 namespace kfd {
 namespace {

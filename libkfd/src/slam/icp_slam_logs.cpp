@@ -13,10 +13,10 @@
 #include <mrpt/system/filesystem.h>
 #include <mrpt/system/memory.h>
 
-#include "kfd/core/format.h"
-#include "kfd/mrpt/gz_output.h"
-#include "kfd/mrpt/png_output.h"
-#include "kfd/mrpt/source.h"
+#include "kfd/io/gz_output.h"
+#include "kfd/io/png_output.h"
+#include "kfd/io/source.h"
+#include "kfd/pipeline/format.h"
 
 namespace kfd {
 namespace {

@@ -22,17 +22,17 @@
 
 #include "kfd/baselines/decimate_stage.h"
 #include "kfd/baselines/motion_stage.h"
-#include "kfd/core/cancel.h"
-#include "kfd/core/format.h"
-#include "kfd/core/keyframe_stage.h"
 #include "kfd/eval/ate.h"
+#include "kfd/io/open_source.h"
+#include "kfd/io/scan_csv.h"
+#include "kfd/io/source.h"
 #include "kfd/mrpt/config.h"
-#include "kfd/mrpt/open_source.h"
 #include "kfd/mrpt/scan_check.h"
-#include "kfd/mrpt/scan_csv.h"
-#include "kfd/mrpt/source.h"
 #include "kfd/mrpt/stream_filter.h"
+#include "kfd/os/cancel.h"
+#include "kfd/pipeline/format.h"
 #include "kfd/slam/gap_check.h"
+#include "kfd/stages/keyframe_stage.h"
 
 namespace kfd {
 namespace {

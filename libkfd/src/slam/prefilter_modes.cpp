@@ -1,7 +1,7 @@
 #include "kfd/slam/prefilter_modes.h"
 
-#include "kfd/core/error.h"
 #include "kfd/mrpt/default_stages.h"
+#include "kfd/pipeline/error.h"
 
 namespace kfd {
 namespace {

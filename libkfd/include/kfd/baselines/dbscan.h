@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "kfd/baselines/neighbour_search.h"
-#include "kfd/core/clusters.h"
-#include "kfd/core/error.h"
-#include "kfd/core/scan.h"
+#include "kfd/paper/clusters.h"
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 

@@ -1,7 +1,7 @@
 // Uniform decimation (baseline, beyond the paper): keep a fixed share of the scans, evenly.
 #pragma once
 
-#include "kfd/core/error.h"
+#include "kfd/pipeline/error.h"
 
 namespace kfd {
 

@@ -3,8 +3,8 @@
 
 #include <optional>
 
-#include "kfd/core/error.h"
-#include "kfd/core/scan.h"
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 

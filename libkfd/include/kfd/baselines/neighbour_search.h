@@ -7,7 +7,7 @@
 #include <memory>
 #include <vector>
 
-#include "kfd/core/scan.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "kfd/baselines/radius_outlier.h"
-#include "kfd/core/stage.h"
+#include "kfd/pipeline/stage.h"
 
 namespace kfd {
 

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "kfd/core/error.h"
-#include "kfd/core/scan.h"
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 

@@ -7,7 +7,7 @@
 #include "kfd/baselines/radius_stage.h"
 #include "kfd/baselines/shadow_stage.h"
 #include "kfd/baselines/sor_stage.h"
-#include "kfd/core/stage_registry.h"
+#include "kfd/pipeline/stage_registry.h"
 
 namespace kfd {
 

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "kfd/baselines/neighbour_search.h"
-#include "kfd/core/error.h"
-#include "kfd/core/scan.h"
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 

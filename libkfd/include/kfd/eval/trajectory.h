@@ -1,4 +1,4 @@
-// Stamped 2D trajectories: TUM file I/O and lookup by timestamp (SE(2) helpers: core/pose.h).
+// Stamped 2D trajectories: TUM file I/O and lookup by timestamp (SE(2) helpers: algorithms/pose.h).
 // std only.
 #pragma once
 
@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "kfd/core/error.h"
-#include "kfd/core/pose.h"  // compose, inverse, between, wrapAngle
-#include "kfd/core/scan.h"
+#include "kfd/algorithms/pose.h"  // compose, inverse, between, wrapAngle
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 
@@ -31,7 +31,7 @@ using Trajectory = std::vector<StampedPose>;
 /// from the quaternion (any non-zero norm). Throws EvalError naming the file and line on
 /// malformed input: missing, unparsable or non-finite numbers, a quaternion of norm 0.
 Trajectory readTum(const std::string& path);
-/// Writes `traj` as TUM lines through kfd's checked OutputFile (kfd/core/output_paths.h):
+/// Writes `traj` as TUM lines through kfd's checked OutputFile (kfd/os/output_paths.h):
 /// WriteError naming `name` (the file users know; `path` when empty) and the reason when any
 /// write, the fsync or the close fails.
 void writeTum(const std::string& path, const Trajectory& traj, const std::string& name = {});

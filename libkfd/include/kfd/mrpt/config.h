@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "kfd/core/error.h"
-#include "kfd/core/pipeline.h"
-#include "kfd/core/stage_registry.h"
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/pipeline.h"
+#include "kfd/pipeline/stage_registry.h"
 
 namespace mrpt::config {
 class CConfigFileBase;

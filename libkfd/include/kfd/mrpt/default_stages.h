@@ -2,7 +2,7 @@
 #pragma once
 
 #include "kfd/baselines/stages.h"
-#include "kfd/core/stage_registry.h"
+#include "kfd/pipeline/stage_registry.h"
 
 namespace kfd {
 

@@ -3,7 +3,7 @@
 
 #include <mrpt/obs/CObservation2DRangeScan.h>
 
-#include "kfd/core/scan.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 

@@ -6,13 +6,13 @@
 #include <cstddef>
 #include <optional>
 
-#include "kfd/core/scan.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 
 /// The check of the one door: StreamFilter::process (kfd/mrpt/stream_filter.h) runs it on every
 /// scan before any stage, and nothing else does. Skip reasons are kfd::ScanSkipReason
-/// (kfd/core/scan.h). A skipped scan never reaches a stage nor the map builder; it is counted
+/// (kfd/pipeline/scan.h). A skipped scan never reaches a stage nor the map builder; it is counted
 /// per reason (ScanCounters, the per-scan CSV's reason "skipped:<reason>").
 
 /// What checkScan() found.

@@ -8,8 +8,8 @@
 #include <optional>
 #include <string>
 
-#include "kfd/core/odometry_check.h"
-#include "kfd/core/scan.h"
+#include "kfd/algorithms/odometry_check.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 
@@ -28,7 +28,7 @@ inline const char* toString(DenoiseBound b) {
                                                 : "none";
 }
 
-/// One scan as the door saw it: the row of the per-scan CSV (kfd/mrpt/scan_csv.h documents
+/// One scan as the door saw it: the row of the per-scan CSV (kfd/io/scan_csv.h documents
 /// the columns). A skipped scan (bad geometry) has `skipped` set, points_in = its beam count
 /// and zeros elsewhere.
 struct ScanRecord {
@@ -49,7 +49,7 @@ struct ScanRecord {
     std::size_t removed_noise = 0;  // by the denoising stages
     std::size_t points_out = 0;     // valid beams leaving the pipeline
     double microseconds = 0.0;      // time in the pipeline's stages
-    double view_change = 0.0;       // the view selector's measures (kfd/core/view_selector.h)
+    double view_change = 0.0;       // the view selector's measures (kfd/algorithms/view_selector.h)
     double changed_fraction = 0.0;
     double degeneracy = 1.0;
     bool corridor = false;           // the corridor switch found the scan degenerate

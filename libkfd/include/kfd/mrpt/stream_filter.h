@@ -13,9 +13,10 @@
 
 #include <mrpt/obs/CObservation2DRangeScan.h>
 
-#include "kfd/core/pipeline.h"
+#include "kfd/io/source.h"
+#include "kfd/mrpt/config.h"
 #include "kfd/mrpt/scan_record.h"
-#include "kfd/mrpt/source.h"
+#include "kfd/pipeline/pipeline.h"
 
 namespace kfd {
 
@@ -36,7 +37,7 @@ struct StreamResult {
     bool bad_odometry = false;     // the odometry given was not finite: used as unknown
     bool stamp_backwards = false;  // this scan's stamp is before the sensor's previous one
     ScanReport report;             // every stage's diagnostics and the time spent
-    ScanRecord record;             // the scan's row of the per-scan CSV (kfd/mrpt/scan_csv.h)
+    ScanRecord record;             // the scan's row of the per-scan CSV (kfd/io/scan_csv.h)
 };
 
 /// Holds the state of a scan stream: one Pipeline per sensor label, so two lasers on one robot
@@ -71,10 +72,14 @@ class StreamFilter {
     /// Builds stages for a new sensor; lets callers add custom stages (e.g. baselines).
     using StageFactory = std::function<void(Pipeline&)>;
 
-    /// `one_scan_latency`: the caller handles pending results (takeFinished(), finish()).
-    /// Without it, a pipeline that holds scans (the denoise key next_scan = true) is refused:
-    /// kfd::ParameterError naming next_scan (a tool that would use a held scan unfinished).
-    explicit StreamFilter(const Pipeline::Params& params = {}, StageFactory extra = {},
+    /// `params`: kfd's defaults (kfdDefaults(), share/kfd/default.ini) unless given, so that a
+    /// default-constructed filter runs what kfd-filter runs without -c (pass Pipeline::Params{}
+    /// for the stages' own Params defaults: distance, keyframe, denoise without the odometry
+    /// check). `one_scan_latency`: the caller handles pending results (takeFinished(),
+    /// finish()). Without it, a pipeline that holds scans (the denoise key next_scan = true) is
+    /// refused: kfd::ParameterError naming next_scan (a tool that would use a held scan
+    /// unfinished).
+    explicit StreamFilter(const Pipeline::Params& params = kfdDefaults(), StageFactory extra = {},
                           bool one_scan_latency = false);
 
     /// The one door: checks the scan (kfd::checkScan, the only place it runs), then runs the

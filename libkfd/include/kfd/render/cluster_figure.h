@@ -9,9 +9,9 @@
 #include <stdexcept>
 #include <utility>
 
-#include "kfd/core/clusters.h"
-#include "kfd/core/error.h"
-#include "kfd/core/scan.h"
+#include "kfd/paper/clusters.h"
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 

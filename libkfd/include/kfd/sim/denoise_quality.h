@@ -6,7 +6,7 @@
 #include <functional>
 #include <string>
 
-#include "kfd/core/pipeline.h"
+#include "kfd/pipeline/pipeline.h"
 #include "kfd/sim/noise_injector.h"
 #include "kfd/sim/real_noise.h"
 

@@ -5,8 +5,8 @@
 #include <random>
 #include <vector>
 
-#include "kfd/core/error.h"
-#include "kfd/core/scan.h"
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 

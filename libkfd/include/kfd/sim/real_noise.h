@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "kfd/core/error.h"
-#include "kfd/core/scan.h"
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/scan.h"
 #include "kfd/sim/noise_injector.h"
 
 namespace kfd {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "kfd/core/error.h"
+#include "kfd/pipeline/error.h"
 
 namespace kfd {
 

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "kfd/core/output_paths.h"
-#include "kfd/core/scan.h"
+#include "kfd/os/output_paths.h"
+#include "kfd/pipeline/scan.h"
 
 namespace kfd {
 

@@ -10,13 +10,13 @@
 #include <string>
 #include <vector>
 
-#include "kfd/core/error.h"
-#include "kfd/core/output_paths.h"
-#include "kfd/core/pipeline.h"
 #include "kfd/eval/relations.h"
 #include "kfd/eval/trajectory.h"
+#include "kfd/io/source.h"
 #include "kfd/mrpt/scan_record.h"
-#include "kfd/mrpt/source.h"
+#include "kfd/os/output_paths.h"
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/pipeline.h"
 #include "kfd/slam/icp_slam_logs.h"
 #include "kfd/slam/prefilter_modes.h"
 
@@ -223,7 +223,7 @@ class SlamOptionError : public SlamError {
 /// log_times.txt, log_MemoryUsage.txt, one line per icp-slam step; the periodic
 /// mapbuild_posepdf_NNN.txt and buildingmap_NNNNN.3Dscene; with write_map _finalmap_.simplemap
 /// and _finalmaps_.txt_*; the keys it cannot honour are summary.notices) and scans.csv (the
-/// door's per-scan records with the scan's pose, kfd/mrpt/scan_csv.h), through kfd's checked
+/// door's per-scan records with the scan's pose, kfd/io/scan_csv.h), through kfd's checked
 /// writers: a failed write is a WriteError (a ScanCsvError for scans.csv) naming the file's final
 /// name and the reason ("cannot write OUT/scans.csv: No space left on device").
 /// summary.json, final_map.simplemap, map.png, map_figure.png and report.md are written from

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "kfd/core/pipeline.h"
+#include "kfd/pipeline/pipeline.h"
 
 namespace kfd {
 

@@ -1,0 +1,283 @@
+// kfd's evidence variant of the denoiser (beyond the paper): spatial and temporal evidence,
+// with thresholds derived from the scan itself. std only.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "kfd/paper/clusters.h"
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/scan.h"
+
+namespace kfd {
+
+/// Why: on real scans with injected noise, clustering by size alone finds few outliers and
+/// removes real points (docs/RESULTS.md). A one-beam spike 0.2 m in front of a wall, a burst of
+/// 20 beams at 1 m and a chair leg look alike to a clusterer; what differs is the evidence:
+///  - spatial: does a return continue a surface of its neighbours?
+///  - temporal: did the last keyframes see the same place, or see *through* it?
+///
+/// Per scan (n beams, O(n), no allocation once the buffers have grown):
+///  1. Range noise sigma from the scan: a line in polar coordinates satisfies
+///     1/r(i-1) + 1/r(i+1) = 2 cos(res) / r(i), so the residual e(i) of each beam against its
+///     two neighbours is ~ N(0, 1.5 sigma^2) on any flat surface, at any incidence. sigma is
+///     the lower decile of |e| (every fourth beam) scaled to a standard deviation, floored at
+///     min_sigma_m and smoothed over scans, or fixed by sigma_m. Resolution comes from the
+///     geometry: nothing is tuned per sensor.
+///  2. Segments: consecutive returns (at most max_gap_beams missing between them) are one
+///     surface when their distance is within the adaptive breakpoint
+///     D = r_min sin(dtheta) / sin(lambda - dtheta) + 3 sqrt(2) sigma (Borges & Aldon 2004), or
+///     when both lie on a line with their own neighbours (|e| <= 3 sqrt(1.5) sigma at both):
+///     the second test keeps far walls seen at grazing angles in one piece, which the
+///     breakpoint (and laser_filters' shadow filter) cut into single points.
+///  3. Temporal evidence from the last two keyframes this filter saw. The step from the newest
+///     comes from odometry (or zero motion when the scans carry none), refined by a projective
+///     point-to-line alignment (refine_iterations x refine_samples returns). Each return is
+///     moved into the keyframe's sensor frame and compared with the beams bracketing it:
+///     - free: both bracketing beams reached beyond it by more than m: the keyframe saw
+///       through this place (an outlier, or a moving object: a free return within
+///       moving_object_m of a return that was free in the keyframe is "tracked" and kept);
+///     - supported: within m plus one beam's arc of a keyframe return, or within m of the
+///       keyframe's surface segment between the bracketing returns; the older keyframe may
+///       support what the newest could not, never overrule free space;
+///     - unknown otherwise (occluded before, out of the keyframe's view, no return there).
+///     m = 3 sqrt(2) sigma + pose_trans_error_m + motion_error_fraction x translation
+///         + range x (pose_rot_error_deg + motion_error_fraction x rotation),
+///     plus range x resolution for the free test across a depth edge of the keyframe.
+///     Returns off a line, of short segments, and every fourth along a line are classified.
+///  3b. Temporal evidence from the raw scans just before (issue 25, temporal_scans > 0): the
+///     last temporal_scans scans the filter was shown (observe(): the scans the keyframe stage
+///     dropped; filter(): the keyframes, before removal) are kept as copies of their ranges,
+///     flags and odometry. At a keyframe the newest is converted (points, breakpoint links)
+///     and aligned like a keyframe (refineStep from odometry or zero motion); its step is
+///     milliseconds long, so its margin comes from the alignment instead of the constants:
+///     m = 3 max(sqrt(2) sigma, s) + motion_error_fraction x translation
+///         + range x motion_error_fraction x rotation,
+///     s = 1.4826 x the median |point-to-line residual| of the alignment's last iteration.
+///     Its verdict (free or supported) comes first; the keyframes decide what it left unknown
+///     (and may still call a free return tracked); older raw scans only add support. Without
+///     a usable alignment (too few pairs, no common odometry frame) it is not used.
+///  3c. The raw scan just after (issue 25, next_scan = true, one scan of latency): the caller
+///     holds the keyframe until the sensor's next scan (dropped or kept) and calls
+///     filter(scan, out, &next) (kfd::Pipeline does this: Stage::defers). The next scan is
+///     converted and aligned like step 3b's newest raw scan (same margins). The exact rule,
+///     per classified return, from the raw scan before (B) and the one after (A):
+///     - supported when B or A supports it;
+///     - else free when B or A saw through it (then tracked when the newest keyframe says so);
+///     - else unknown: the keyframes (and older raw scans) decide, as in step 3.
+///     So a return seen by neither neighbour in space one of them saw through goes (a burst
+///     that came and went); a surface newly revealed in the keyframe and still there in the
+///     next scan stays. Without a next scan (the end of a log, a reset, a geometry change:
+///     filter(scan, out) or next = nullptr) step 3b alone runs. The raw scans' verdict is
+///     dropped together in step 5's first re-run (the keyframes alone).
+///  4. Removal: every free return not on a line with its neighbours; every segment whose
+///     classified returns are at least half free; every small segment without a supported
+///     return. A segment is small when it has fewer points than an object of
+///     min_object_size_m returns at its range, clamped to [1, max_small_points]: single beams
+///     at 5 m on a 1-degree scanner, up to 3 at 1 m on a 0.25-degree one. Without temporal
+///     evidence (first scan, too large a step, a new geometry) only small segments go.
+///  5. Bounded removal (issue 22): when the removals of step 4 exceed max_removed_fraction of
+///     the scan's valid returns, the references are stale (a turn or a walk away, odometry
+///     that lied), not the scan: with step 3b's raw scans, steps 3-4 first run again on the
+///     keyframes alone; then step 4 runs again without temporal evidence. When even that
+///     exceeds the bound, the smallest segments go first until the bound is reached. Both are
+///     reported (Result::stale_references, Result::capped).
+///     Except for a burst (issue 25): when the raw scan just before was used and supports at
+///     least confirm_support of the returns it judged outside the segments to be removed (its
+///     alignment holds: the scan, not the reference, changed there), the removal stands up to
+///     max_confirmed_fraction of the valid returns (Result::confirmed). A 3-20-beam burst is
+///     up to 11 % of a 180-beam scan; stale references or a failed alignment leave free
+///     returns scattered over the surfaces that stay, and fall back as above.
+class EvidenceFilter {
+  public:
+    struct Params {
+        double incidence_deg = 10.0;       // lambda (deg): breakpoint incidence limit (step 2)
+        double sigma_m = 0.0;              // m: range noise; 0 = estimated from the scans (step 1)
+        double min_sigma_m = 0.01;         // m: floor of the estimate (range quantisation)
+        std::size_t max_gap_beams = 2;     // missing beams a segment may span (dropouts)
+        double min_object_size_m = 0.1;    // m: the smallest real object kept without support
+        std::size_t max_small_points = 3;  // points: a larger segment is never "small"
+        bool temporal = true;              // use the previous keyframe (step 3)
+        // Pose margins (step 3), wide enough for the steps between SLAM keyframes: with 2 cm,
+        // 0.5 deg and 10 % the denoiser found more spikes but made ICP worse on two of four
+        // logs (docs/RESULTS.md, "Do no harm").
+        double pose_trans_error_m = 0.05;    // m: odometry error of one step
+        double pose_rot_error_deg = 1.0;     // deg: the same, in rotation
+        double motion_error_fraction = 0.2;  // error per metre / per radian of odometry step
+        double moving_object_m = 0.5;        // m: reach of a moving object between keyframes
+        double max_step_m = 2.0;             // m: farther keyframes give no temporal evidence
+        double max_step_deg = 45.0;          // deg: the same, in rotation
+        std::size_t refine_iterations = 3;   // Gauss-Newton steps aligning to the keyframe
+        std::size_t refine_samples = 128;    // returns used per step (every n/128-th)
+        double refine_gate_m = 1.0;          // m: pairing gate of the first step (halved after)
+        /// Largest share of a scan's valid returns removed (step 5), in (0, 1]; 1 = no bound.
+        /// 5 %: issue 22's bound; real bursts cover 0.3-1.2 % of a log's returns (RESULTS).
+        double max_removed_fraction = 0.05;
+        /// Step 5's exception for bursts: removals beyond max_removed_fraction are kept, up to
+        /// max_confirmed_fraction of the valid returns, when the raw scan just before (step 3b)
+        /// supports at least confirm_support of the returns it judged outside the removed
+        /// segments (a good alignment: the burst is what changed, not the references).
+        double max_confirmed_fraction = 0.25;
+        double confirm_support = 0.9;
+        /// Raw scans kept for step 3b (the scans just before a keyframe, dropped or not), in
+        /// [0, 16]; 0 = keyframes only (no copies, the behaviour before issue 25). 1: on six
+        /// real logs with injected noise (seed 7, kept scans) every kind's recall rose (isolated
+        /// +1 to +8 points) at -0.04 to +0.16 points of real returns kept on the clean logs;
+        /// 2 gave the same within 0.5 points (docs/RESULTS.md, issue 25).
+        std::size_t temporal_scans = 1;
+        /// Step 3c: also confirm a keyframe against the raw scan just after it. Costs one scan
+        /// of latency (kfd::Pipeline holds the keyframe until the next scan; a node publishes
+        /// it one scan later): for offline use and nodes that can afford it. Needs temporal.
+        bool next_scan = false;
+    };
+
+    struct Result {
+        std::size_t points_removed = 0;
+        std::size_t segments = 0;
+        std::size_t small_segments = 0;  // small segments removed
+        std::size_t free_points = 0;     // returns in space the previous keyframe saw through
+        std::size_t supported = 0;       // returns the previous keyframe confirmed
+        std::size_t tracked = 0;         // free, but near a moving object seen before: kept
+        bool temporal = false;           // temporal evidence was used for this scan
+        bool refined = false;            // the odometry step was refined against the keyframe
+        double sigma = 0.0;              // m: range noise used
+        /// m: the scans' residuals' own estimate, before the floor min_sigma_m (smoothed over
+        /// scans like sigma); 0 when nothing was measured (sigma_m set, or too few residuals
+        /// so far). sigma is the floor when this is below it.
+        double sigma_measured = 0.0;
+        std::size_t removal_wanted = 0;  // returns steps 1-4 would have removed
+        bool stale_references = false;   // step 5: temporal evidence ignored for this scan
+        bool capped = false;             // step 5: spatial removal cut to the bound too
+        bool recent = false;             // step 3b: the raw scan just before was used
+        double recent_margin_m = 0.0;    // m: its margin's constant part (3 max(sqrt 2 sigma, s))
+        bool recent_overruled = false;   // step 5: it wanted too much; the keyframes alone used
+        bool confirmed = false;  // step 5: beyond the bound, confirmed by the raw scan just before
+        bool next = false;       // step 3c: the raw scan just after was used
+    };
+
+    EvidenceFilter() { initialize(Params{}); }
+    explicit EvidenceFilter(const Params& p) { initialize(p); }
+    void initialize(const Params& p);  // kfd::ParameterError on bad values
+    const Params& params() const { return params_; }
+
+    /// Filters the scan (clears the valid flag of removed returns); `out` receives the
+    /// segments as clusters (label per beam, noise flag per segment).
+    Result filter(Scan& scan, Clusters& out);
+    /// The same with the sensor's next scan as a second raw reference (step 3c; `next` as the
+    /// keyframe stage passed it on: dropped or kept, before its own denoising). nullptr or
+    /// next_scan off: filter(scan, out). `next` is only read, during the call.
+    Result filter(Scan& scan, Clusters& out, const Scan* next);
+    /// Keeps a copy of a scan not filtered (one the keyframe stage dropped) as a temporal
+    /// reference for the next keyframe (step 3b). Copies ranges, flags and odometry into a
+    /// ring of temporal_scans preallocated slots: no allocation once they have grown, O(n).
+    /// Does nothing when temporal_scans is 0 or temporal is off.
+    void observe(const Scan& scan);
+    /// Forget the previous keyframe and the noise estimate (a new sensor or log).
+    void reset();
+
+    /// The residual of the middle of three returns at ranges a, r, b, res (rad) apart, against
+    /// the line through the outer two, along its beam (step 1). NaN when a + b are degenerate.
+    static double lineResidual(double a, double r, double b, double cos_res);
+    /// atan2 to ~1e-5 rad (a 0.25-degree beam is 4.4e-3 rad) at a fraction of libm's cost.
+    static float approxAtan2(float y, float x);
+
+  private:
+    enum Evidence : std::uint8_t { kUnknown = 0, kSupported = 1, kFree = 2, kTracked = 3 };
+    // One of the last two keyframes: returns before removal, links, evidence, points, its
+    // odometry pose and the pose refined by the chain of alignments (sensor frames).
+    struct Reference {
+        bool present = false;
+        ScanGeometry geometry;
+        std::vector<float> range, x, y;
+        std::vector<std::uint8_t> valid, link, evidence;
+        bool has_odom = false;
+        Pose2D odom, pose;
+    };
+    // A raw scan kept for step 3b: copies, converted only when a keyframe comes.
+    struct RawScan {
+        ScanGeometry geometry;
+        std::vector<float> range;
+        std::vector<std::uint8_t> valid;
+        bool has_odom = false;
+        Pose2D odom;
+        void copy(const Scan& scan);  // ranges, flags, odometry pose (buffers reused)
+    };
+    // A reference seen from this scan: the step and the margins (m0 + m1 x range).
+    struct Projection {
+        bool usable = false;
+        float c = 1, s = 0, tx = 0, ty = 0, m0 = 0, m1 = 0;
+        const Reference* ref = nullptr;
+    };
+
+    void updateTables(const ScanGeometry& g);
+    double estimateSigma(const Scan& scan);
+    void segment(const Scan& scan, double sigma, Clusters& out);
+    // `recent`: use the raw scans of step 3b (false: the keyframes only).
+    bool temporalEvidence(const Scan& scan, const Clusters& out, double sigma, Result& res,
+                          bool recent);
+    Projection projection(const Reference& ref, const Pose2D& d, double sigma) const;
+    std::uint8_t classify(const Projection& pr, float x, float y, bool free_test) const;
+    // The same for the point (qx, qy) already in the reference's frame, at bracket position u.
+    std::uint8_t classifyAt(const Projection& pr, float qx, float qy, float u,
+                            bool free_test) const;
+    // `spread` (optional): 1.4826 x the median |residual| of the last iteration's pairs (m).
+    bool refineStep(const Scan& scan, const Reference& ref, Pose2D& d,
+                    double* spread = nullptr) const;
+    // Step 3b: the newest raw scan as a projection (usable = false when it cannot be used).
+    // Steps 3b/3c: a converted raw scan aligned from odometry (or zero motion) and its margin
+    // from the alignment (`base`: 3 max(sqrt 2 sigma, s)); usable = false without one.
+    Projection rawProjection(const Scan& scan, const Reference& ref, double sigma,
+                             double* base) const;
+    Projection recentProjection(const Scan& scan, std::size_t age, double sigma, Result& res);
+    // Converts raw scan `age` (0 = newest) into recent_ (points, breakpoint links).
+    bool convertRaw(const Scan& scan, std::size_t age, double sigma);
+    // Converts raw scan `w` into `r` (convertRaw's work, for any slot).
+    bool convertInto(const RawScan& w, Reference& r, const Scan& scan, double sigma);
+    // Step 3c: the next scan (next_) as a projection, converted into next_ref_.
+    Projection nextProjection(const Scan& scan, double sigma, Result& res);
+    void keepRaw(const Scan& scan);
+    bool trackedMotion(const Reference& ref, float qx, float qy, float rho, std::size_t k0) const;
+    void keepAsReference(const Scan& scan);
+    // Step 4: marks noise segments; returns the returns it would remove (`kept_ev`: evidence).
+    std::size_t markNoise(Clusters& out, bool temporal, const std::vector<std::uint8_t>& ev);
+    // Step 5: removals beyond the bound that the raw scan just before confirms.
+    bool confirmedByRecent(const Clusters& out, std::size_t valid_in, std::size_t wanted) const;
+    static constexpr std::size_t kMinConfirmJudged = 16;  // returns judged outside the removal
+    // Step 5: the smallest noise segments only, up to `cap` returns.
+    void capNoise(Clusters& out, std::size_t cap);
+
+    Params params_;
+    double lambda_ = 0.0;
+    BeamDirections dirs_;
+    float first_ = 0.0f, inv_step_ = 0.0f, res_ = 0.0f;  // of the scan's geometry
+    std::vector<float> x_, y_;                           // this scan's points (sensor frame)
+    std::vector<float> scratch_;                         // residuals sampled for the noise quantile
+    std::vector<std::uint8_t> line_;      // per beam: on a line with its two neighbours
+    std::vector<std::uint8_t> link_;      // per beam: one surface with the next return
+    std::vector<std::uint8_t> evidence_;  // per beam: Evidence
+    std::vector<float> sums_;             // per segment: range sum
+    std::vector<std::uint32_t> unknown_;  // beams classified unknown against the newest keyframe
+    std::vector<float> batch_;            // returns to classify: points, projections, brackets
+    std::vector<std::uint32_t> free_in_, supported_in_, classified_in_;  // per segment
+    std::vector<std::uint32_t> order_;                                   // segments by size
+    std::vector<std::uint8_t> small_;                                    // per segment: small
+    double sigma_smoothed_ = -1.0;
+    double measured_smoothed_ = -1.0;       // the same, of the estimates before the floor
+    Reference refs_[2];                     // [0] the newest keyframe
+    std::vector<RawScan> raw_;              // step 3b: ring of temporal_scans raw scans
+    std::size_t raw_next_ = 0;              // the slot the next raw scan goes to
+    std::size_t raw_count_ = 0;             // raw scans held
+    Reference recent_;                      // a raw scan converted for this keyframe
+    std::vector<std::uint8_t> recent_ev_;   // per beam: the raw scan just before's verdict
+    const Scan* next_ = nullptr;            // step 3c: the next scan, during filter() only
+    RawScan next_raw_;                      // its copy (reused buffers)
+    Reference next_ref_;                    // converted
+    mutable std::vector<float> residuals_;  // refineStep's last iteration |e|
+    mutable std::vector<float> align_;      // refineStep's samples, projections, brackets
+    Pose2D pose_;                           // this scan's refined pose (when have_pose_)
+    bool have_pose_ = false;
+};
+
+}  // namespace kfd

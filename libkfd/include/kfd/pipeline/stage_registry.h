@@ -1,0 +1,87 @@
+// Stages found by name (as mp2p_icp's class_name registry): what a pipeline, the config layer,
+// --list-keys and kfd-icp-slam's modes know about every stage (std only).
+#pragma once
+
+#include <functional>
+#include <initializer_list>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <typeinfo>
+#include <vector>
+
+#include "kfd/pipeline/error.h"
+#include "kfd/pipeline/stage.h"
+
+namespace kfd {
+
+/// Everything the registry knows about one stage.
+struct StageInfo {
+    std::string name;            // e.g. "keyframe", as listed in Pipeline::Params::stages
+    std::string help;            // one line
+    std::vector<StageKey> keys;  // its configuration keys, in documentation order
+    std::function<std::unique_ptr<StageParams>()> defaults;  // its Params, default values
+    /// Validates parameters of this stage (kfd::ParameterError naming the Params field).
+    std::function<void(const StageParams&)> validate;
+    /// Builds the stage (validating the parameters once, in the algorithm's initialize()).
+    std::function<std::unique_ptr<Stage>(const StageParams&)> create;
+
+    /// The key whose Params field is `field` (or whose name is `field`), or nullptr.
+    const StageKey* keyForField(std::string_view field) const;
+};
+
+/// A set of stages by name. Registration is explicit (registerCoreStages(),
+/// registerBaselineStages(), kfd::defaultStageRegistry() in the MRPT layer): static
+/// initialisers in a static library would be dropped by the linker.
+class StageRegistry {
+  public:
+    /// Registers stage class S, which provides: static constexpr const char* kName, kHelp;
+    /// a copyable `Params` struct; static std::vector<StageKey> keys(); and a constructor
+    /// S(const Params&) that throws kfd::ParameterError on invalid parameters.
+    template <class S>
+    void add() {
+        using P = typename S::Params;
+        StageInfo info;
+        info.name = S::kName;
+        info.help = S::kHelp;
+        info.keys = S::keys();
+        info.defaults = [] { return std::make_unique<StageParamsOf<P>>(); };
+        info.validate = [](const StageParams& p) { S check(paramsOf<P>(p, S::kName)); };
+        info.create = [](const StageParams& p) -> std::unique_ptr<Stage> {
+            return std::make_unique<S>(paramsOf<P>(p, S::kName));
+        };
+        add(std::move(info));
+    }
+    /// Registers a stage; kfd::Error when the name is taken or empty.
+    void add(StageInfo info);
+
+    /// The stage called `name`, or nullptr.
+    const StageInfo* find(std::string_view name) const;
+    /// Every stage, in registration order.
+    const std::vector<StageInfo>& stages() const { return stages_; }
+    /// "distance, keyframe, denoise, ..." (registration order).
+    std::string names() const;
+
+    /// The typed Params inside `p`; kfd::Error when `p` holds another type.
+    template <class P>
+    static const P& paramsOf(const StageParams& p, const char* stage) {
+        if (p.type() != typeid(P))
+            throw Error(std::string("stage '") + stage + "': parameters of the wrong type", stage);
+        return *static_cast<const P*>(p.data());
+    }
+
+  private:
+    std::vector<StageInfo> stages_;
+};
+
+/// A registry filled by `registrars` in order, e.g. {registerCoreStages, registerBaselineStages}.
+StageRegistry makeStageRegistry(std::initializer_list<void (*)(StageRegistry&)> registrars);
+
+/// Registers the paper's stages: distance (Algorithm 1), keyframe (Sec. 3.1), denoise
+/// (Sec. 3.2), in that order.
+void registerCoreStages(StageRegistry& registry);
+
+/// A registry holding the core stages only (what Pipeline uses unless told otherwise).
+const StageRegistry& coreStageRegistry();
+
+}  // namespace kfd

@@ -1,0 +1,869 @@
+#include "kfd/algorithms/evidence_filter.h"
+#include "kfd/algorithms/point_to_line.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "kfd/algorithms/pose.h"
+
+namespace kfd {
+
+namespace {
+
+constexpr double kDeg = kPi / 180.0;
+
+/// Distance squared from (px, py) to the segment (ax, ay)-(bx, by).
+inline float segmentDistance2(float px, float py, float ax, float ay, float bx, float by) {
+    const float ux = bx - ax, uy = by - ay, wx = px - ax, wy = py - ay;
+    const float uu = ux * ux + uy * uy;
+    float t = uu > 0.0f ? (wx * ux + wy * uy) / uu : 0.0f;
+    t = std::min(1.0f, std::max(0.0f, t));
+    const float dx = wx - t * ux, dy = wy - t * uy;
+    return dx * dx + dy * dy;
+}
+
+// sqrt(1.5): the residual of a beam against its two neighbours' line has variance 1.5 sigma^2.
+constexpr double kResidualScale = 1.2247448713915889;
+
+/// atan(a) / a for a in [0, 1]: a minimax polynomial (atan to ~1e-5 rad).
+inline float atanUnit(float a) {
+    const float s = a * a;
+    return ((((-0.0117212f * s + 0.05265332f) * s - 0.11643287f) * s + 0.19354346f) * s -
+            0.33262347f) *
+               s +
+           0.99997726f;
+}
+
+/// EvidenceFilter::approxAtan2, inlined where it runs per projected return.
+inline float fastAtan2(float y, float x) {
+    const float ax = std::abs(x), ay = std::abs(y);
+    const float mx = std::max(ax, ay), mn = std::min(ax, ay);
+    if (!(mx > 0.0f)) return 0.0f;
+    const float a = mn / mx;
+    float r = atanUnit(a) * a;
+    if (ay > ax) r = 1.57079637f - r;
+    if (x < 0.0f) r = 3.14159274f - r;
+    return y < 0.0f ? -r : r;
+}
+
+/// `c ? a : b` by bit masks: GCC (-ftrapping-math) if-converts no floating-point select in an
+/// omp simd loop, but vectorises these.
+inline float pick(bool c, float a, float b) {
+    std::uint32_t ua, ub;
+    std::memcpy(&ua, &a, sizeof ua);
+    std::memcpy(&ub, &b, sizeof ub);
+    const std::uint32_t m = 0u - static_cast<std::uint32_t>(c);
+    const std::uint32_t r = (ua & m) | (ub & ~m);
+    float f;
+    std::memcpy(&f, &r, sizeof f);
+    return f;
+}
+
+/// fastAtan2 without branches (for omp simd loops): the same operations, the same results.
+inline float fastAtan2Select(float y, float x) {
+    const float ax = std::abs(x), ay = std::abs(y);
+    const float mx = pick(ax < ay, ay, ax), mn = pick(ay < ax, ay, ax);  // std::max, std::min
+    const float a = mn / mx;
+    float r = atanUnit(a) * a;
+    r = pick(ay > ax, 1.57079637f - r, r);
+    r = pick(x < 0.0f, 3.14159274f - r, r);
+    r = pick(y < 0.0f, -r, r);
+    return pick(mx > 0.0f, r, 0.0f);
+}
+
+/// Points (x, y) moved by the rotation (c, s) and translation (tx, ty) into a reference's
+/// frame (qx, qy), and their bracket positions u = (bearing - first) * inv_step in its beams:
+/// one omp simd pass.
+inline void projectPoints(std::size_t m, const float* x, const float* y, float c, float s, float tx,
+                          float ty, float first, float inv_step, float* qx, float* qy, float* u) {
+#pragma omp simd
+    for (std::size_t j = 0; j < m; ++j) {
+        const float px = c * x[j] - s * y[j] + tx, py = s * x[j] + c * y[j] + ty;
+        qx[j] = px;
+        qy[j] = py;
+        u[j] = (fastAtan2Select(py, px) - first) * inv_step;
+    }
+}
+
+}  // namespace
+
+float EvidenceFilter::approxAtan2(float y, float x) { return fastAtan2(y, x); }
+
+double EvidenceFilter::lineResidual(double a, double r, double b, double cos_res) {
+    const double inv = 1.0 / a + 1.0 / b;
+    if (!(inv > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    return r - 2.0 * cos_res / inv;
+}
+
+void EvidenceFilter::initialize(const Params& p) {
+    if (!(p.incidence_deg > 0.0 && p.incidence_deg < 90.0))
+        throw ParameterError("incidence_deg", "incidence_deg must be in (0, 90)");
+    if (!(p.sigma_m >= 0.0) || !std::isfinite(p.sigma_m))
+        throw ParameterError("sigma_m", "sigma_m must be >= 0 (0 = estimated from the scans)");
+    if (!(p.min_sigma_m > 0.0) || !std::isfinite(p.min_sigma_m))
+        throw ParameterError("min_sigma_m", "min_sigma_m must be > 0");
+    if (p.max_gap_beams > 16)
+        throw ParameterError("max_gap_beams", "max_gap_beams must be in [0, 16]");
+    if (!(p.min_object_size_m >= 0.0) || !std::isfinite(p.min_object_size_m))
+        throw ParameterError("min_object_size_m", "min_object_size_m must be >= 0");
+    if (p.max_small_points > 1000)
+        throw ParameterError("max_small_points", "max_small_points must be in [0, 1000]");
+    auto nonneg = [](double v) { return v >= 0.0 && std::isfinite(v); };
+    if (!nonneg(p.pose_trans_error_m) || !nonneg(p.pose_rot_error_deg) ||
+        !nonneg(p.motion_error_fraction) || !nonneg(p.moving_object_m))
+        throw ParameterError("pose_error", "pose error terms must be finite and >= 0");
+    if (!(p.max_step_m > 0.0) || !(p.max_step_deg > 0.0) || !std::isfinite(p.max_step_m) ||
+        !std::isfinite(p.max_step_deg))
+        throw ParameterError("max_step", "max_step_m and max_step_deg must be > 0");
+    if (p.refine_iterations > 20 || p.refine_samples < 1 || !(p.refine_gate_m > 0.0) ||
+        !std::isfinite(p.refine_gate_m))
+        throw ParameterError("refine", "refine_iterations <= 20, refine_samples >= 1, gate > 0");
+    if (!(p.max_removed_fraction > 0.0 && p.max_removed_fraction <= 1.0))
+        throw ParameterError("max_removed_fraction", "max_removed_fraction must be in (0, 1]");
+    if (!(p.max_confirmed_fraction >= 0.0 && p.max_confirmed_fraction <= 1.0))
+        throw ParameterError("max_confirmed_fraction", "max_confirmed_fraction must be in [0, 1]");
+    if (!(p.confirm_support > 0.0 && p.confirm_support <= 1.0))
+        throw ParameterError("confirm_support", "confirm_support must be in (0, 1]");
+    if (p.temporal_scans > 16)
+        throw ParameterError("temporal_scans", "temporal_scans must be in [0, 16]");
+    params_ = p;
+    raw_.assign(p.temporal_scans, RawScan{});
+    residuals_.reserve(2 * p.refine_samples + 2);
+    align_.reserve(5 * (2 * p.refine_samples + 2));
+    lambda_ = p.incidence_deg * kDeg;
+    reset();
+}
+
+void EvidenceFilter::reset() {
+    refs_[0].present = refs_[1].present = false;
+    sigma_smoothed_ = -1.0;
+    measured_smoothed_ = -1.0;
+    have_pose_ = false;
+    raw_next_ = raw_count_ = 0;
+}
+
+void EvidenceFilter::observe(const Scan& scan) {
+    if (!raw_.empty() && params_.temporal) keepRaw(scan);
+}
+
+void EvidenceFilter::RawScan::copy(const Scan& scan) {
+    geometry = scan.geometry;
+    range.assign(scan.range.begin(), scan.range.end());
+    valid.assign(scan.valid.begin(), scan.valid.end());
+    has_odom = scan.odometry.has_value();
+    odom = has_odom ? compose(*scan.odometry, scan.sensor_pose) : Pose2D{};
+}
+
+void EvidenceFilter::keepRaw(const Scan& scan) {
+    raw_[raw_next_].copy(scan);
+    raw_next_ = (raw_next_ + 1) % raw_.size();
+    raw_count_ = std::min(raw_count_ + 1, raw_.size());
+}
+
+bool EvidenceFilter::convertRaw(const Scan& scan, std::size_t age, double sigma) {
+    if (age >= raw_count_) return false;
+    return convertInto(raw_[(raw_next_ + raw_.size() - 1 - age) % raw_.size()], recent_, scan,
+                       sigma);
+}
+
+bool EvidenceFilter::convertInto(const RawScan& w, Reference& r, const Scan& scan, double sigma) {
+    const std::size_t n = scan.range.size();
+    if (w.geometry != scan.geometry || w.range.size() != n) return false;
+    r.present = true;
+    r.geometry = w.geometry;
+    r.range.assign(w.range.begin(), w.range.end());
+    r.valid.resize(n);
+    r.x.resize(n);
+    r.y.resize(n);
+    r.link.resize(n);
+    if (n > 0) r.link[n - 1] = 0;  // the others are all written below
+    r.evidence.clear();            // no evidence of its own: nothing is tracked against it
+    r.has_odom = w.has_odom;
+    r.odom = r.pose = w.odom;
+    // Branch-free passes (this runs once per keyframe over every beam).
+    const float* range = w.range.data();
+    const std::uint8_t* wv = w.valid.data();
+    const float* cs = dirs_.cos.data();
+    const float* sn = dirs_.sin.data();
+    std::uint8_t* valid = r.valid.data();
+    float* x = r.x.data();
+    float* y = r.y.data();
+    const float max_range = kMaxScanRangeM;
+#pragma omp simd
+    for (std::size_t k = 0; k < n; ++k) {
+        const float rk = range[k];
+        valid[k] = static_cast<std::uint8_t>((wv[k] != 0) & (rk >= 0.0f) & (rk <= max_range));
+        x[k] = rk * cs[k];
+        y[k] = rk * sn[k];
+    }
+    // Links: the breakpoint test of step 2 between neighbouring returns (one surface).
+    const double dt = std::min(static_cast<double>(res_), 0.5 * lambda_);
+    const float factor = static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt));
+    const float noise = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
+    std::uint8_t* link = r.link.data();
+    const std::size_t pairs = n > 0 ? n - 1 : 0;
+#pragma omp simd
+    for (std::size_t k = 0; k < pairs; ++k) {
+        const float dx = x[k + 1] - x[k], dy = y[k + 1] - y[k];
+        const float dmax = std::min(range[k], range[k + 1]) * factor + noise;
+        link[k] =
+            static_cast<std::uint8_t>(valid[k] & valid[k + 1] & (dx * dx + dy * dy <= dmax * dmax));
+    }
+    return true;
+}
+
+EvidenceFilter::Projection EvidenceFilter::rawProjection(const Scan& scan, const Reference& ref,
+                                                         double sigma, double* base) const {
+    Projection pr;
+    Pose2D d;  // this scan's sensor in the raw scan's frame
+    if (scan.odometry && ref.has_odom)
+        d = between(ref.odom, compose(*scan.odometry, scan.sensor_pose));
+    else if (scan.odometry || ref.has_odom)
+        return pr;  // no common frame
+    if (!projection(ref, d, sigma).usable) return pr;
+    double spread = 0.0;
+    if (!refineStep(scan, ref, d, &spread)) return pr;  // no alignment: no margin to trust
+    pr = projection(ref, d, sigma);
+    // The margin from what was measured: the larger of the two scans' range noise and the
+    // alignment's own residual spread (3 standard deviations), plus the odometry-error share
+    // of this (short) step; no constant pose error.
+    *base = 3.0 * std::max(std::sqrt(2.0) * sigma, spread);
+    pr.m0 = static_cast<float>(*base + params_.motion_error_fraction * std::hypot(d.x, d.y));
+    pr.m1 = static_cast<float>(params_.motion_error_fraction * std::abs(d.phi));
+    return pr;
+}
+
+EvidenceFilter::Projection EvidenceFilter::recentProjection(const Scan& scan, std::size_t age,
+                                                            double sigma, Result& res) {
+    if (!convertRaw(scan, age, sigma)) return Projection{};
+    double base = 0.0;
+    const Projection pr = rawProjection(scan, recent_, sigma, &base);
+    if (pr.usable && age == 0) res.recent_margin_m = base;
+    return pr;
+}
+
+EvidenceFilter::Projection EvidenceFilter::nextProjection(const Scan& scan, double sigma,
+                                                          Result& res) {
+    // Step 3c: the next scan, copied and converted like a raw scan of step 3b, aligned the
+    // same way and with the same margins.
+    next_raw_.copy(*next_);
+    if (!convertInto(next_raw_, next_ref_, scan, sigma)) return Projection{};
+    double base = 0.0;
+    const Projection pr = rawProjection(scan, next_ref_, sigma, &base);
+    res.next = pr.usable;
+    return pr;
+}
+
+void EvidenceFilter::updateTables(const ScanGeometry& g) {
+    dirs_.update(g);
+    first_ = static_cast<float>(g.angle(0));
+    inv_step_ = g.beams > 1 ? static_cast<float>(1.0 / g.step()) : 0.0f;
+    res_ = static_cast<float>(g.resolution());
+}
+
+double EvidenceFilter::estimateSigma(const Scan& scan) {
+    if (params_.sigma_m > 0.0) return params_.sigma_m;
+    // The lower decile of |e| over every fourth beam: flat surfaces dominate it, corners and
+    // clutter (which inflate the median on a 1-degree scanner) do not.
+    // decile of |N(0, 1.5 s^2)| = 0.1257 sqrt(1.5) s.
+    const std::size_t n = scan.range.size();
+    const float cos_res = std::cos(res_);
+    scratch_.clear();
+    for (std::size_t i = 1; i + 1 < n; i += 4) {
+        if (!scan.valid[i - 1] || !scan.valid[i] || !scan.valid[i + 1]) continue;
+        const float a = scan.range[i - 1], r = scan.range[i], b = scan.range[i + 1];
+        if (!(a + b > 0.0f)) continue;
+        scratch_.push_back(std::abs(r - 2.0f * cos_res * a * b / (a + b)));
+    }
+    if (scratch_.size() < 16) return sigma_smoothed_ > 0.0 ? sigma_smoothed_ : params_.min_sigma_m;
+    auto q = scratch_.begin() + static_cast<std::ptrdiff_t>(scratch_.size() / 10);
+    std::nth_element(scratch_.begin(), q, scratch_.end());
+    const double measured = static_cast<double>(*q) / (0.1257 * kResidualScale);
+    const double sigma = std::max(params_.min_sigma_m, measured);
+    sigma_smoothed_ = sigma_smoothed_ < 0.0 ? sigma : 0.8 * sigma_smoothed_ + 0.2 * sigma;
+    measured_smoothed_ =
+        measured_smoothed_ < 0.0 ? measured : 0.8 * measured_smoothed_ + 0.2 * measured;
+    return sigma_smoothed_;
+}
+
+void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
+    const std::size_t n = scan.range.size();
+    const float cos_res = std::cos(res_);
+    // On a line with both neighbours: |e| <= 3 sqrt(1.5) sigma, written without the division
+    // (|r (a + b) - 2 cos(res) a b| <= tol (a + b)).
+    const float tol = static_cast<float>(3.0 * kResidualScale * sigma);
+    line_.resize(n);
+    link_.resize(n);
+    const std::uint8_t* valid = scan.valid.data();
+    const float* range = scan.range.data();
+    const float* x = x_.data();
+    const float* y = y_.data();
+    std::uint8_t* line = line_.data();
+    std::uint8_t* link = link_.data();
+    const std::size_t pairs = n > 0 ? n - 1 : 0;
+    if (n > 0) line[0] = line[n - 1] = 0;
+        // Branch-free passes over every beam (the same arithmetic as a test per beam).
+#pragma omp simd
+    for (std::size_t i = 1; i < pairs; ++i) {
+        const float a = range[i - 1], r = range[i], b = range[i + 1];
+        const float sum = a + b;
+        line[i] =
+            static_cast<std::uint8_t>((valid[i - 1] != 0) & (valid[i] != 0) & (valid[i + 1] != 0) &
+                                      (std::abs(r * sum - 2.0f * cos_res * a * b) <= tol * sum));
+    }
+    // Breakpoint distance / r_min per beam step, for steps 1..max_gap + 1 (dtheta < lambda).
+    const std::size_t max_step = params_.max_gap_beams + 1;
+    float factor[18];
+    for (std::size_t k = 1; k <= max_step; ++k) {
+        const double dt = std::min(static_cast<double>(k) * res_, 0.5 * lambda_);
+        factor[k] = static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt));
+    }
+    const float noise = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
+    // Neighbouring returns: one surface within the breakpoint distance or on a line together.
+    const float factor1 = factor[1];
+    if (n > 0) link[n - 1] = 0;
+#pragma omp simd
+    for (std::size_t i = 0; i < pairs; ++i) {
+        const float dx = x[i + 1] - x[i], dy = y[i + 1] - y[i];
+        const float dmax = std::min(range[i], range[i + 1]) * factor1 + noise;
+        link[i] = static_cast<std::uint8_t>(
+            (valid[i] != 0) & (valid[i + 1] != 0) &
+            ((dx * dx + dy * dy <= dmax * dmax) | (line[i] & line[i + 1])));
+    }
+    // Segments (at most n): returns across up to max_gap_beams missing beams are tested here.
+    out.label.resize(n);  // every beam written below (-1: no return)
+    out.size.resize(n);
+    sums_.resize(n);
+    std::int32_t* label = out.label.data();
+    std::uint32_t* size = out.size.data();
+    float* sums = sums_.data();
+    std::size_t count = 0;
+    std::size_t first_valid = 0;
+    while (first_valid < n && !valid[first_valid]) label[first_valid++] = -1;
+    std::size_t last = n;  // the previous valid beam
+    // The open segment's size and range sum stay in registers until the next one starts.
+    std::uint32_t cur_size = 0;
+    float cur_sum = 0.0f;
+    for (std::size_t i = first_valid; i < n; ++i) {
+        if (!valid[i]) {
+            label[i] = -1;
+            continue;
+        }
+        bool linked = false;
+        if (i == last + 1) {
+            linked = link[last] != 0;
+        } else if (last < n && i - last <= max_step) {
+            const float dx = x[i] - x[last], dy = y[i] - y[last];
+            const float dmax = std::min(range[last], range[i]) * factor[i - last] + noise;
+            linked = dx * dx + dy * dy <= dmax * dmax;
+            link[last] = static_cast<std::uint8_t>(linked);
+        }
+        if (!linked) {
+            if (count > 0) {
+                size[count - 1] = cur_size;
+                sums[count - 1] = cur_sum;
+            }
+            ++count;
+            cur_size = 0;
+            cur_sum = 0.0f;
+        }
+        label[i] = static_cast<std::int32_t>(count - 1);
+        ++cur_size;
+        cur_sum += range[i];
+        last = i;
+    }
+    if (count > 0) {
+        size[count - 1] = cur_size;
+        sums[count - 1] = cur_sum;
+    }
+    out.size.resize(count);
+    sums_.resize(count);
+    // A scanner closing the circle: the last segment continues the first across the seam.
+    const ScanGeometry& g = scan.geometry;
+    if (out.size.size() > 1 && last < n && first_valid < last) {
+        const double gap = static_cast<double>(n - 1 - last + first_valid) * res_ + g.seamGap();
+        if (gap <= static_cast<double>(max_step) * res_ + 1e-9) {
+            const float dx = x_[first_valid] - x_[last], dy = y_[first_valid] - y_[last];
+            const double dt = std::min(gap, 0.5 * lambda_);
+            const float dmax = std::min(scan.range[last], scan.range[first_valid]) *
+                                   static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt)) +
+                               noise;
+            if (dx * dx + dy * dy <= dmax * dmax) {
+                const std::size_t tail = out.size.size() - 1;
+                for (std::size_t i = 0; i < n; ++i)
+                    if (out.label[i] == static_cast<std::int32_t>(tail)) out.label[i] = 0;
+                out.size[0] += out.size[tail];
+                sums_[0] += sums_[tail];
+                out.size.pop_back();
+                sums_.pop_back();
+                link_[last] = 1;
+            }
+        }
+    }
+    out.mean_range.resize(out.size.size());
+    for (std::size_t c = 0; c < out.size.size(); ++c)
+        out.mean_range[c] = sums_[c] / static_cast<float>(out.size[c]);
+    out.noise.assign(out.size.size(), 0);
+}
+
+EvidenceFilter::Projection EvidenceFilter::projection(const Reference& ref, const Pose2D& d,
+                                                      double sigma) const {
+    Projection pr;
+    const double step_t = std::hypot(d.x, d.y), step_r = std::abs(d.phi);
+    pr.usable = step_t <= params_.max_step_m && step_r <= params_.max_step_deg * kDeg;
+    pr.m0 = static_cast<float>(3.0 * std::sqrt(2.0) * sigma + params_.pose_trans_error_m +
+                               params_.motion_error_fraction * step_t);
+    pr.m1 = static_cast<float>(params_.pose_rot_error_deg * kDeg +
+                               params_.motion_error_fraction * step_r);
+    pr.c = static_cast<float>(std::cos(d.phi));
+    pr.s = static_cast<float>(std::sin(d.phi));
+    pr.tx = static_cast<float>(d.x);
+    pr.ty = static_cast<float>(d.y);
+    pr.ref = &ref;
+    return pr;
+}
+
+std::uint8_t EvidenceFilter::classify(const Projection& pr, float x, float y,
+                                      bool free_test) const {
+    const float qx = pr.c * x - pr.s * y + pr.tx, qy = pr.s * x + pr.c * y + pr.ty;
+    return classifyAt(pr, qx, qy, (fastAtan2(qy, qx) - first_) * inv_step_, free_test);
+}
+
+std::uint8_t EvidenceFilter::classifyAt(const Projection& pr, float qx, float qy, float u,
+                                        bool free_test) const {
+    const Reference& ref = *pr.ref;
+    const std::size_t rn = ref.range.size();
+    if (!(u >= 0.0f) || !(u < static_cast<float>(rn - 1))) return kUnknown;  // unseen before
+    const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
+    const float rho = std::sqrt(qx * qx + qy * qy);
+    const float m = pr.m0 + pr.m1 * rho;
+    const float arc = rho * res_;  // the spread of a beam's position within its bracket
+    // Free space: both bracketing beams passed this place. On one surface (linked) that
+    // surface lies beyond the nearer of the two; across a depth edge an object could hide
+    // between the beams, so the margin adds the arc.
+    if (free_test && ref.valid[k0] && ref.valid[k1]) {
+        const float mf = ref.link[k0] ? m : m + arc;
+        if (ref.range[k0] > rho + mf && ref.range[k1] > rho + mf)
+            return !ref.evidence.empty() && trackedMotion(ref, qx, qy, rho, k0) ? kTracked : kFree;
+    }
+    // Supported: a reference return within m plus one beam's arc (the same object sampled at
+    // other angles), a beam either side of the bracket, or the reference surface segment
+    // between the bracketing returns within m.
+    const float ms2 = (m + arc) * (m + arc);
+    const std::size_t lo = k0 > 0 ? k0 - 1 : 0, hi = std::min(rn - 1, k1 + 1);
+    for (std::size_t k = lo; k <= hi; ++k) {
+        if (!ref.valid[k]) continue;
+        const float dx = qx - ref.x[k], dy = qy - ref.y[k];
+        if (dx * dx + dy * dy <= ms2) return kSupported;
+    }
+    if (ref.valid[k0] && ref.valid[k1] && ref.link[k0] &&
+        segmentDistance2(qx, qy, ref.x[k0], ref.y[k0], ref.x[k1], ref.y[k1]) <= m * m)
+        return kSupported;
+    return kUnknown;
+}
+
+bool EvidenceFilter::trackedMotion(const Reference& ref, float qx, float qy, float rho,
+                                   std::size_t k0) const {
+    // A return in the reference's own free space near here: a moving object seen before.
+    const double reach = params_.moving_object_m;
+    if (!(reach > 0.0)) return false;
+    const std::size_t rn = ref.range.size();
+    const std::size_t w = std::min<std::size_t>(
+        64, static_cast<std::size_t>(reach / std::max(0.05, static_cast<double>(rho * res_))) + 1);
+    const std::size_t lo = k0 > w ? k0 - w : 0, hi = std::min(rn - 1, k0 + 1 + w);
+    const float r2 = static_cast<float>(reach * reach);
+    for (std::size_t k = lo; k <= hi; ++k) {
+        if (!ref.valid[k] || (ref.evidence[k] != kFree && ref.evidence[k] != kTracked)) continue;
+        const float dx = qx - ref.x[k], dy = qy - ref.y[k];
+        if (dx * dx + dy * dy <= r2) return true;
+    }
+    return false;
+}
+
+bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& d,
+                                double* spread) const {
+    // Projective point-to-line alignment: each sampled return is projected into the reference
+    // scan and paired with the reference segment between its two bracketing beams (when they
+    // are one surface); Gauss-Newton on the distances to those lines corrects the step. The
+    // gate halves per iteration down to 0.1 m; too few pairs keep the step as it is.
+    const std::size_t n = scan.range.size(), rn = ref.range.size();
+    if (params_.refine_iterations == 0 || rn < 2) return false;
+    const std::size_t stride = std::max<std::size_t>(1, n / params_.refine_samples);
+    // Raw pointers: the stores below cannot alias the vectors' own pointers then.
+    const std::uint8_t* valid = scan.valid.data();
+    const float* px = x_.data();
+    const float* py = y_.data();
+    const std::uint8_t* rvalid = ref.valid.data();
+    const std::uint8_t* rlink = ref.link.data();
+    const float* rx = ref.x.data();
+    const float* ry = ref.y.data();
+    const float u_max = static_cast<float>(rn - 1);
+    const float first = first_, inv_step = inv_step_;
+    // The sampled returns, gathered once; per iteration their projections and bracket
+    // positions in one omp simd pass, then the pairs.
+    const std::size_t cap = n / stride + 1;  // within the capacity reserved by initialize()
+    residuals_.resize(cap);
+    align_.resize(5 * cap);
+    float* residuals = residuals_.data();
+    float* sx = align_.data();
+    float* sy = sx + cap;
+    float* qxs = sy + cap;
+    float* qys = qxs + cap;
+    float* us = qys + cap;
+    std::size_t m = 0;
+    for (std::size_t i = 0; i < n; i += stride) {
+        if (!valid[i]) continue;
+        sx[m] = px[i];
+        sy[m] = py[i];
+        ++m;
+    }
+    double gate = params_.refine_gate_m;
+    bool changed = false;
+    for (std::size_t it = 0; it < params_.refine_iterations; ++it) {
+        const float c = static_cast<float>(std::cos(d.phi)),
+                    s = static_cast<float>(std::sin(d.phi));
+        const float tx = static_cast<float>(d.x), ty = static_cast<float>(d.y);
+        const float gate_f = static_cast<float>(gate);
+        projectPoints(m, sx, sy, c, s, tx, ty, first, inv_step, qxs, qys, us);
+        PointToLineSystem<float> sys;
+        std::size_t kept = 0;
+        for (std::size_t j = 0; j < m; ++j) {
+            const float u = us[j];
+            if (!(u >= 0.0f) || !(u < u_max)) continue;
+            const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
+            if (!rvalid[k0] || !rvalid[k1] || !rlink[k0]) continue;
+            const float qx = qxs[j], qy = qys[j];
+            float nx = ry[k0] - ry[k1], ny = rx[k1] - rx[k0];
+            const float len2 = nx * nx + ny * ny;
+            if (!(len2 > 1e-12f)) continue;
+            const float inv = 1.0f / std::sqrt(len2);
+            nx *= inv;
+            ny *= inv;
+            const float e = nx * (qx - rx[k0]) + ny * (qy - ry[k0]);
+            if (std::abs(e) > gate_f) continue;
+            sys.add(nx, ny, qx, qy, e);
+            residuals[kept++] = std::abs(e);
+        }
+        gate = std::max(0.5 * gate, 0.1);
+        if (sys.pairs < 12) break;
+        if (spread) {  // the robust spread of the residuals at the step before this update
+            float* mid = residuals + kept / 2;
+            std::nth_element(residuals, mid, residuals + kept);
+            *spread = 1.4826 * static_cast<double>(*mid);
+        }
+        if (!sys.step(d)) break;
+        changed = true;
+    }
+    return changed;
+}
+
+bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, double sigma,
+                                      Result& res, bool recent) {
+    const std::size_t n = scan.range.size();
+    have_pose_ = false;
+    if (!params_.temporal) return false;
+    // 3b. The raw scan just before (tight margins from its own alignment), when kept.
+    Projection pt;
+    if (recent) pt = recentProjection(scan, 0, sigma, res);
+    res.recent = pt.usable;
+    // 3c. The raw scan just after (next_scan), the same way.
+    Projection pn;
+    if (recent && next_) pn = nextProjection(scan, sigma, res);
+    // This scan's sensor in the newest keyframe's frame: the odometry step (no motion without
+    // odometry), refined.
+    Projection p0;
+    const Reference& r0 = refs_[0];
+    if (r0.present && r0.geometry == scan.geometry) {
+        Pose2D d;
+        bool common = true;
+        if (scan.odometry && r0.has_odom)
+            d = between(r0.odom, compose(*scan.odometry, scan.sensor_pose));
+        else if (scan.odometry || r0.has_odom)
+            common = false;  // odometry appeared or vanished: no common frame
+        if (common && projection(r0, d, sigma).usable) {
+            res.refined = refineStep(scan, r0, d);
+            p0 = projection(r0, d, sigma);
+            pose_ = compose(r0.pose, d);
+            have_pose_ = true;
+        }
+    }
+    if (!pt.usable && !pn.usable && !p0.usable) return false;
+    recent_ev_.assign(pt.usable || pn.usable ? n : 0, kUnknown);
+    // Every return off a line, every return of a short segment, and every fourth return along
+    // a line (enough to tell how much of a surface lies in free space).
+    free_in_.assign(out.count(), 0);
+    supported_in_.assign(out.count(), 0);
+    classified_in_.assign(out.count(), 0);
+    if (unknown_.size() < n) unknown_.resize(n);  // kept at its largest: no refill per scan
+    const std::int32_t* labels = out.label.data();
+    const std::uint32_t* sizes = out.size.data();
+    const std::uint8_t* line = line_.data();
+    const float* x = x_.data();
+    const float* y = y_.data();
+    std::uint8_t* evidence = evidence_.data();
+    std::uint32_t* free_in = free_in_.data();
+    std::uint32_t* supported_in = supported_in_.data();
+    std::uint32_t* classified_in = classified_in_.data();
+    std::uint32_t* unknown = unknown_.data();
+    std::size_t unknowns = 0;
+    // The returns to classify with their points, then (one omp simd pass) their projections
+    // and bracket positions in the first reference asked.
+    if (batch_.size() < 5 * n) batch_.resize(5 * n);  // kept at its largest
+    float* bx = batch_.data();
+    float* by = bx + n;
+    float* bqx = by + n;
+    float* bqy = bqx + n;
+    float* bu = bqy + n;
+    std::size_t listed = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::int32_t label = labels[i];
+        if (label < 0) continue;
+        if (line[i] && (i & 3u) != 0 && sizes[static_cast<std::size_t>(label)] >= 8) continue;
+        unknown[listed] = static_cast<std::uint32_t>(i);
+        bx[listed] = x[i];
+        by[listed] = y[i];
+        ++listed;
+    }
+    const Projection& first_pr = pt.usable ? pt : pn.usable ? pn : p0;
+    projectPoints(listed, bx, by, first_pr.c, first_pr.s, first_pr.tx, first_pr.ty, first_,
+                  inv_step_, bqx, bqy, bu);
+    for (std::size_t j = 0; j < listed; ++j) {
+        const std::size_t i = unknown[j];
+        const auto c = static_cast<std::size_t>(labels[i]);
+        // The raw scan just before decides first; the keyframe decides what it left unknown,
+        // and a return free just before is still tracked when the keyframe saw a moving object
+        // here.
+        std::uint8_t e = classifyAt(first_pr, bqx[j], bqy[j], bu[j], true);
+        if (pt.usable && pn.usable && e != kSupported) {  // 3c: either raw neighbour's support
+            const std::uint8_t en = classify(pn, x[i], y[i], true);
+            if (en != kUnknown) e = en;
+        }
+        if (pt.usable || pn.usable) {
+            if (!recent_ev_.empty()) recent_ev_[i] = e;  // the raw neighbours' verdict (step 5)
+            if (e == kFree && p0.usable && classify(p0, x[i], y[i], true) == kTracked) e = kTracked;
+            if (e == kUnknown && p0.usable) e = classify(p0, x[i], y[i], true);
+        }
+        evidence[i] = e;
+        ++classified_in[c];
+        if (e == kFree) {
+            ++free_in[c];
+            ++res.free_points;
+        } else if (e == kSupported) {
+            ++supported_in[c];
+            ++res.supported;
+        } else if (e == kTracked) {
+            ++res.tracked;
+        } else {
+            unknown[unknowns++] = static_cast<std::uint32_t>(i);
+        }
+    }
+    // The keyframe before it (and the older raw scans) can support what the newest could not
+    // (a thin object between two beams, a return among dropouts); they never overrule free
+    // space.
+    auto support = [&](const Projection& p) {
+        for (std::size_t j = 0; j < unknowns; ++j) {
+            const std::uint32_t i = unknown[j];
+            if (evidence_[i] == kUnknown && classify(p, x_[i], y_[i], false) == kSupported) {
+                evidence_[i] = kSupported;
+                ++supported_in_[static_cast<std::size_t>(out.label[i])];
+                ++res.supported;
+            }
+        }
+    };
+    const Reference& r1 = refs_[1];
+    if (have_pose_ && r1.present && r1.geometry == scan.geometry && unknowns > 0) {
+        const Projection p1 = projection(r1, between(r1.pose, pose_), sigma);
+        if (p1.usable) support(p1);
+    }
+    for (std::size_t age = 1; recent && age < raw_count_ && unknowns > 0; ++age) {
+        const Projection pa = recentProjection(scan, age, sigma, res);
+        if (pa.usable) support(pa);
+    }
+    return true;
+}
+
+void EvidenceFilter::keepAsReference(const Scan& scan) {
+    if (!params_.temporal) {
+        refs_[0].present = refs_[1].present = false;
+        return;
+    }
+    std::swap(refs_[0], refs_[1]);  // the newest becomes the older; buffers are reused
+    Reference& r = refs_[0];
+    r.present = true;
+    r.geometry = scan.geometry;
+    r.range = scan.range;
+    r.valid = scan.valid;
+    r.link.swap(link_);
+    r.evidence.swap(evidence_);
+    r.x.swap(x_);
+    r.y.swap(y_);
+    r.has_odom = scan.odometry.has_value();
+    r.odom = r.has_odom ? compose(*scan.odometry, scan.sensor_pose) : Pose2D{};
+    // The refined pose chains the alignments; without one the odometry (or the origin) starts
+    // a new chain, and the older keyframe is no longer in it.
+    r.pose = have_pose_ ? pose_ : r.odom;
+    if (!have_pose_) refs_[1].present = false;
+}
+
+EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out, const Scan* next) {
+    next_ = params_.next_scan ? next : nullptr;
+    Result res;
+    try {
+        res = filter(scan, out);
+    } catch (...) {
+        next_ = nullptr;
+        throw;
+    }
+    next_ = nullptr;
+    return res;
+}
+
+EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
+    Result res;
+    const std::size_t n = scan.range.size();
+    ScanGeometry geom = scan.geometry;
+    geom.beams = n;  // tables follow the data
+    updateTables(geom);
+    x_.resize(n);
+    y_.resize(n);
+    {
+        const float* range = scan.range.data();
+        const float* cs = dirs_.cos.data();
+        const float* sn = dirs_.sin.data();
+        float* x = x_.data();
+        float* y = y_.data();
+#pragma omp simd
+        for (std::size_t i = 0; i < n; ++i) {
+            x[i] = range[i] * cs[i];
+            y[i] = range[i] * sn[i];
+        }
+    }
+    // 1.-2. Noise, lines and segments.
+    const double sigma = estimateSigma(scan);
+    res.sigma = sigma;
+    res.sigma_measured = params_.sigma_m > 0.0 ? 0.0 : std::max(0.0, measured_smoothed_);
+    segment(scan, sigma, out);
+    res.segments = out.count();
+
+    // 3. Temporal evidence from the last two keyframes.
+    evidence_.assign(n, kUnknown);
+    res.temporal = temporalEvidence(scan, out, sigma, res, true);
+
+    // 4. Segments: small and unsupported, or mostly in free space.
+    const std::size_t valid_in = scan.countValid();
+    const auto cap = static_cast<std::size_t>(
+        std::floor(params_.max_removed_fraction * static_cast<double>(valid_in)));
+    res.removal_wanted = markNoise(out, res.temporal, evidence_);
+    // 5. Bounded removal: more than the bound disagrees with the references: they are stale.
+    // With the raw scan just before, first the keyframes alone (what temporal_scans = 0 does).
+    bool temporal = res.temporal;
+    std::size_t wanted = res.removal_wanted;
+    if (wanted > cap && temporal && res.recent && confirmedByRecent(out, valid_in, wanted)) {
+        res.confirmed = true;  // a burst the raw scan just before saw through: removed whole
+        wanted = 0;
+    }
+    if (wanted > cap && temporal && res.recent) {
+        Result kf;
+        evidence_.assign(n, kUnknown);
+        temporal = temporalEvidence(scan, out, sigma, kf, false);
+        res.free_points = kf.free_points;
+        res.supported = kf.supported;
+        res.tracked = kf.tracked;
+        res.recent_overruled = true;
+        wanted = markNoise(out, temporal, evidence_);
+    }
+    if (wanted > cap && temporal) {
+        res.stale_references = true;
+        temporal = false;
+        if (markNoise(out, false, evidence_) > cap) {
+            capNoise(out, cap);
+            res.capped = true;
+        }
+    } else if (wanted > cap) {
+        capNoise(out, cap);
+        res.capped = true;
+    }
+    for (std::size_t c = 0; c < out.count(); ++c) res.small_segments += out.noise[c] & small_[c];
+    // The previous keyframe for the next scan keeps every return (removed ones too: a thin
+    // object removed once as unsupported must still support the next view).
+    keepAsReference(scan);  // swaps evidence_, x_, y_, link_ away: use the reference's below
+    if (!raw_.empty() && params_.temporal) keepRaw(scan);  // before removal: the raw scan
+    const std::vector<std::uint8_t>& kept_ev = refs_[0].present ? refs_[0].evidence : evidence_;
+    // Free returns go unless they lie on a line with their neighbours (a surface the previous
+    // keyframe saw a little farther: pose error, a door that moved); every return of a removed
+    // segment goes.
+    for (std::size_t i = 0; i < n; ++i) {
+        if (out.label[i] < 0) continue;
+        if (out.noise[static_cast<std::size_t>(out.label[i])] ||
+            (temporal && kept_ev[i] == kFree && !line_[i])) {
+            scan.valid[i] = 0;
+            ++res.points_removed;
+        }
+    }
+    return res;
+}
+
+bool EvidenceFilter::confirmedByRecent(const Clusters& out, std::size_t valid_in,
+                                       std::size_t wanted) const {
+    if (recent_ev_.size() != out.label.size()) return false;
+    if (static_cast<double>(wanted) >
+        params_.max_confirmed_fraction * static_cast<double>(valid_in))
+        return false;
+    // The rest of the scan, as the raw scan just before saw it: a good alignment supports the
+    // surfaces outside the removed segments; stale references or a wrong alignment leave free
+    // returns scattered over them.
+    std::size_t supported = 0, free = 0;
+    for (std::size_t i = 0; i < out.label.size(); ++i) {
+        if (out.label[i] < 0 || out.noise[static_cast<std::size_t>(out.label[i])]) continue;
+        supported += recent_ev_[i] == kSupported;
+        free += recent_ev_[i] == kFree;
+    }
+    const std::size_t judged = supported + free;
+    return judged >= kMinConfirmJudged &&
+           static_cast<double>(supported) >= params_.confirm_support * static_cast<double>(judged);
+}
+
+std::size_t EvidenceFilter::markNoise(Clusters& out, bool temporal,
+                                      const std::vector<std::uint8_t>& ev) {
+    small_.resize(out.count());
+    for (std::size_t c = 0; c < out.count(); ++c) {
+        const double r = std::max(0.05, static_cast<double>(out.mean_range[c]));
+        const double need = res_ > 0.0f ? std::ceil(params_.min_object_size_m / (r * res_)) : 1.0;
+        const auto bar = static_cast<std::size_t>(
+            std::min(static_cast<double>(params_.max_small_points) + 1.0, std::max(2.0, need)));
+        const bool small = out.size[c] < bar;
+        const bool supported = temporal && supported_in_[c] > 0;
+        const bool free = temporal && classified_in_[c] > 0 && 2 * free_in_[c] >= classified_in_[c];
+        out.noise[c] = (small && !supported) || free ? 1 : 0;
+        small_[c] = small ? 1 : 0;
+    }
+    std::size_t removed = 0;
+    for (std::size_t i = 0; i < out.label.size(); ++i) {
+        if (out.label[i] < 0) continue;
+        removed += out.noise[static_cast<std::size_t>(out.label[i])] ||
+                   (temporal && ev[i] == kFree && !line_[i]);
+    }
+    return removed;
+}
+
+void EvidenceFilter::capNoise(Clusters& out, std::size_t cap) {
+    order_.clear();
+    for (std::size_t c = 0; c < out.count(); ++c)
+        if (out.noise[c]) order_.push_back(static_cast<std::uint32_t>(c));
+    // Smallest first; among equals the farthest (fewest returns expected of an object there).
+    std::sort(order_.begin(), order_.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return out.size[a] != out.size[b] ? out.size[a] < out.size[b]
+                                          : out.mean_range[a] > out.mean_range[b];
+    });
+    std::size_t removed = 0;
+    for (const std::uint32_t c : order_) {
+        if (removed + out.size[c] <= cap)
+            removed += out.size[c];
+        else
+            out.noise[c] = 0;
+    }
+}
+
+}  // namespace kfd

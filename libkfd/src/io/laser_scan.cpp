@@ -1,0 +1,70 @@
+#include "kfd/io/laser_scan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+
+namespace kfd {
+
+bool validRange(const sensor_msgs::LaserScan& m, float r) {
+    return std::isfinite(r) && r >= m.range_min && r < m.range_max;
+}
+
+bool laserAnglesMatch(const sensor_msgs::LaserScan& m) {
+    const std::size_t n = m.ranges.size();
+    if (n < 2) return true;
+    const double lo = m.angle_min, hi = m.angle_max, inc = m.angle_increment;
+    if (!std::isfinite(lo) || !std::isfinite(hi) || !std::isfinite(inc) || inc == 0.0) return false;
+    return std::fabs((hi - lo) / inc - static_cast<double>(n - 1)) <= 1.0;
+}
+
+mrpt::obs::CObservation2DRangeScan::Ptr laserScanToObservation(const sensor_msgs::LaserScan& m,
+                                                               double stamp,
+                                                               const std::string& label,
+                                                               const Pose2D& mount) {
+    auto obs = std::make_shared<mrpt::obs::CObservation2DRangeScan>();
+    obs->sensorLabel = label;
+    obs->timestamp = mrpt::Clock::fromDouble(stamp);
+    const std::size_t n = m.ranges.size();
+    const bool angles_ok = laserAnglesMatch(m);
+    obs->aperture = angles_ok
+                        ? static_cast<float>(std::fabs(double(m.angle_max) - double(m.angle_min)))
+                        : std::numeric_limits<float>::quiet_NaN();
+    obs->rightToLeft = !angles_ok || m.angle_increment >= 0.0f;
+    obs->maxRange = m.range_max;
+    const double mid = angles_ok ? 0.5 * (double(m.angle_min) + double(m.angle_max)) : 0.0;
+    obs->sensorPose = mrpt::poses::CPose3D(mount.x, mount.y, 0.0, mount.phi + mid, 0.0, 0.0);
+    obs->resizeScan(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const float r = m.ranges[i];
+        obs->setScanRange(i, std::isfinite(r) ? r : 0.0f);
+        obs->setScanRangeValidity(i, validRange(m, r));
+    }
+    if (m.intensities.size() == n && n > 0) {
+        obs->setScanHasIntensity(true);
+        for (std::size_t i = 0; i < n; ++i)
+            obs->setScanIntensity(
+                i, static_cast<int32_t>(
+                       std::lround(std::isfinite(m.intensities[i]) ? m.intensities[i] : 0.f)));
+    }
+    return obs;
+}
+
+std::size_t markRemovedBeams(sensor_msgs::LaserScan& m,
+                             const mrpt::obs::CObservation2DRangeScan& cleaned, RemovedMark mark) {
+    const float value = mark == RemovedMark::NaN ? std::numeric_limits<float>::quiet_NaN()
+                                                 : std::numeric_limits<float>::infinity();
+    std::size_t marked = 0;
+    const std::size_t n = std::min(m.ranges.size(), cleaned.getScanSize());
+    for (std::size_t i = 0; i < n; ++i) {
+        if (validRange(m, m.ranges[i]) && !cleaned.getScanRangeValidity(i)) {
+            m.ranges[i] = value;
+            ++marked;
+        }
+    }
+    return marked;
+}
+
+}  // namespace kfd

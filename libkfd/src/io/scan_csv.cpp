@@ -1,0 +1,60 @@
+#include "kfd/io/scan_csv.h"
+
+#include <cmath>
+
+#include "kfd/pipeline/format.h"
+
+#include "kfd/io/source.h"
+
+namespace kfd {
+namespace {
+
+// ",x,y,phi" of a pose (%.6f, any size), or ",,," when there is none.
+void appendPose(std::string& line, const std::optional<Pose2D>& p) {
+    line += p ? format(",%.6f,%.6f,%.6f", p->x, p->y, p->phi) : std::string(",,,");
+}
+
+// Runs fn; a failed write comes out as a ScanCsvError with the same message.
+template <class Fn>
+void asScanCsvError(Fn&& fn) {
+    try {
+        fn();
+    } catch (const WriteError& e) {
+        throw ScanCsvError(e.what(), e.field());
+    }
+}
+
+}  // namespace
+
+void ScanCsvWriter::open(const std::string& path, const std::string& name) {
+    asScanCsvError([&] {
+        out_.emplace(path, name);
+        *out_ << "index,timestamp,sensor,kept,reason,p_common,p_threshold,references,points_in,"
+                 "removed_range,clusters,noise_clusters,removed_noise,points_out,microseconds,"
+                 "view_change,changed_fraction,degeneracy,corridor,denoise_bound,odometry_check,"
+                 "icp_goodness,odom_x,odom_y,odom_phi,"
+                 "x,y,phi\n";
+    });
+}
+
+void ScanCsvWriter::write(const ScanRecord& r, const std::optional<Pose2D>& pose) {
+    std::string line = format(
+        "%zu,%.6f,%s,%d,%s,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu,%zu,%zu,%.2f,%.4f,%.4f,%.4f,%d,%s,%s",
+        r.index, stampForOutput(r.stamp), r.sensor.c_str(), r.kept ? 1 : 0, r.reason, r.p_common,
+        r.p_threshold, r.references, r.points_in, r.removed_range, r.clusters, r.noise_clusters,
+        r.removed_noise, r.points_out, r.microseconds, r.view_change, r.changed_fraction,
+        r.degeneracy, r.corridor ? 1 : 0, toString(r.denoise_bound), toString(r.odometry_check));
+    line += std::isnan(r.icp_goodness)
+                ? std::string(",")
+                : format(",%.4f%s", r.icp_goodness, r.icp_rejected ? "r" : "");
+    appendPose(line, r.odometry);
+    appendPose(line, pose);
+    line += '\n';
+    asScanCsvError([&] { out_->write(line); });
+}
+
+void ScanCsvWriter::close() {
+    if (out_) asScanCsvError([&] { out_->close(); });
+}
+
+}  // namespace kfd

@@ -1,0 +1,207 @@
+#include "kfd/pipeline/pipeline.h"
+
+#include <chrono>
+#include <string>
+
+#include "kfd/stages/denoise_stage.h"
+
+namespace kfd {
+
+PipelineParams::PipelineParams(const PipelineParams& o) : stages(o.stages) {
+    for (const auto& e : o.entries_) entries_.push_back(Entry{e.stage, e.params->clone()});
+}
+
+PipelineParams& PipelineParams::operator=(const PipelineParams& o) {
+    if (this != &o) {
+        PipelineParams copy(o);
+        *this = std::move(copy);
+    }
+    return *this;
+}
+
+StageParams& PipelineParams::at(const StageInfo& stage) {
+    if (StageParams* p = find(stage.name)) return *p;
+    entries_.push_back(Entry{stage.name, stage.defaults()});
+    return *entries_.back().params;
+}
+
+StageParams* PipelineParams::find(std::string_view name) {
+    for (auto& e : entries_)
+        if (e.stage == name) return e.params.get();
+    return nullptr;
+}
+
+const StageParams* PipelineParams::find(std::string_view name) const {
+    for (const auto& e : entries_)
+        if (e.stage == name) return e.params.get();
+    return nullptr;
+}
+
+void Pipeline::initialize(const Params& p, const StageRegistry& registry) {
+    if (p.stages.size() > ScanReport::kMaxStages)
+        throw ParameterError("stages",
+                             "more than " + std::to_string(ScanReport::kMaxStages) + " stages");
+    std::vector<const StageInfo*> infos;
+    for (const auto& name : p.stages) {
+        const StageInfo* info = registry.find(name);
+        if (!info)
+            throw ParameterError("stages", "pipeline: unknown stage '" + name +
+                                               "' (known: " + registry.names() + ")");
+        for (const auto* s : infos)
+            if (s == info)
+                throw ParameterError("stages", "pipeline: stage '" + name + "' listed twice");
+        infos.push_back(info);
+    }
+    // Set but not listed: validated here (listed stages validate when they are built).
+    for (const auto& e : p.entries()) {
+        const StageInfo* info = registry.find(e.stage);
+        bool listed = false;
+        for (const auto* s : infos) listed = listed || s == info;
+        if (info && !listed) info->validate(*e.params);
+    }
+    std::vector<std::unique_ptr<Stage>> stages;
+    for (const auto* info : infos) {
+        const StageParams* set = p.find(info->name);
+        stages.push_back(set ? info->create(*set) : info->create(*info->defaults()));
+    }
+    finished_ = false;
+    if (held_) finishHeld(nullptr);  // by the stages that held it; finished() returns it
+    stages_ = std::move(stages);
+    params_ = p;
+    registry_ = &registry;
+}
+
+void Pipeline::add(std::unique_ptr<Stage> stage) {
+    if (!stage) throw Error("pipeline: null stage");
+    if (stages_.size() >= ScanReport::kMaxStages)
+        throw Error("pipeline: more than " + std::to_string(ScanReport::kMaxStages) + " stages");
+    stages_.push_back(std::move(stage));
+}
+
+namespace {
+
+// A stage's end: its time since `t` (then `t` moves on) and, when it dropped the scan, the
+// report says so. Returns `keep`.
+bool endStage(const Stage& stage, bool keep, StageReport& sr, ScanReport& report,
+              std::chrono::steady_clock::time_point& t) {
+    const auto now = std::chrono::steady_clock::now();
+    sr.microseconds = std::chrono::duration<double, std::micro>(now - t).count();
+    t = now;
+    if (!keep) {
+        sr.dropped = true;
+        report.keep = false;
+        report.dropped_by = stage.name();
+    }
+    return keep;
+}
+
+}  // namespace
+
+ScanReport Pipeline::process(Scan& scan) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    ScanReport report;
+    if (scan.valid.size() != scan.range.size())
+        throw ScanError("scan: range and valid sizes differ");
+    {
+        ScanGeometry g = scan.geometry;
+        g.beams = scan.range.size();  // the stages follow the data's length
+        const ScanSkipReason why = checkGeometry(g);
+        if (why != ScanSkipReason::None)
+            throw ScanError(std::string("scan: unusable geometry (") + toString(why) + ")");
+    }
+    finished_ = false;
+    report.points_in = scan.countValid();
+    // One clock read per stage: each stage's end is the next one's start.
+    auto t = t0;
+    for (std::size_t i = 0; i < stages_.size(); ++i) {
+        Stage& stage = *stages_[i];
+        // This scan reached the stage holding the one before: that one is finished first,
+        // with this scan as its next.
+        if (held_ && i == held_stage_) t += finishHeld(&scan);  // not this scan's time
+        StageReport& sr = report.stage_reports[report.stage_count++];
+        sr.name = stage.name();
+        if (stage.defers()) {  // held: finished by the next scan (or finish(), reset())
+            held_scan_ = scan;
+            held_stage_ = i;
+            held_ = true;
+            --report.stage_count;
+            report.pending = true;
+            break;
+        }
+        const bool keep = stage.process(scan, sr, report);
+        if (!keep) {  // the later stages see the dropped scan (Stage::observeDropped)
+            for (std::size_t j = i + 1; j < stages_.size(); ++j) {
+                if (held_ && j == held_stage_) t += finishHeld(&scan);
+                stages_[j]->observeDropped(scan);
+            }
+        }
+        if (!endStage(stage, keep, sr, report, t)) break;
+    }
+    if (stages_.empty()) {
+        report.microseconds = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
+    } else {  // the sum of the stages' times, so that they add up exactly to the chain's time
+        for (std::size_t i = 0; i < report.stage_count; ++i)
+            report.microseconds += report.stage_reports[i].microseconds;
+    }
+    report.points_out = scan.countValid();
+    if (report.pending) held_report_ = report;
+    return report;
+}
+
+// Runs the held scan through the holding stage (with `next` as its next scan) and the later
+// ones; its report becomes finished().
+std::chrono::steady_clock::duration Pipeline::finishHeld(const Scan* next) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    held_ = false;
+    ScanReport& report = held_report_;
+    report.pending = false;
+    auto t = Clock::now();
+    for (std::size_t i = held_stage_; i < stages_.size(); ++i) {
+        Stage& stage = *stages_[i];
+        StageReport& sr = report.stage_reports[report.stage_count++];
+        sr.name = stage.name();
+        const bool keep = i == held_stage_ ? stage.finish(held_scan_, sr, report, next)
+                                           : stage.process(held_scan_, sr, report);
+        if (!keep) {
+            for (std::size_t j = i + 1; j < stages_.size(); ++j)
+                stages_[j]->observeDropped(held_scan_);
+        }
+        const bool kept = endStage(stage, keep, sr, report, t);
+        report.microseconds += sr.microseconds;
+        if (!kept) break;
+    }
+    report.points_out = held_scan_.countValid();
+    // Handed out by finished(); held_scan_ takes the old buffers (no allocation once grown).
+    std::swap(held_scan_, finished_scan_);
+    finished_report_ = report;
+    finished_ = true;
+    return Clock::now() - t0;
+}
+
+const Scan* Pipeline::finished(ScanReport& report) const {
+    if (!finished_) return nullptr;
+    report = finished_report_;
+    return &finished_scan_;
+}
+
+bool Pipeline::finish() {
+    finished_ = false;
+    if (!held_) return false;
+    finishHeld(nullptr);
+    return true;
+}
+
+void Pipeline::reset() {
+    finished_ = false;
+    if (held_) finishHeld(nullptr);
+    for (auto& s : stages_) s->reset();
+}
+
+const Clusters* Pipeline::lastClusters() const {
+    const auto* d = find<DenoiseStage>();
+    return d ? &d->algorithm().clusters() : nullptr;
+}
+
+}  // namespace kfd

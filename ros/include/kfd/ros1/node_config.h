@@ -1,0 +1,44 @@
+// The node's parameters: its own (~odom, ~removed_as, ...) and kfd's keys (~config and ~KEY
+// overrides), validated as kfd-filter validates a -c file.
+#pragma once
+
+#include <xmlrpcpp/XmlRpcValue.h>
+
+#include <map>
+#include <string>
+
+#include "kfd/io/bag_writer.h"
+#include "kfd/pipeline/pipeline.h"
+
+namespace kfd::ros1 {
+
+/// The node's own settings (every private parameter that is not a kfd key).
+struct NodeConfig {
+    enum class Odometry { Tf, Topic, None };
+    Pipeline::Params pipeline;             // ~config then the ~KEY overrides, validated
+    std::string config_path;               // ~config ("" = kfd's defaults, share/kfd/default.ini)
+    Odometry odometry = Odometry::Tf;      // ~odom: tf | topic | none
+    std::string odom_frame = "odom";       // ~odom_frame
+    std::string base_frame = "base_link";  // ~base_frame
+    // ~tf_wait, s of ROS time after the scan's stamp: the longest a scan waits for its odometry
+    // (odom_frame -> base_frame, or the odometry sample after it); 1 s, the bag source's hold.
+    // The node also never waits longer than its queue can absorb (ScanFilterNode::waitBound).
+    double tf_wait = 1.0;
+    RemovedMark removed = RemovedMark::NaN;  // ~removed_as: nan | inf
+    double reset_jump = 1.0;                 // ~reset_jump, s (LiveFilter::Params::reset_jump)
+    int queue_size = 10;  // ~queue_size: the scan subscriber's and publisher's queues
+};
+
+/// The node's own parameter names (without '~').
+bool isNodeParameter(const std::string& name);
+
+/// The node's configuration from its private parameters (names without '~', values as the
+/// parameter server holds them). kfd's configuration: ~config's file (kfd::loadConfigFile) or
+/// kfd's defaults, then every other parameter as a kfd key (kfd::applyConfigKey: ints,
+/// doubles, bools and strings as their text, a list as its comma-separated items), then
+/// kfd::validateConfig. kfd::ConfigError naming the parameter (e.g. "config key 'window': ...",
+/// "config key 'odom': ...") on an unknown key, a bad value or a value of the wrong type: the
+/// node refuses to start.
+NodeConfig nodeConfig(const std::map<std::string, XmlRpc::XmlRpcValue>& params);
+
+}  // namespace kfd::ros1

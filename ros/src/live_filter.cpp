@@ -1,0 +1,102 @@
+#include "kfd/ros1/live_filter.h"
+
+#include <boost/make_shared.hpp>
+
+#include <algorithm>
+
+#include "kfd/io/laser_scan.h"
+#include "kfd/mrpt/default_stages.h"
+
+namespace kfd::ros1 {
+
+std::string frameLabel(const std::string& frame_id) {
+    const auto b = frame_id.find_first_not_of('/');
+    return b == std::string::npos ? std::string() : frame_id.substr(b);
+}
+
+LiveFilter::LiveFilter(const Params& p) : params_(p), door_(p.pipeline, {}, true) {}
+
+void LiveFilter::reset() {
+    door_.reset();  // finishes held keyframes first
+    collectFinished();
+    last_stamp_.clear();
+}
+
+void LiveFilter::finish() {
+    door_.finish();
+    collectFinished();
+}
+
+bool LiveFilter::takeReady(sensor_msgs::LaserScan::Ptr& out) {
+    if (ready_.empty()) return false;
+    out = std::move(ready_.front());
+    ready_.pop_front();
+    return true;
+}
+
+std::size_t LiveFilter::markKept(sensor_msgs::LaserScan& m,
+                                 const mrpt::obs::CObservation2DRangeScan& o) {
+    const std::size_t removed = markRemovedBeams(m, o, params_.removed);
+    ++counters_.scans_kept;
+    counters_.points_removed += removed;
+    return removed;
+}
+
+void LiveFilter::collectFinished() {
+    for (StreamResult done; door_.takeFinished(done);) {
+        const auto it = std::find_if(held_.begin(), held_.end(),
+                                     [&](const Held& h) { return h.obs.get() == done.scan; });
+        if (it == held_.end()) continue;  // not ours (cannot happen: every pending one is held)
+        Held h = std::move(*it);
+        held_.erase(it);
+        if (!done.keep) continue;
+        markKept(*h.message, *h.obs);
+        ready_.push_back(std::move(h.message));
+    }
+}
+
+bool LiveFilter::onClock(double now) {
+    const bool back = last_clock_ >= 0.0 && now < last_clock_;
+    last_clock_ = now;
+    if (!back) return false;
+    reset();
+    ++counters_.resets;
+    return true;
+}
+
+LiveResult LiveFilter::process(sensor_msgs::LaserScan& m, double stamp,
+                               const std::optional<Pose2D>& odometry, bool odom_expected,
+                               const Pose2D& mount) {
+    LiveResult r;
+    ++counters_.scans_in;
+    const std::string label = frameLabel(m.header.frame_id);
+    const auto last = last_stamp_.find(label);
+    if (last != last_stamp_.end() && stamp < last->second) {
+        if (last->second - stamp < params_.reset_jump) {
+            r.out_of_order = true;
+            ++counters_.out_of_order;
+            return r;
+        }
+        reset();
+        r.reset = true;
+        ++counters_.resets;
+    }
+    last_stamp_[label] = stamp;
+    if (odom_expected && !odometry) ++counters_.odom_missing;
+    auto obs = laserScanToObservation(m, stamp, label, mount);
+    r.stream = door_.process(*obs, odometry);
+    collectFinished();  // the frame's held keyframe, when this scan finished it
+    if (r.stream.geometry_reset) ++counters_.geometry_resets;
+    if (r.stream.skipped != ScanSkipReason::None) ++counters_.scans_skipped;
+    if (!r.stream.keep) return r;
+    if (r.stream.pending) {  // published once finished: a copy as received
+        r.pending = true;
+        held_.push_back({std::move(obs), boost::make_shared<sensor_msgs::LaserScan>(m)});
+        return r;
+    }
+    r.removed = markKept(m, *obs);
+    r.publish = true;
+    return r;
+}
+
+}  // namespace kfd::ros1

@@ -1,0 +1,293 @@
+#include "kfd/algorithms/denoiser.h"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "kfd/paper/distance_filter.h"
+#include "test_scans.h"
+
+namespace kfd {
+namespace {
+
+using test::distinctLabels;
+using test::emptyScan;
+using test::setRange;
+using test::setWall;
+
+/// 181 beams over 180 deg (1 deg resolution), a flat wall 4 m ahead over beams 30-150
+/// (-60..60 deg, 4 to 8 m), isolated outliers at 1.0 m on beams 50, 100 and 130, and a group
+/// of four outliers at 0.8 m on beams 70-73 (close to the sensor: too narrow for any object).
+Scan wallWithOutliers() {
+    Scan scan = emptyScan(181, kPi);
+    setWall(scan, 30, 150, 4.0);
+    test::insertOutliers(scan, {50, 100, 130}, 1.0);
+    setRange(scan, 70, 73, 0.8);
+    return scan;
+}
+
+constexpr std::size_t kOutlierBeams[] = {50, 70, 71, 72, 73, 100, 130};
+
+bool isOutlierBeam(std::size_t i) {
+    for (const auto o : kOutlierBeams)
+        if (o == i) return true;
+    return false;
+}
+
+Denoiser::Params variant(DenoiseVariant v) {
+    Denoiser::Params p;
+    p.variant = v;
+    return p;
+}
+
+class DenoiserBothVariants : public ::testing::TestWithParam<DenoiseVariant> {};
+
+TEST_P(DenoiserBothVariants, RemovesOutliersAndKeepsTheWallWhole) {
+    Scan scan = wallWithOutliers();
+    Denoiser d(variant(GetParam()));
+    const auto res = d.filter(scan);
+    for (std::size_t i = 0; i < scan.size(); ++i) {
+        const bool wall = i >= 30 && i <= 150 && !isOutlierBeam(i);
+        EXPECT_EQ(scan.valid[i] != 0, wall) << "beam " << i;
+    }
+    // The wall is one cluster, not a chain of pieces that happened to survive.
+    EXPECT_EQ(distinctLabels(d.clusters().label, 30, 49), 1u);
+    const auto wall = d.clusters().label[30];
+    for (std::size_t i = 30; i <= 150; ++i)
+        if (!isOutlierBeam(i)) {
+            EXPECT_EQ(d.clusters().label[i], wall) << i;
+        }
+    EXPECT_EQ(res.points_in, 121u);
+    EXPECT_EQ(res.points_removed, 7u);
+    EXPECT_EQ(res.noise_clusters, 4u);  // three single outliers and the group
+    EXPECT_EQ(res.clusters, 5u);
+    EXPECT_EQ(res.variant, GetParam());
+}
+
+TEST_P(DenoiserBothVariants, NoiseFlagsMatchTheRemovedBeams) {
+    Scan scan = wallWithOutliers();
+    const Scan before = scan;
+    Denoiser d(variant(GetParam()));
+    d.filter(scan);
+    const Clusters& c = d.clusters();
+    for (std::size_t i = 0; i < scan.size(); ++i) {
+        if (!before.valid[i]) {
+            EXPECT_EQ(c.label[i], -1);
+            continue;
+        }
+        ASSERT_GE(c.label[i], 0);
+        EXPECT_EQ(c.noise[static_cast<std::size_t>(c.label[i])] != 0, scan.valid[i] == 0) << i;
+    }
+}
+
+TEST_P(DenoiserBothVariants, KeepsRangesAndBeamCount) {
+    Scan scan = wallWithOutliers();
+    const Scan before = scan;
+    Denoiser d(variant(GetParam()));
+    d.filter(scan);
+    EXPECT_EQ(scan.range, before.range);
+    EXPECT_EQ(scan.size(), before.size());
+    EXPECT_EQ(scan.geometry, before.geometry);
+}
+
+TEST_P(DenoiserBothVariants, AllInvalidScan) {
+    Scan scan = emptyScan(181, kPi);
+    Denoiser d(variant(GetParam()));
+    const auto res = d.filter(scan);
+    EXPECT_EQ(res.points_in, 0u);
+    EXPECT_EQ(res.clusters, 0u);
+    EXPECT_EQ(res.points_removed, 0u);
+    EXPECT_EQ(scan.countValid(), 0u);
+}
+
+TEST_P(DenoiserBothVariants, OneBeamScan) {
+    Scan scan = test::makeScan({2.0f});
+    Denoiser d(variant(GetParam()));
+    const auto res = d.filter(scan);
+    EXPECT_EQ(res.points_in, 1u);
+    EXPECT_EQ(res.clusters, 1u);
+    // A lone point is below any bar of at least 2 points.
+    EXPECT_EQ(res.points_removed, 1u);
+    EXPECT_EQ(scan.countValid(), 0u);
+    EXPECT_EQ(scan.range[0], 2.0f);
+}
+
+TEST_P(DenoiserBothVariants, EmptyScan) {
+    Scan scan = test::makeScan({});
+    Denoiser d(variant(GetParam()));
+    const auto res = d.filter(scan);
+    EXPECT_EQ(res.points_in, 0u);
+    EXPECT_EQ(res.clusters, 0u);
+}
+
+TEST_P(DenoiserBothVariants, NaNRangesAfterDistanceFilter) {
+    Scan scan = wallWithOutliers();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (const std::size_t i : {31u, 60u, 61u, 90u, 149u}) scan.range[i] = nan;
+    scan.range[120] = std::numeric_limits<float>::infinity();
+    DistanceFilter().filter(scan);
+    ASSERT_EQ(scan.countValid(), 121u - 6u);
+    Denoiser d(variant(GetParam()));
+    const auto res = d.filter(scan);
+    EXPECT_EQ(res.points_in, 115u);
+    EXPECT_EQ(res.points_removed, 7u);  // the same outliers; the wall bridges the holes
+    for (const std::size_t i : {31u, 60u, 61u, 90u, 120u, 149u}) {
+        EXPECT_EQ(scan.valid[i], 0u) << i;
+        EXPECT_EQ(d.clusters().label[i], -1) << i;
+    }
+    EXPECT_EQ(distinctLabels(d.clusters().label, 30, 150), 5u);  // the wall + 4 noise clusters
+}
+
+TEST_P(DenoiserBothVariants, ReusedDenoiserForgetsThePreviousScan) {
+    Denoiser d(variant(GetParam()));
+    Scan first = wallWithOutliers();
+    d.filter(first);
+    Scan second = test::circle(360, 3.0);
+    const auto res = d.filter(second);
+    EXPECT_EQ(res.clusters, 1u);
+    EXPECT_EQ(res.points_removed, 0u);
+    EXPECT_EQ(d.clusters().label.size(), 360u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Denoiser, DenoiserBothVariants,
+                         ::testing::Values(DenoiseVariant::Reference, DenoiseVariant::RangeAware),
+                         [](const ::testing::TestParamInfo<DenoiseVariant>& param_info) {
+                             return std::string(param_info.param == DenoiseVariant::Reference
+                                                    ? "Reference"
+                                                    : "RangeAware");
+                         });
+
+/// The wall of wallWithOutliers() (no outliers) plus a small real object, 4 beams at 8 m on
+/// beams 5-8, 22 deg away from the wall.
+Scan wallAndFarSmallObject() {
+    Scan scan = emptyScan(181, kPi);
+    setWall(scan, 30, 150, 4.0);
+    setRange(scan, 5, 8, 8.0);
+    return scan;
+}
+
+TEST(Denoiser, ReferenceRemovesFarSmallObject) {
+    // The paper's fixed bar: 4 points < m_threshold = 10.
+    Scan scan = wallAndFarSmallObject();
+    Denoiser d(variant(DenoiseVariant::Reference));
+    const auto res = d.filter(scan);
+    EXPECT_EQ(res.points_removed, 4u);
+    for (std::size_t i = 5; i <= 8; ++i) EXPECT_EQ(scan.valid[i], 0u) << i;
+    EXPECT_EQ(scan.countValid(), 121u);
+}
+
+TEST(Denoiser, RangeAwareKeepsFarSmallObject) {
+    // 4 beams at 8 m span 0.56 m >= 0.1 m: the bar is the floor of 3 points.
+    Scan scan = wallAndFarSmallObject();
+    Denoiser d(variant(DenoiseVariant::RangeAware));
+    const auto res = d.filter(scan);
+    EXPECT_EQ(res.points_removed, 0u);
+    EXPECT_EQ(res.clusters, 2u);
+    EXPECT_EQ(scan.countValid(), 125u);
+}
+
+TEST(Denoiser, ReferenceIgnoresMinObjectSize) {
+    auto p = variant(DenoiseVariant::Reference);
+    p.filter.min_object_size_m = 0.1;
+    p.filter.min_points_floor = 1;
+    Scan scan = wallAndFarSmallObject();
+    EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 4u);
+}
+
+TEST(Denoiser, MThresholdIsConfigurable) {
+    auto p = variant(DenoiseVariant::Reference);
+    p.filter.m_threshold = 4;  // the 4-point object now reaches the bar
+    Scan scan = wallAndFarSmallObject();
+    EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 0u);
+    p.filter.m_threshold = 5;
+    scan = wallAndFarSmallObject();
+    EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 4u);
+}
+
+TEST(Denoiser, MinPointsFloorIsConfigurable) {
+    // The far object's range-adaptive bar is the floor: 4 points pass a floor of 4, not of 5.
+    auto p = variant(DenoiseVariant::RangeAware);
+    p.filter.min_points_floor = 4;
+    Scan scan = wallAndFarSmallObject();
+    EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 0u);
+    p.filter.min_points_floor = 5;
+    scan = wallAndFarSmallObject();
+    EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 4u);
+}
+
+TEST(Denoiser, ReferenceResultReportsRingsAndBlocks) {
+    Scan scan = wallAndFarSmallObject();
+    auto p = variant(DenoiseVariant::Reference);
+    p.reference.rings.r_max = 20.0;  // r_1 = 8.94 m: everything in ring 1
+    const auto res = Denoiser(p).filter(scan);
+    EXPECT_DOUBLE_EQ(res.r_max, 20.0);
+    EXPECT_EQ(res.blocks, 2u);
+    EXPECT_EQ(res.merges, 0u);
+    EXPECT_NEAR(res.theta_threshold, test::deg2rad(10.0), 1e-12);
+}
+
+TEST(Denoiser, AngleGapFactorReachesBothVariants) {
+    // With theta = 30 deg the far object (22 deg from the wall) joins the wall's block in the
+    // reference variant (everything in ring 1 with r_max = 20 m) and is no longer removed.
+    auto p = variant(DenoiseVariant::Reference);
+    p.reference.rings.r_max = 20.0;
+    p.reference.angle_gap_factor = p.range_aware.angle_gap_factor = 30.0;
+    Scan scan = wallAndFarSmallObject();
+    auto res = Denoiser(p).filter(scan);
+    EXPECT_EQ(res.clusters, 1u);
+    EXPECT_NEAR(res.theta_threshold, test::deg2rad(30.0), 1e-12);
+    p.variant = DenoiseVariant::RangeAware;
+    scan = wallAndFarSmallObject();
+    res = Denoiser(p).filter(scan);
+    EXPECT_NEAR(res.theta_threshold, test::deg2rad(30.0), 1e-12);
+}
+
+TEST(Denoiser, DefaultsAreKfdsEvidenceVariantAndThePapersParameters) {
+    const Denoiser d;
+    EXPECT_EQ(d.params().variant, DenoiseVariant::Evidence);
+    EXPECT_EQ(d.params().reference.rings.rings, 5u);
+    EXPECT_EQ(d.params().filter.m_threshold, 10u);
+    EXPECT_DOUBLE_EQ(d.params().reference.angle_gap_factor, 10.0);
+    EXPECT_DOUBLE_EQ(d.params().range_aware.angle_gap_factor, 10.0);
+}
+
+TEST(Denoiser, VariantNames) {
+    EXPECT_EQ(std::string(toString(DenoiseVariant::Reference)), "reference");
+    EXPECT_EQ(std::string(toString(DenoiseVariant::RangeAware)), "range_aware");
+    EXPECT_EQ(parseDenoiseVariant("reference"), DenoiseVariant::Reference);
+    EXPECT_EQ(parseDenoiseVariant("range_aware"), DenoiseVariant::RangeAware);
+    for (const auto v : {DenoiseVariant::Reference, DenoiseVariant::RangeAware})
+        EXPECT_EQ(parseDenoiseVariant(toString(v)), v);
+}
+
+TEST(Denoiser, UnknownVariantNameThrows) {
+    for (const char* s : {"", "Reference", "range-aware", "rangeaware", "ring", " reference"})
+        EXPECT_THROW(parseDenoiseVariant(s), kfd::ParameterError) << '"' << s << '"';
+}
+
+TEST(Denoiser, RejectsBadParams) {
+    auto bad = [](auto mutate) {
+        Denoiser::Params p;
+        mutate(p);
+        EXPECT_THROW(Denoiser{p}, kfd::ParameterError);
+    };
+    bad([](auto& p) { p.filter.m_threshold = 0; });
+    bad([](auto& p) { p.filter.min_points_floor = 0; });
+    bad([](auto& p) { p.filter.min_object_size_m = -0.1; });
+    bad([](auto& p) { p.filter.min_object_size_m = std::nan(""); });
+    bad([](auto& p) { p.reference.rings.rings = 0; });
+    bad([](auto& p) { p.reference.rings.r_max = -1.0; });
+    bad([](auto& p) { p.reference.angle_gap_factor = 0.0; });
+    bad([](auto& p) { p.range_aware.angle_gap_factor = 0.0; });
+    bad([](auto& p) { p.reference.merge_distance_m = -1.0; });
+    bad([](auto& p) { p.range_aware.jump_lambda_deg = 90.0; });
+    bad([](auto& p) { p.range_aware.jump_sigma_m = -0.01; });
+}
+
+}  // namespace
+}  // namespace kfd

@@ -1,0 +1,552 @@
+// The evidence denoiser on tiny hand-made scans: what spatial and temporal evidence keep and
+// remove, the noise estimate, the approximations against plain references, and bad parameters.
+#include "kfd/algorithms/evidence_filter.h"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "test_scans.h"
+
+namespace kfd {
+namespace {
+
+using test::deg2rad;
+
+// A room seen by a 361-beam, 180-degree scanner (0.5 deg): a wall 4 m ahead across the view.
+Scan room(std::optional<Pose2D> odometry = Pose2D{}) {
+    Scan s = test::flatWall(361, deg2rad(150.0), 4.0);
+    s.odometry = odometry;
+    return s;
+}
+
+// The same wall after the robot moved `dx` metres forward (odometry says so).
+Scan roomAfter(double dx) {
+    Scan s = test::flatWall(361, deg2rad(150.0), 4.0 - dx);
+    s.odometry = Pose2D{dx, 0.0, 0.0};
+    return s;
+}
+
+EvidenceFilter::Params exact() {
+    EvidenceFilter::Params p;
+    p.sigma_m = 0.01;  // noiseless test scans: fix the noise instead of estimating it
+    return p;
+}
+
+TEST(EvidenceFilter, ASpikeInFrontOfAWallThePreviousKeyframeSawThroughIsRemoved) {
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    Scan second = roomAfter(0.1);
+    test::insertSpike(second, 180, 3.6);  // 0.3 m in front of the wall, one beam
+    const auto r = f.filter(second, c);
+    EXPECT_TRUE(r.temporal);
+    EXPECT_EQ(second.valid[180], 0);
+    EXPECT_GE(r.free_points, 1u);
+    EXPECT_EQ(r.points_removed, 1u);  // nothing else
+}
+
+TEST(EvidenceFilter, ABurstInFreeSpaceIsRemovedThoughItLooksLikeAnObject) {
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    Scan second = roomAfter(0.1);
+    test::setRange(second, 170, 185, 1.0);  // 16 beams at 1 m: a flat "object"
+    f.filter(second, c);
+    for (std::size_t i = 170; i <= 185; ++i) EXPECT_EQ(second.valid[i], 0) << i;
+    EXPECT_EQ(second.countValid(), first.countValid() - 16);
+}
+
+TEST(EvidenceFilter, APersistentThinObjectIsKept) {
+    // A chair leg (one beam at 2 m) seen by two keyframes in a row: spatially a lone return, but
+    // the previous keyframe saw it at the same place.
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = room();
+    test::insertSpike(first, 200, 2.0);
+    f.filter(first, c);
+    Scan second = room();  // the robot stands still
+    test::insertSpike(second, 200, 2.0);
+    const auto r = f.filter(second, c);
+    EXPECT_EQ(second.valid[200], 1);
+    EXPECT_EQ(r.points_removed, 0u);
+}
+
+TEST(EvidenceFilter, ReferencesThatContradictTooMuchOfAScanAreStale) {
+    // The keyframe saw a wall at 4 m; odometry says the robot did not move, but the scan shows
+    // a wall at 2 m across the whole view (odometry that lied, a turn): every return lies in
+    // space the keyframe saw through. That is stale references, not noise (issue 22).
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    Scan second = test::flatWall(361, deg2rad(150.0), 2.0);
+    second.odometry = Pose2D{};
+    const auto r = f.filter(second, c);
+    EXPECT_TRUE(r.stale_references);
+    EXPECT_FALSE(r.capped);
+    EXPECT_GT(r.removal_wanted, 300u);
+    EXPECT_EQ(r.points_removed, 0u);  // spatially one wall: nothing small
+    EXPECT_EQ(second.countValid(), 361u);
+}
+
+TEST(EvidenceFilter, RemovalIsCappedSmallestSegmentsFirst) {
+    // 30 lone returns and one pair, all small and unsupported (no keyframe yet): 32 returns,
+    // above 5 % of 361 (18). The 18 lone returns of the farthest ranges go, nothing else.
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan s = room(std::nullopt);
+    for (std::size_t k = 0; k < 30; ++k) test::insertSpike(s, 15 + 10 * k, 1.5 + 0.01 * k);
+    test::setRange(s, 330, 331, 1.0);
+    const auto r = f.filter(s, c);
+    EXPECT_FALSE(r.stale_references);
+    EXPECT_TRUE(r.capped);
+    EXPECT_EQ(r.removal_wanted, 32u);
+    EXPECT_EQ(r.points_removed, 18u);
+    EXPECT_EQ(s.valid[330], 1);
+    EXPECT_EQ(s.valid[331], 1);
+    for (std::size_t k = 0; k < 30; ++k)
+        EXPECT_EQ(s.valid[15 + 10 * k], k >= 12 ? 0 : 1) << k;  // the farthest 18
+}
+
+TEST(EvidenceFilter, NoBoundRemovesEverySmallSegment) {
+    EvidenceFilter::Params p = exact();
+    p.max_removed_fraction = 1.0;
+    EvidenceFilter f(p);
+    Clusters c;
+    Scan s = room(std::nullopt);
+    for (std::size_t k = 0; k < 30; ++k) test::insertSpike(s, 15 + 10 * k, 1.5 + 0.01 * k);
+    const auto r = f.filter(s, c);
+    EXPECT_FALSE(r.capped);
+    EXPECT_EQ(r.points_removed, 30u);
+}
+
+TEST(EvidenceFilter, WithoutAPreviousKeyframeOnlyLoneReturnsAreRemoved) {
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan s = room(std::nullopt);
+    test::insertSpike(s, 100, 1.5);    // alone
+    test::setRange(s, 250, 259, 1.0);  // ten beams at 1 m: an object
+    const auto r = f.filter(s, c);
+    EXPECT_FALSE(r.temporal);
+    EXPECT_EQ(s.valid[100], 0);
+    for (std::size_t i = 250; i <= 259; ++i) EXPECT_EQ(s.valid[i], 1) << i;
+    EXPECT_EQ(r.points_removed, 1u);
+}
+
+TEST(EvidenceFilter, AWallAtGrazingIncidenceStaysOneSegment) {
+    // A wall 0.5 m to the side running along the view: consecutive returns are far apart and
+    // nearly along the beam (the breakpoint cuts it), but they lie on a line.
+    Scan s = test::emptyScan(361, deg2rad(180.0));
+    for (std::size_t i = 10; i < 100; ++i) {
+        const double a = s.geometry.angle(i);  // -90 .. -45 deg: the right side
+        s.range[i] = static_cast<float>(0.5 / std::abs(std::sin(a)));
+        s.valid[i] = 1;
+    }
+    EvidenceFilter f(exact());
+    Clusters c;
+    const auto r = f.filter(s, c);
+    EXPECT_EQ(r.points_removed, 0u);
+    EXPECT_EQ(c.count(), 1u);
+}
+
+// A corner (a wall 4 m ahead, one 1.5 m to the right) seen from (x, 0), heading forward.
+Scan corner(double x) {
+    Scan s = test::emptyScan(361, deg2rad(180.0));
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const double a = s.geometry.angle(i), c = std::cos(a), sn = std::sin(a);
+        double r = c > 1e-9 ? (4.0 - x) / c : 1e9;
+        if (sn < -1e-9) r = std::min(r, 1.5 / -sn);
+        if (r < 10.0) test::setRange(s, i, i, r);
+    }
+    return s;
+}
+
+TEST(EvidenceFilter, WithoutOdometryTheStepIsFoundByAlignment) {
+    // Laser only: the robot moved 0.15 m; the scans are aligned from zero motion.
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = corner(0.0);
+    f.filter(first, c);
+    Scan second = corner(0.15);
+    test::insertSpike(second, 200, 2.5);
+    const auto r = f.filter(second, c);
+    EXPECT_TRUE(r.temporal);
+    EXPECT_TRUE(r.refined);
+    EXPECT_EQ(second.valid[200], 0);
+    EXPECT_EQ(r.points_removed, 1u);
+}
+
+EvidenceFilter::Params withRecent(std::size_t scans) {
+    EvidenceFilter::Params p = exact();
+    p.temporal_scans = scans;
+    return p;
+}
+
+TEST(EvidenceFilter, ASpikeNearAWallIsRemovedWithTheScanJustBeforeTheKeyframe) {
+    // The keyframe 1 m back supports a spike 0.12 m in front of the wall (its margin is
+    // 0.04 + 0.05 + 0.2 x 1 m); the scan dropped 2 cm before sees through it.
+    for (const std::size_t kept : {0u, 1u}) {
+        EvidenceFilter f(withRecent(kept));
+        Clusters c;
+        Scan first = room();
+        f.filter(first, c);
+        f.observe(roomAfter(0.98));
+        Scan second = roomAfter(1.0);
+        test::insertSpike(second, 180, 2.88f);
+        const auto r = f.filter(second, c);
+        EXPECT_TRUE(r.temporal);
+        EXPECT_EQ(r.recent, kept > 0);
+        if (kept == 0) {
+            EXPECT_EQ(second.valid[180], 1);  // the wide keyframe margin supports it
+            EXPECT_EQ(r.points_removed, 0u);
+        } else {
+            EXPECT_EQ(second.valid[180], 0);
+            EXPECT_EQ(r.points_removed, 1u);
+            EXPECT_NEAR(r.recent_margin_m, 3.0 * std::sqrt(2.0) * 0.01, 1e-6);  // sigma-bound
+        }
+    }
+}
+
+TEST(EvidenceFilter, WhenTheScanJustBeforeWantsTooMuchTheKeyframesAloneDecide) {
+    // 20 beams 0.3 m before the wall: the scan 2 cm before sees through them, the keyframe
+    // 1 m back supports them. 20 returns exceed a 5 % bound (18 of 361): without the burst
+    // exception (max_confirmed_fraction = 0) the keyframes decide.
+    for (const double bound : {0.05, 1.0}) {
+        EvidenceFilter::Params p = withRecent(1);
+        p.max_removed_fraction = bound;
+        p.max_confirmed_fraction = 0.0;
+        EvidenceFilter f(p);
+        Clusters c;
+        Scan first = room();
+        f.filter(first, c);
+        f.observe(roomAfter(0.98));
+        Scan second = roomAfter(1.0);
+        test::setRange(second, 170, 189, 2.7);
+        const auto r = f.filter(second, c);
+        EXPECT_TRUE(r.recent);
+        EXPECT_EQ(r.recent_overruled, bound < 1.0) << bound;
+        EXPECT_FALSE(r.stale_references);
+        EXPECT_FALSE(r.confirmed);
+        EXPECT_EQ(r.points_removed, bound < 1.0 ? 0u : 20u) << bound;
+    }
+}
+
+// The keyframe room(), then the scan `before` dropped, then `key` filtered (with `after` as
+// its next scan when given).
+EvidenceFilter::Result keyframeAfter(const EvidenceFilter::Params& p, const Scan& before, Scan& key,
+                                     const Scan* after = nullptr) {
+    EvidenceFilter f(p);
+    Clusters c;
+    Scan start = room();
+    f.filter(start, c);
+    f.observe(before);
+    return f.filter(key, c, after);
+}
+
+// The keyframe 1 m back, the scan dropped 2 cm before the next keyframe (`recent`), and that
+// keyframe with a burst of beams [first, last] 0.3 m in front of the wall.
+EvidenceFilter::Result burstAfter(const EvidenceFilter::Params& p, const Scan& recent,
+                                  std::size_t first, std::size_t last, Scan& out) {
+    out = roomAfter(1.0);
+    test::setRange(out, first, last, 2.7);
+    return keyframeAfter(p, recent, out);
+}
+
+TEST(EvidenceFilter, ABurstAboveTheBoundIsRemovedWholeWhenTheScanJustBeforeConfirmsIt) {
+    // The same 20-beam burst (5.5 % of the returns, above the 5 % bound): the scan just before
+    // supports every other return it judged, so the burst is what changed, not the references.
+    Scan second;
+    const auto r = burstAfter(withRecent(1), roomAfter(0.98), 170, 189, second);
+    EXPECT_TRUE(r.recent);
+    EXPECT_TRUE(r.confirmed);
+    EXPECT_FALSE(r.recent_overruled);
+    EXPECT_FALSE(r.stale_references);
+    EXPECT_FALSE(r.capped);
+    EXPECT_EQ(r.removal_wanted, 20u);
+    EXPECT_EQ(r.points_removed, 20u);
+    for (std::size_t i = 170; i <= 189; ++i) EXPECT_EQ(second.valid[i], 0) << i;
+}
+
+TEST(EvidenceFilter, ABurstIsNotConfirmedWhenTheScanJustBeforeDisagreesElsewhere) {
+    // The scan just before saw a recess 1.2 m deep over beams 100-159 (beyond the alignment's
+    // gate, so the alignment holds) that this scan does not: 15 of the 88 wall returns it
+    // judged are free (83 % supported). With confirm_support 0.9 it is not trusted beyond the
+    // bound and the keyframes decide (their margin supports the burst); asking half confirms.
+    Scan recent = roomAfter(0.98);
+    test::setWall(recent, 100, 159, 4.0 - 0.98 + 1.2);
+    for (const double support : {0.9, 0.5}) {
+        EvidenceFilter::Params p = withRecent(1);
+        p.confirm_support = support;
+        Scan second;
+        const auto r = burstAfter(p, recent, 170, 189, second);
+        EXPECT_TRUE(r.recent);
+        EXPECT_EQ(r.confirmed, support < 0.9) << support;
+        EXPECT_EQ(r.recent_overruled, support >= 0.9) << support;
+        EXPECT_EQ(r.points_removed, support < 0.9 ? 20u : 0u) << support;
+    }
+}
+
+TEST(EvidenceFilter, ABurstAboveTheConfirmedBoundIsNotRemovedWhole) {
+    // 100 beams (28 % of the returns) exceed max_confirmed_fraction (25 %): the references
+    // are taken as stale even though the scan just before agrees with the rest.
+    Scan second;
+    const auto r = burstAfter(withRecent(1), roomAfter(0.98), 130, 229, second);
+    EXPECT_FALSE(r.confirmed);
+    EXPECT_LE(r.points_removed, 18u);  // the 5 % bound
+    EXPECT_EQ(second.valid[180], 1);
+}
+
+TEST(EvidenceFilter, AThinPostSeenJustBeforeIsKept) {
+    // A two-beam post at 2 m (small) in front of the wall: the scan just before saw it too.
+    auto withPost = [](Scan s) {
+        test::setRange(s, 180, 181, 2.0);
+        return s;
+    };
+    EvidenceFilter f(withRecent(1));
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    f.observe(withPost(roomAfter(0.08)));
+    Scan second = withPost(roomAfter(0.1));
+    const auto r = f.filter(second, c);
+    EXPECT_TRUE(r.recent);
+    EXPECT_EQ(second.valid[180], 1);
+    EXPECT_EQ(second.valid[181], 1);
+    EXPECT_EQ(r.points_removed, 0u);
+}
+
+TEST(EvidenceFilter, WithoutOdometryTheScanJustBeforeIsAligned) {
+    EvidenceFilter f(withRecent(2));
+    Clusters c;
+    Scan first = corner(0.0);
+    f.filter(first, c);
+    f.observe(corner(0.13));
+    f.observe(corner(0.14));
+    Scan second = corner(0.15);
+    test::insertSpike(second, 200, 2.5);
+    const auto r = f.filter(second, c);
+    EXPECT_TRUE(r.recent);
+    EXPECT_EQ(second.valid[200], 0);
+    EXPECT_EQ(r.points_removed, 1u);
+}
+
+TEST(EvidenceFilter, TheKeyframeItselfIsTheScanBeforeTheNextWhenNothingWasDropped) {
+    EvidenceFilter f(withRecent(1));
+    Clusters c;
+    Scan first = room();
+    EXPECT_FALSE(f.filter(first, c).recent);  // nothing before the first scan
+    Scan second = roomAfter(0.02);
+    EXPECT_TRUE(f.filter(second, c).recent);
+    f.reset();
+    Scan third = roomAfter(0.04);
+    EXPECT_FALSE(f.filter(third, c).recent);  // reset forgets the raw scans too
+}
+
+EvidenceFilter::Params withNext(bool next) {
+    EvidenceFilter::Params p = withRecent(1);
+    p.next_scan = next;
+    return p;
+}
+
+TEST(EvidenceFilter, ABurstOnlyInTheKeyframeIsRemovedWithTheScanJustAfter) {
+    // A 5-beam burst 0.28 m in front of the wall in the keyframe only. The scan just before
+    // has dropouts there (no verdict); the keyframe 1 m back supports the burst (its wide
+    // margin). Without the next scan it stays; the scan 2 cm after sees through it.
+    for (const bool next : {false, true}) {
+        Scan before = roomAfter(0.98);
+        for (std::size_t i = 175; i <= 185; ++i) before.valid[i] = 0;
+        Scan key = roomAfter(1.0);
+        test::setRange(key, 178, 182, 2.72f);  // its own segment (0.19 m breakpoint)
+        const Scan after = roomAfter(1.02);
+        const auto r = keyframeAfter(withNext(next), before, key, &after);
+        EXPECT_TRUE(r.recent);
+        EXPECT_EQ(r.next, next);
+        for (std::size_t i = 178; i <= 182; ++i) EXPECT_EQ(key.valid[i], next ? 0 : 1) << i;
+        EXPECT_EQ(r.points_removed, next ? 5u : 0u);
+    }
+}
+
+TEST(EvidenceFilter, ASurfaceThatAppearsInTheKeyframeAndStaysInTheNextScanIsKept) {
+    // 12 beams at 2 m (a door swung open, a person stepping in): the keyframe and the scan
+    // just after see it, the scan just before and the keyframe before saw the wall through
+    // it. Without the next scan it goes as free space; with it, its support keeps it.
+    auto withSurface = [](Scan s) {
+        test::setRange(s, 175, 186, 2.0f);
+        return s;
+    };
+    for (const bool next : {false, true}) {
+        Scan key = withSurface(roomAfter(1.0));
+        const Scan after = withSurface(roomAfter(1.02));
+        const auto r = keyframeAfter(withNext(next), roomAfter(0.98), key, &after);
+        EXPECT_TRUE(r.recent);
+        EXPECT_EQ(r.next, next);
+        for (std::size_t i = 175; i <= 186; ++i) EXPECT_EQ(key.valid[i], next ? 1 : 0) << i;
+        EXPECT_EQ(r.points_removed, next ? 0u : 12u);
+    }
+}
+
+TEST(EvidenceFilter, WithoutANextScanTheKeyframeIsFilteredAsWithoutTheOption) {
+    // The end of a log: no scan after the keyframe. next = nullptr gives what next_scan =
+    // false gives; and a next scan is ignored when the option is off.
+    EvidenceFilter on(withNext(true)), off(withNext(false));
+    Clusters c;
+    Scan a = room(), b = room();
+    on.filter(a, c);
+    off.filter(b, c);
+    Scan x = roomAfter(1.0), y = roomAfter(1.0), z = roomAfter(1.0);
+    test::setRange(x, 178, 182, 2.88f);
+    test::setRange(y, 178, 182, 2.88f);
+    test::insertSpike(x, 100, 1.5f);
+    test::insertSpike(y, 100, 1.5f);
+    const auto rx = on.filter(x, c, nullptr);
+    const auto ry = off.filter(y, c, &z);
+    EXPECT_FALSE(rx.next);
+    EXPECT_FALSE(ry.next);
+    EXPECT_EQ(x.valid, y.valid);
+    EXPECT_EQ(rx.points_removed, ry.points_removed);
+}
+
+TEST(EvidenceFilter, ObservingDoesNothingWithoutTemporalScans) {
+    // temporal_scans = 0 keeps today's behaviour: an observed scan changes no result.
+    EvidenceFilter a(withRecent(0)), b(withRecent(0));
+    Clusters c;
+    Scan first = room(), first_b = room();
+    a.filter(first, c);
+    b.filter(first_b, c);
+    Scan seen = roomAfter(0.98);
+    test::insertSpike(seen, 100, 1.0);
+    b.observe(seen);
+    Scan x = roomAfter(1.0), y = roomAfter(1.0);
+    test::insertSpike(x, 180, 2.88f);
+    test::insertSpike(y, 180, 2.88f);
+    const auto ra = a.filter(x, c), rb = b.filter(y, c);
+    EXPECT_EQ(ra.points_removed, rb.points_removed);
+    EXPECT_EQ(ra.supported, rb.supported);
+    EXPECT_EQ(x.valid, y.valid);
+    EXPECT_FALSE(rb.recent);
+}
+
+TEST(EvidenceFilter, ARawScanOfAnotherGeometryIsNotUsed) {
+    EvidenceFilter f(withRecent(1));
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    Scan other = test::flatWall(181, deg2rad(150.0), 3.0);
+    other.odometry = Pose2D{0.98, 0.0, 0.0};
+    f.observe(other);
+    Scan second = roomAfter(1.0);
+    EXPECT_FALSE(f.filter(second, c).recent);
+}
+
+TEST(EvidenceFilter, TheNoiseEstimateFollowsTheSensor) {
+    std::mt19937 rng(7);
+    for (const double sigma : {0.01, 0.03}) {
+        EvidenceFilter f;  // estimated
+        Clusters c;
+        std::normal_distribution<double> noise(0.0, sigma);
+        double last = 0.0;
+        for (int k = 0; k < 20; ++k) {
+            Scan s = test::flatWall(1081, deg2rad(150.0), 3.0);
+            for (auto& r : s.range) r = static_cast<float>(r + noise(rng));
+            last = f.filter(s, c).sigma;
+        }
+        EXPECT_NEAR(last, sigma, 0.35 * sigma) << sigma;
+    }
+}
+
+TEST(EvidenceFilter, ResetForgetsThePreviousKeyframe) {
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    f.reset();
+    Scan second = roomAfter(0.1);
+    EXPECT_FALSE(f.filter(second, c).temporal);
+}
+
+TEST(EvidenceFilter, AnotherGeometryGivesNoTemporalEvidence) {
+    EvidenceFilter f(exact());
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    Scan other = test::flatWall(181, deg2rad(150.0), 4.0);
+    other.odometry = Pose2D{};
+    EXPECT_FALSE(f.filter(other, c).temporal);
+}
+
+TEST(EvidenceFilter, ApproxAtan2MatchesStdAtan2) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-50.0f, 50.0f);
+    double worst = 0.0;
+    for (int k = 0; k < 200000; ++k) {
+        const float y = u(rng), x = u(rng);
+        worst =
+            std::max(worst, std::abs(static_cast<double>(EvidenceFilter::approxAtan2(y, x)) -
+                                     std::atan2(static_cast<double>(y), static_cast<double>(x))));
+    }
+    EXPECT_LT(worst, 2e-5);  // a 0.25-degree beam is 4.4e-3 rad
+    EXPECT_EQ(EvidenceFilter::approxAtan2(0.0f, 0.0f), 0.0f);
+}
+
+TEST(EvidenceFilter, LineResidualIsZeroOnAnyLine) {
+    // Three beams 0.5 deg apart hitting a line at any incidence: the middle one is predicted.
+    const double res = deg2rad(0.5);
+    for (const double incidence : {0.0, 40.0, 80.0, 88.0}) {
+        const double a = deg2rad(incidence);
+        auto r = [&](double theta) { return 2.0 * std::cos(a) / std::cos(theta - a); };
+        EXPECT_NEAR(EvidenceFilter::lineResidual(r(-res), r(0.0), r(res), std::cos(res)), 0.0, 1e-9)
+            << incidence;
+    }
+}
+
+TEST(EvidenceFilter, TooManyTemporalScansAreRejected) {
+    EvidenceFilter::Params p;
+    p.temporal_scans = 17;
+    EXPECT_THROW(EvidenceFilter{p}, ParameterError);
+    p.temporal_scans = 16;
+    EXPECT_NO_THROW(EvidenceFilter{p});
+}
+
+TEST(EvidenceFilter, BadParametersAreRejected) {
+    auto bad = [](auto change) {
+        EvidenceFilter::Params p;
+        change(p);
+        EXPECT_THROW(EvidenceFilter{p}, ParameterError);
+    };
+    bad([](auto& p) { p.incidence_deg = 0.0; });
+    bad([](auto& p) { p.incidence_deg = 90.0; });
+    bad([](auto& p) { p.sigma_m = -1.0; });
+    bad([](auto& p) { p.sigma_m = std::nan(""); });
+    bad([](auto& p) { p.min_sigma_m = 0.0; });
+    bad([](auto& p) { p.max_gap_beams = 17; });
+    bad([](auto& p) { p.pose_rot_error_deg = -1.0; });
+    bad([](auto& p) { p.moving_object_m = std::numeric_limits<double>::infinity(); });
+    bad([](auto& p) { p.max_step_m = 0.0; });
+    bad([](auto& p) { p.refine_samples = 0; });
+    bad([](auto& p) { p.max_removed_fraction = 0.0; });
+    bad([](auto& p) { p.max_removed_fraction = 1.5; });
+    bad([](auto& p) { p.max_confirmed_fraction = -0.1; });
+    bad([](auto& p) { p.max_confirmed_fraction = 1.1; });
+    bad([](auto& p) { p.confirm_support = 0.0; });
+}
+
+TEST(EvidenceFilter, DegenerateScansAreHandled) {
+    EvidenceFilter f;
+    Clusters c;
+    Scan empty = test::emptyScan(361, kPi);
+    EXPECT_EQ(f.filter(empty, c).points_removed, 0u);
+    Scan two = test::makeScan({1.0f, 1.0f}, kPi);
+    f.filter(two, c);
+    Scan circle = test::circle(720, 3.0);  // closes the circle: one segment across the seam
+    circle.odometry = Pose2D{};
+    f.filter(circle, c);
+    EXPECT_EQ(c.count(), 1u);
+    EXPECT_EQ(circle.countValid(), 720u);
+}
+
+}  // namespace
+}  // namespace kfd

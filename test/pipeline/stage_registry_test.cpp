@@ -1,0 +1,226 @@
+// Stages found by name: the registry, the stages' own keys, typed parameters and reports.
+#include "kfd/pipeline/stage_registry.h"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "kfd/pipeline/pipeline.h"
+#include "test_scans.h"
+
+namespace kfd {
+namespace {
+
+std::vector<std::string> keyNames(const StageInfo& s) {
+    std::vector<std::string> v;
+    for (const auto& k : s.keys) v.push_back(k.name);
+    return v;
+}
+
+// test::noisyWall: outliers at beams 50, 100 and 130, beam 60 out of range and beam 61 NaN.
+using test::noisyWall;
+
+TEST(StageRegistry, CoreRegistryHoldsThePapersStagesInOrder) {
+    const auto& r = coreStageRegistry();
+    EXPECT_EQ(r.names(), "distance, keyframe, denoise, odometry_check, fuse");
+    ASSERT_EQ(r.stages().size(), 5u);
+    for (const auto& s : r.stages()) {
+        EXPECT_FALSE(s.help.empty()) << s.name;
+        EXPECT_FALSE(s.keys.empty()) << s.name;
+    }
+    EXPECT_EQ(r.find("motion"), nullptr);  // the baselines are not in the core
+    EXPECT_NE(r.find("keyframe"), nullptr);
+}
+
+TEST(StageRegistry, EachStageOwnsItsKeys) {
+    const auto& r = coreStageRegistry();
+    EXPECT_EQ(keyNames(*r.find("distance")), (std::vector<std::string>{"min_range", "max_range"}));
+    EXPECT_EQ(keyNames(*r.find("keyframe")),
+              (std::vector<std::string>{
+                  "selector", "bins", "window", "p_pair", "max_consecutive_drops", "max_interval_s",
+                  "max_translation_m", "max_rotation_deg", "view_samples", "view_tolerance_m",
+                  "view_tolerance_deg", "max_view_change", "change_tolerance_m",
+                  "change_tolerance_ratio", "max_changed_fraction", "degeneracy_ratio",
+                  "corridor_translation_m", "corridor_rotation_deg", "corridor_interval_s"}));
+    EXPECT_EQ(keyNames(*r.find("denoise")), (std::vector<std::string>{"variant",
+                                                                      "rings",
+                                                                      "ring_r_max",
+                                                                      "angle_gap_factor",
+                                                                      "merge_distance_m",
+                                                                      "m_threshold",
+                                                                      "jump_lambda_deg",
+                                                                      "jump_sigma_m",
+                                                                      "min_object_size_m",
+                                                                      "min_points_floor",
+                                                                      "incidence_deg",
+                                                                      "sigma_m",
+                                                                      "max_gap_beams",
+                                                                      "max_small_points",
+                                                                      "temporal",
+                                                                      "pose_trans_error_m",
+                                                                      "pose_rot_error_deg",
+                                                                      "motion_error_fraction",
+                                                                      "max_removed_fraction",
+                                                                      "max_confirmed_fraction",
+                                                                      "confirm_support",
+                                                                      "temporal_scans",
+                                                                      "next_scan"}));
+    EXPECT_EQ(keyNames(*r.find("odometry_check")),
+              (std::vector<std::string>{"frozen_changed_fraction", "jump_margin"}));
+}
+
+TEST(StageRegistry, KeysParseRangeCheckAndPrintBack) {
+    const StageInfo& kf = *coreStageRegistry().find("keyframe");
+    PipelineParams p;
+    StageParams& sp = p.at(kf);
+    const StageKey* window = kf.keyForField("window");
+    ASSERT_NE(window, nullptr);
+    window->set(sp.data(), "3");  // the config layer hands over trimmed text
+    EXPECT_EQ(p.get<KeyframeStage>().window, 3u);
+    EXPECT_EQ(window->get(sp.data()), "3");
+    try {
+        window->set(sp.data(), "0");
+        FAIL() << "window = 0 accepted";
+    } catch (const ParameterError& e) {
+        EXPECT_EQ(e.field(), "window");
+        EXPECT_NE(std::string(e.what()).find("out of range"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(window->set(sp.data(), "2.5"), ParameterError);
+    EXPECT_THROW(window->set(sp.data(), "eight"), ParameterError);
+    EXPECT_EQ(p.get<KeyframeStage>().window, 3u);  // a rejected value changes nothing
+    const StageKey* p_pair = kf.keyForField("p_pair");
+    ASSERT_NE(p_pair, nullptr);
+    p_pair->set(sp.data(), "0.99");
+    EXPECT_DOUBLE_EQ(p.get<KeyframeStage>().p_pair, 0.99);
+    EXPECT_THROW(p_pair->set(sp.data(), "0"), ParameterError);  // (0, 1]: open below
+    EXPECT_THROW(p_pair->set(sp.data(), "inf"), ParameterError);
+}
+
+TEST(StageRegistry, MaxRangeKeyTakesScanOrANumber) {
+    const StageInfo& d = *coreStageRegistry().find("distance");
+    PipelineParams p;
+    StageParams& sp = p.at(d);
+    const StageKey* max = d.keyForField("max_range");
+    ASSERT_NE(max, nullptr);
+    EXPECT_EQ(max->get(sp.data()), "scan");  // the default: the scan's own maximum
+    max->set(sp.data(), "25");
+    EXPECT_DOUBLE_EQ(p.get<DistanceStage>().max_range, 25.0);
+    EXPECT_EQ(max->get(sp.data()), "25");
+    max->set(sp.data(), "scan");
+    EXPECT_TRUE(std::isinf(p.get<DistanceStage>().max_range));
+    EXPECT_THROW(max->set(sp.data(), "inf"), ParameterError);
+    EXPECT_THROW(max->set(sp.data(), "0"), ParameterError);
+    EXPECT_THROW(max->set(sp.data(), "Scan"), ParameterError);
+    EXPECT_NE(max->range.find("scan"), std::string::npos) << max->range;
+}
+
+TEST(StageRegistry, AngleGapKeySetsBothVariants) {
+    const StageInfo& dn = *coreStageRegistry().find("denoise");
+    PipelineParams p;
+    dn.keyForField("angle_gap_factor")->set(p.at(dn).data(), "30");
+    EXPECT_EQ(p.get<DenoiseStage>().reference.angle_gap_factor, 30.0);
+    EXPECT_EQ(p.get<DenoiseStage>().range_aware.angle_gap_factor, 30.0);
+}
+
+TEST(StageRegistry, RejectsRepeatedAndEmptyNames) {
+    StageRegistry r;
+    registerCoreStages(r);
+    EXPECT_THROW(r.add<KeyframeStage>(), Error);
+    StageInfo nameless;
+    EXPECT_THROW(r.add(nameless), Error);
+    EXPECT_EQ(r.stages().size(), 5u);
+}
+
+TEST(PipelineParams, TypedAccessCopiesAndDefaults) {
+    PipelineParams p;
+    EXPECT_TRUE(p.entries().empty());
+    const PipelineParams& cp = p;
+    EXPECT_EQ(cp.get<KeyframeStage>().window, KeyframeSelector::Params{}.window);  // defaults
+    EXPECT_TRUE(p.entries().empty());  // reading does not create
+    p.get<KeyframeStage>().window = 3;
+    p.get<DenoiseStage>().variant = DenoiseVariant::RangeAware;
+    ASSERT_EQ(p.entries().size(), 2u);
+    PipelineParams copy = p;
+    p.get<KeyframeStage>().window = 4;  // deep copy: the copy keeps its own value
+    EXPECT_EQ(copy.get<KeyframeStage>().window, 3u);
+    EXPECT_EQ(copy.get<DenoiseStage>().variant, DenoiseVariant::RangeAware);
+    copy = p;
+    EXPECT_EQ(copy.get<KeyframeStage>().window, 4u);
+}
+
+TEST(PipelineParams, WrongTypeUnderAStageNameThrows) {
+    StageInfo impostor;  // claims the name "keyframe" with other parameters
+    impostor.name = "keyframe";
+    impostor.defaults = [] { return std::make_unique<StageParamsOf<int>>(); };
+    PipelineParams p;
+    p.at(impostor);
+    EXPECT_THROW(p.get<KeyframeStage>(), Error);
+    EXPECT_THROW(Pipeline{p}, Error);
+}
+
+TEST(ScanReport, OneStageReportPerStageWithTypedDiagnostics) {
+    Pipeline pipe;
+    Scan scan = noisyWall();
+    const ScanReport r = pipe.process(scan);
+    ASSERT_EQ(r.stage_count, 3u);
+    EXPECT_STREQ(r.stage_reports[0].name, "distance");
+    EXPECT_STREQ(r.stage_reports[1].name, "keyframe");
+    EXPECT_STREQ(r.stage_reports[2].name, "denoise");
+    const StageReport* d = r.stage("distance");
+    ASSERT_NE(d, nullptr);
+    ASSERT_NE(d->diagnostics<DistanceFilter::Result>(), nullptr);
+    EXPECT_EQ(d->diagnostics<KeyframeDecision>(), nullptr);  // typed: another type is absent
+    EXPECT_EQ(d->points_removed, 2u);
+    EXPECT_FALSE(d->noise);
+    EXPECT_TRUE(r.stage("denoise")->noise);
+    EXPECT_EQ(r.stage("denoise")->points_removed, r.find<Denoiser::Result>()->points_removed);
+    std::size_t removed = 0;
+    double us = 0.0;
+    for (const auto& s : r) {
+        EXPECT_FALSE(s.dropped);
+        EXPECT_GE(s.microseconds, 0.0);
+        removed += s.points_removed;
+        us += s.microseconds;
+    }
+    EXPECT_EQ(removed, r.points_in - r.points_out);
+    EXPECT_LE(us, r.microseconds);
+    EXPECT_EQ(r.noiseRemoved(), r.find<Denoiser::Result>()->points_removed);
+    EXPECT_EQ(r.stage("motion"), nullptr);
+}
+
+TEST(ScanReport, TheDroppingStageIsMarkedAndLaterStagesAreAbsent) {
+    Pipeline pipe;
+    Scan a = noisyWall();
+    pipe.process(a);
+    Scan b = noisyWall();
+    const ScanReport r = pipe.process(b);
+    ASSERT_FALSE(r.keep);
+    ASSERT_EQ(r.stage_count, 2u);
+    EXPECT_TRUE(r.stage("keyframe")->dropped);
+    EXPECT_EQ(r.stage("denoise"), nullptr);
+    EXPECT_EQ(r.find<Denoiser::Result>(), nullptr);
+    EXPECT_EQ(r.findOrDefault<Denoiser::Result>().points_removed, 0u);
+    const ScanReport copy = r;  // a plain value: diagnostics are copied, not referenced
+    Scan c = noisyWall();
+    pipe.reset();
+    pipe.process(c);
+    EXPECT_EQ(copy.find<KeyframeDecision>()->reason, KeyframeReason::Covered);
+}
+
+TEST(Pipeline, InitializeKeepsTheRegistryItWasBuiltWith) {
+    StageRegistry only_distance;
+    only_distance.add<DistanceStage>();
+    PipelineParams p;
+    p.stages = {"distance"};
+    Pipeline pipe(p, only_distance);
+    EXPECT_EQ(&pipe.registry(), &only_distance);
+    p.stages = {"distance", "keyframe"};
+    EXPECT_THROW(pipe.initialize(p), ParameterError);  // keyframe is not in that registry
+    EXPECT_NO_THROW(pipe.initialize(p, coreStageRegistry()));
+    EXPECT_EQ(pipe.stages().size(), 2u);
+}
+
+}  // namespace
+}  // namespace kfd
