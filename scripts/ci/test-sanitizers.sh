@@ -15,7 +15,7 @@ build="$root/build-asan"
 # tests hung idle at 0 % CPU with fast_unwind_on_malloc=0).
 # allocator_may_return_null: an impossible malloc (a corrupt image size in a rawlog asks OpenCV
 # for 1.2e18 bytes) returns null as glibc's does, and the apps report it, instead of ASan
-# stopping the process (the bad-input row BadInputCorruptLength.FuzzFindingsAreClearErrors).
+# stopping the process (the bad-input row CorruptLength.FuzzFindingsAreClearErrors).
 export ASAN_OPTIONS="detect_leaks=1:check_initialization_order=1:allocator_may_return_null=1"
 export LSAN_OPTIONS="suppressions=$root/scripts/ci/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
