@@ -70,7 +70,7 @@ slam() {  # name, log, options...
     verdict "kfd-icp-slam $name: $f" same_file "$tmp/slam-old-$name/$f" "$tmp/slam-new-$name/$f"
   done
   verdict "kfd-icp-slam $name: summary.json" same_text "$tmp/slam-old-$name/summary.json" \
-    "$tmp/slam-new-$name/summary.json" '_s_|_us_|_ms_|wall|cpu|output|seconds'
+    "$tmp/slam-new-$name/summary.json" '_s_|_us_|_ms_|wall|cpu|output|seconds|_configured"'  # _configured: added by issue 34
 }
 slam aces-kfd "$data/aces/aces.rawlog" -g "$data/aces/aces.relations"
 slam aces-odometry "$data/aces/aces.rawlog" -m odometry --match-drop-of kfd

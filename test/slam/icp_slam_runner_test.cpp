@@ -830,6 +830,16 @@ TEST(IcpSlamRunner, KeyframeGuardsFollowTheSlamsLocalisationGate) {
     EXPECT_LE(every.scans_kept, gated.scans_kept);  // the gate's guards keep at least as many
     EXPECT_NE(text(dir / "gated/summary.json").find("\"guard_translation_m\": 0.2"),
               std::string::npos);
+    // The lowering is reported, not silent: the guards as configured beside those used.
+    EXPECT_DOUBLE_EQ(gated.guard_translation_m_configured, 0.5);
+    EXPECT_DOUBLE_EQ(gated.guard_rotation_deg_configured, 15.0);
+    EXPECT_NE(text(dir / "gated/summary.json").find("\"guard_translation_m_configured\": 0.5"),
+              std::string::npos);
+    EXPECT_NE(kfd::summaryText(gated).find("keyframe guards lowered to the SLAM's localisation "
+                                           "gate: 0.5 -> 0.2 m, 15 -> 5 deg"),
+              std::string::npos)
+        << kfd::summaryText(gated);
+    EXPECT_EQ(kfd::summaryText(every).find("guards"), std::string::npos);
 }
 
 TEST(IcpSlamRunner, ARejectedCorrectionIsReMatchedThroughTheDroppedScans) {

@@ -216,8 +216,12 @@ void relationsJson(nlohmann::ordered_json& o, const RelationsError& r) {
 
 }  // namespace
 
-std::string toJson(const IcpSlamSummary& s) {
-    nlohmann::ordered_json j;
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+// The scans and points: what went in, what the pre-filter kept, skipped and removed.
+void scansJson(Json& j, const IcpSlamSummary& s) {
     j["mode"] = toString(s.mode);
     j["rawlog"] = s.rawlog;
     j["stages"] = s.pipeline.stages;
@@ -239,6 +243,10 @@ std::string toJson(const IcpSlamSummary& s) {
     j["points_removed"] = s.points_removed;
     j["points_removed_noise"] = s.points_removed_noise;
     j["max_removed_noise_share"] = s.max_removed_noise_share;  // of a kept scan's valid returns
+}
+
+// ICP's corrections, their verdicts, re-matching and the guards under the SLAM's gate.
+void icpJson(Json& j, const IcpSlamSummary& s) {
     j["icp_runs"] = s.icp_runs;
     j["icp_rejected"] = s.icp_rejected;
     j["icp_goodness_median"] = s.icp_goodness_median;
@@ -251,6 +259,12 @@ std::string toJson(const IcpSlamSummary& s) {
     j["gap_checks_failed"] = s.gap_checks_failed;
     j["guard_translation_m"] = s.guard_translation_m;  // after the SLAM's localisation gate
     j["guard_rotation_deg"] = s.guard_rotation_deg;
+    j["guard_translation_m_configured"] = s.guard_translation_m_configured;  // before the gate
+    j["guard_rotation_deg_configured"] = s.guard_rotation_deg_configured;
+}
+
+// The pre-filter's own counters and times, the matched drop rates, the scans before the run.
+void prefilterJson(Json& j, const IcpSlamSummary& s) {
     j["scans_odometry_frozen"] = s.scans_odometry_frozen;
     j["scans_odometry_jump"] = s.scans_odometry_jump;
     j["scans_denoise_stale"] = s.scans_denoise_stale;
@@ -269,6 +283,10 @@ std::string toJson(const IcpSlamSummary& s) {
     j["scans_skipped_start"] = s.scans_skipped_start;
     j["scans_without_step"] = s.scans_without_step;
     j["scans_before_offset"] = s.scans_before_offset;
+}
+
+// What a bag or CARMEN source repaired, laser only, what the run did not honour.
+void sourceJson(Json& j, const IcpSlamSummary& s) {
     if (s.source.any()) {  // what a bag or CARMEN source repaired (absent when nothing)
         nlohmann::ordered_json src;
         src["lines_unparsable"] = s.source.lines_unparsable;
@@ -282,6 +300,10 @@ std::string toJson(const IcpSlamSummary& s) {
     j["laser_only"] = s.laser_only;
     if (!s.notices.empty())  // what the run did not honour (icp-slam keys, map kinds)
         j["notices"] = s.notices;
+}
+
+// ATE and the relations error, all, local and long.
+void evaluationJson(Json& j, const IcpSlamSummary& s) {
     if (s.ate_rmse) j["ate_rmse_m"] = *s.ate_rmse;
     if (s.relations) {
         const auto& r = *s.relations;
@@ -299,8 +321,39 @@ std::string toJson(const IcpSlamSummary& s) {
             j[key] = std::move(o);
         }
     }
+}
+
+}  // namespace
+
+std::string toJson(const IcpSlamSummary& s) {
+    Json j;
+    scansJson(j, s);
+    icpJson(j, s);
+    prefilterJson(j, s);
+    sourceJson(j, s);
+    evaluationJson(j, s);
     return j.dump(2) + "\n";
 }
+
+namespace {
+
+// The keyframe guards the SLAM's localisation gate lowered (the pre-filter runs kfd's keyframe
+// stage): configured -> used. Empty when none was lowered.
+std::string gateText(const IcpSlamSummary& s) {
+    const auto& stages = s.pipeline.stages;
+    if (std::find(stages.begin(), stages.end(), "keyframe") == stages.end()) return {};
+    std::string lowered;
+    if (s.guard_translation_m != s.guard_translation_m_configured)
+        lowered += format("%g -> %g m", s.guard_translation_m_configured, s.guard_translation_m);
+    if (s.guard_rotation_deg != s.guard_rotation_deg_configured)
+        lowered += format("%s%g -> %g deg", lowered.empty() ? "" : ", ",
+                          s.guard_rotation_deg_configured, s.guard_rotation_deg);
+    if (lowered.empty()) return {};
+    return "  guards     keyframe guards lowered to the SLAM's localisation gate: " + lowered +
+           "\n";
+}
+
+}  // namespace
 
 std::string summaryText(const IcpSlamSummary& s) {
     std::string t = format("kfd-icp-slam summary (mode %s)\n", toString(s.mode));
@@ -309,6 +362,7 @@ std::string summaryText(const IcpSlamSummary& s) {
                 s.dropped_pct);
     if (const std::string n = scansNotIn(s); !n.empty()) t += "             not in: " + n + "\n";
     t += format("  points     removed %zu of %zu\n", s.points_removed, s.points_in);
+    t += gateText(s);
     t += format(
         "  time       pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s, wall %.2f s\n",
         s.prefilter_us_per_scan, s.icp_ms_per_scan, s.cpu_s_total, s.wall_s_total);

@@ -119,6 +119,10 @@ struct IcpSlamSummary : ScanCounters {
     /// localisation gate (localizationLinDistance, localizationAngDistance) when that is
     /// shorter, so that kfd never drops the scan ICP's gate would have matched.
     double guard_translation_m = 0.0, guard_rotation_deg = 0.0;
+    /// The keyframe guards as configured ([KFD] or kfd's defaults), before the gate: where they
+    /// differ from the two above, the gate lowered them (reported in summary.json and by
+    /// summaryText).
+    double guard_translation_m_configured = 0.0, guard_rotation_deg_configured = 0.0;
     /// What the run did not honour, one sentence each naming the configuration key or map (an
     /// icp-slam key kfd-icp-slam ignores: IcpSlamLogParams::fromConfig; a map kind it cannot
     /// save: IcpSlamLogs::finish). The caller shows them; the run went on.
