@@ -13,6 +13,11 @@ echo "$out" | grep -q "log not found: no-such-log" || { echo "installed kfd-comp
 cmake -S "$here" -B "$tmp/consumer" -DCMAKE_PREFIX_PATH="$tmp/prefix" >/dev/null
 cmake --build "$tmp/consumer" >/dev/null
 "$tmp/consumer/consumer"
+# A kfd built with the ROS 1 node exports kfd::ros1 (find_package(kfd COMPONENTS ros1)).
+if [ -x "$build/apps/kfd_node" ]; then
+  [ -x "$tmp/consumer/consumer_ros1" ] || { echo "kfd::ros1 not exported" >&2; exit 1; }
+  "$tmp/consumer/consumer_ros1"
+fi
 # The example reads the bundled log with kfd's defaults, then with a config, and reports a
 # missing log and a bad key as the errors they are (exit 1, the key or file named).
 cmake -S "$src/examples/filter_log" -B "$tmp/example" -DCMAKE_PREFIX_PATH="$tmp/prefix" >/dev/null
