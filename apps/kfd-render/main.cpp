@@ -7,19 +7,35 @@
 #include <deque>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "common/cli.h"
 #include "common/source_cli.h"
-#include "kfd/algorithms/denoiser.h"
 #include "kfd/io/open_source.h"
 #include "kfd/io/png_output.h"
 #include "kfd/io/source.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/mrpt/default_stages.h"
 #include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/stream_filter.h"
 #include "kfd/os/cancel.h"
 #include "kfd/pipeline/format.h"
 #include "kfd/render/cluster_figure.h"
+#include "kfd/stages/denoise_result.h"
+#include "kfd/stages/denoise_stage.h"
+
+namespace {
+
+// The denoising stage the configuration's pipeline runs (selected by `variant`), kfd's
+// evidence_denoise when it lists none.
+std::string denoisingStage(const kfd::Pipeline::Params& p) {
+    const kfd::StageChoice* role = kfd::defaultStageRegistry().choice("variant");
+    for (const auto& st : p.stages)
+        if (role && role->ofStage(st)) return st;
+    return "evidence_denoise";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
     kfd::app::Cli cli(
@@ -115,26 +131,21 @@ int main(int argc, char** argv) {
         // kept (no keyframe stage), so the history scans are the denoiser's previous ones. A
         // history scan the door skips is no previous keyframe; the chosen one must be usable.
         kfd::Pipeline::Params drawn = p;
-        drawn.stages = {"distance", "denoise"};
+        drawn.stages = {"distance", denoisingStage(p)};
         kfd::StreamFilter door(drawn, {}, true);
         door.setLaserOnly(laser_only);
-        kfd::StreamResult r;
-        for (const Seen& seen : chosen) r = door.process(*seen.scan, seen.odometry);
-        if (r.pending) {
-            // next_scan: the chosen scan is finished by the scan after it (the log's last one
-            // without it); that one is then held, so the door's last clusters are the chosen's.
-            const auto* drawn_scan = chosen.back().scan.get();
-            const auto take = [&] {
-                for (kfd::StreamResult done; door.takeFinished(done);)
-                    if (done.scan == drawn_scan) r = std::move(done);
-                return !r.pending;
-            };
-            if (after) door.process(*after->scan, after->odometry);
-            if (!take()) {
-                door.finish();
-                take();
-            }
-        }
+        // The chosen scan's result once the door finished it; with next_scan that takes the
+        // scan after it (the log's last one without it), which the door then holds, so the
+        // door's last clusters are the chosen's.
+        const auto* drawn_scan = chosen.back().scan.get();
+        std::optional<kfd::StreamResult> finished;
+        const auto keep = [&](kfd::StreamResult& f) {
+            if (f.scan == drawn_scan) finished = f;
+        };
+        for (const Seen& seen : chosen) door.process(*seen.scan, seen.odometry, keep);
+        if (!finished && after) door.process(*after->scan, after->odometry, keep);
+        if (!finished) door.finish();
+        const kfd::StreamResult r = *finished;
         if (r.skipped != kfd::ScanSkipReason::None) {
             char t[64];
             std::snprintf(t, sizeof(t), "%.6f", kfd::stampOf(*chosen.back().scan));
@@ -151,13 +162,12 @@ int main(int argc, char** argv) {
         kfd::toCore(last, scan);
         for (std::size_t i = 0; i < scan.size() && i < clusters->label.size(); ++i)
             if (clusters->label[i] >= 0) scan.valid[i] = 1;
-        const auto den = r.report.findOrDefault<kfd::Denoiser::Result>();
+        const auto den = r.report.findOrDefault<kfd::DenoiseResult>();
         kfd::ClusterFigureOptions o;
         o.width = o.height = size;
         o.half_extent_m = extent;
-        o.ring_r_max =
-            p.get<kfd::DenoiseStage>().variant == kfd::DenoiseVariant::Reference ? den.r_max : 0.0;
-        o.rings = p.get<kfd::DenoiseStage>().reference.rings.rings;
+        o.ring_r_max = den.variant == kfd::DenoiseVariant::Reference ? den.r_max : 0.0;
+        o.rings = std::as_const(p).get<kfd::DenoiseStage>().clustering.rings.rings;
         kfd::ClusterFigure fig(o);
         auto img = fig.render(scan, *clusters);
         kfd::TempOutputFile tmp(out);  // written under a temporary name, renamed when complete

@@ -3,6 +3,7 @@
 #include <boost/make_shared.hpp>
 
 #include <algorithm>
+#include <memory>
 
 #include "kfd/io/laser_scan.h"
 #include "kfd/mrpt/default_stages.h"
@@ -17,15 +18,11 @@ std::string frameLabel(const std::string& frame_id) {
 LiveFilter::LiveFilter(const Params& p) : params_(p), door_(p.pipeline, {}, true) {}
 
 void LiveFilter::reset() {
-    door_.reset();  // finishes held keyframes first
-    collectFinished();
+    door_.reset();  // finishes held keyframes first (queued for takeReady())
     last_stamp_.clear();
 }
 
-void LiveFilter::finish() {
-    door_.finish();
-    collectFinished();
-}
+void LiveFilter::finish() { door_.finish(); }
 
 bool LiveFilter::takeReady(sensor_msgs::LaserScan::Ptr& out) {
     if (ready_.empty()) return false;
@@ -40,19 +37,6 @@ std::size_t LiveFilter::markKept(sensor_msgs::LaserScan& m,
     ++counters_.scans_kept;
     counters_.points_removed += removed;
     return removed;
-}
-
-void LiveFilter::collectFinished() {
-    for (StreamResult done; door_.takeFinished(done);) {
-        const auto it = std::find_if(held_.begin(), held_.end(),
-                                     [&](const Held& h) { return h.obs.get() == done.scan; });
-        if (it == held_.end()) continue;  // not ours (cannot happen: every pending one is held)
-        Held h = std::move(*it);
-        held_.erase(it);
-        if (!done.keep) continue;
-        markKept(*h.message, *h.obs);
-        ready_.push_back(std::move(h.message));
-    }
 }
 
 bool LiveFilter::onClock(double now) {
@@ -84,14 +68,21 @@ LiveResult LiveFilter::process(sensor_msgs::LaserScan& m, double stamp,
     last_stamp_[label] = stamp;
     if (odom_expected && !odometry) ++counters_.odom_missing;
     auto obs = laserScanToObservation(m, stamp, label, mount);
-    r.stream = door_.process(*obs, odometry);
-    collectFinished();  // the frame's held keyframe, when this scan finished it
+    auto d = std::make_shared<Delivery>();
+    r.stream = door_.process(*obs, odometry, [this, obs, d](StreamResult& done) {
+        d->finished = true;
+        d->keep = done.keep;
+        if (d->copy && done.keep) {  // finished later: the copy goes out marked
+            markKept(*d->copy, *obs);
+            ready_.push_back(d->copy);
+        }
+    });
     if (r.stream.geometry_reset) ++counters_.geometry_resets;
     if (r.stream.skipped != ScanSkipReason::None) ++counters_.scans_skipped;
     if (!r.stream.keep) return r;
-    if (r.stream.pending) {  // published once finished: a copy as received
+    if (!d->finished) {  // published once finished: a copy as received
         r.pending = true;
-        held_.push_back({std::move(obs), boost::make_shared<sensor_msgs::LaserScan>(m)});
+        d->copy = boost::make_shared<sensor_msgs::LaserScan>(m);
         return r;
     }
     r.removed = markKept(m, *obs);

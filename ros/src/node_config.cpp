@@ -96,6 +96,7 @@ NodeConfig nodeConfig(const std::map<std::string, XmlRpc::XmlRpcValue>& params) 
     if (const auto it = params.find("config"); it != params.end())
         c.config_path = stringParam("config", it->second);
     c.pipeline = c.config_path.empty() ? kfdDefaults() : loadConfigFile(c.config_path);
+    std::vector<std::pair<std::string, std::string>> kfd_keys;  // in kfd's order, below
     for (const auto& [key, value] : params) {
         if (key == "odom") {
             const std::string s = stringParam(key, value);
@@ -132,9 +133,10 @@ NodeConfig nodeConfig(const std::map<std::string, XmlRpc::XmlRpcValue>& params) 
                 throw ConfigError(key, e.what());
             }
         } else if (key != "config") {
-            applyConfigKey(c.pipeline, key, keyText(key, value), defaultStageRegistry());
+            kfd_keys.emplace_back(key, keyText(key, value));
         }
     }
+    applyConfigKeys(c.pipeline, kfd_keys, defaultStageRegistry());
     validateConfig(c.pipeline, defaultStageRegistry());
     return c;
 }

@@ -1,4 +1,5 @@
 #include "kfd/algorithms/keyframe_selector.h"
+#include "kfd/algorithms/view_keyframe_selector.h"
 
 #include <algorithm>
 #include <cmath>
@@ -24,7 +25,6 @@ constexpr std::size_t kBins = 6;
 /// Selector with every guard off: decisions follow Formula 3 alone.
 KeyframeSelector::Params paperParams(std::size_t window, double p_pair) {
     KeyframeSelector::Params p;
-    p.selector = KeyframeRule::Paper;
     p.bins = kBins;
     p.window = window;
     p.p_pair = p_pair;
@@ -81,8 +81,8 @@ TEST(KeyframeSelector, FirstScanIsKeyframe) {
 }
 
 TEST(KeyframeSelector, IdenticalScansAreDropped) {
-    KeyframeSelector::Params p;        // the paper's rule with its default parameters, scans
-    p.selector = KeyframeRule::Paper;  // without time or odometry
+    KeyframeSelector::Params p;  // the paper's rule with its default parameters, scans
+    // without time or odometry
     KeyframeSelector s(p);
     const Scan scan = test::flatWall(181, test::deg2rad(120.0), 3.0);
     EXPECT_EQ(s.filter(scan).reason, KeyframeReason::First);
@@ -109,7 +109,6 @@ TEST(KeyframeSelector, DissimilarScanIsKeyframe) {
 
 TEST(KeyframeSelector, ScanThatSuddenlySeesNothingIsKeyframe) {
     KeyframeSelector::Params p;
-    p.selector = KeyframeRule::Paper;
     KeyframeSelector s(p);
     Scan scan = test::flatWall(181, test::deg2rad(120.0), 3.0);
     s.filter(scan);
@@ -121,7 +120,6 @@ TEST(KeyframeSelector, ScanThatSuddenlySeesNothingIsKeyframe) {
 
 TEST(KeyframeSelector, FilterUsesTheScanHistogram) {
     KeyframeSelector::Params p;
-    p.selector = KeyframeRule::Paper;
     p.bins = 4;
     KeyframeSelector s(p);
     const Scan scan = test::makeScan({1, 1, 2, 2, 3, 3, 4, 4});
@@ -414,7 +412,6 @@ TEST(KeyframeSelector, RotationInPlaceProducesKeyframes) {
     // A 360-degree scanner turning on the spot in a round room sees the same scan every time;
     // only the rotation guard makes keyframes.
     KeyframeSelector::Params p;  // defaults: A = 15 deg, D = 0.5 m
-    p.selector = KeyframeRule::Paper;
     p.max_interval_s = 0.0;
     KeyframeSelector s(p);
     Scan scan = test::circle(360, 4.0);
@@ -544,28 +541,39 @@ TEST(KeyframeSelector, ReasonNames) {
     EXPECT_EQ(std::string(toString(KeyframeReason::Covered)), "covered");
 }
 
-TEST(KeyframeSelector, SelectorNamesRoundTrip) {
-    EXPECT_EQ(parseKeyframeRule("paper"), KeyframeRule::Paper);
-    EXPECT_EQ(parseKeyframeRule("view"), KeyframeRule::View);
-    EXPECT_EQ(std::string(toString(KeyframeRule::Paper)), "paper");
-    EXPECT_EQ(std::string(toString(KeyframeRule::View)), "view");
-    try {
-        parseKeyframeRule("histogram");
-        FAIL() << "no error";
-    } catch (const ParameterError& e) {
-        EXPECT_EQ(e.field(), "selector");
-    }
-}
-
-TEST(KeyframeSelector, DefaultIsTheViewSelector) {
-    KeyframeSelector s;
+// kfd's rule is a selector of its own (the view_keyframe stage's): the paper's class never
+// measures a view, and the view selector never builds a histogram.
+TEST(ViewKeyframeSelector, TheSameViewWithoutOdometryIsCovered) {
+    ViewKeyframeSelector s;
     const Scan scan = test::flatWall(181, test::deg2rad(120.0), 3.0);
     EXPECT_EQ(s.filter(scan).reason, KeyframeReason::First);
     const auto d = s.filter(scan);  // the same view, no odometry: covered
     EXPECT_FALSE(d.keyframe);
     EXPECT_EQ(d.reason, KeyframeReason::Covered);
     EXPECT_EQ(d.changed_fraction, 0.0);
-    EXPECT_TRUE(s.lastHistogram() == std::vector<double>(20, 0.0));  // no histogram computed
+}
+
+TEST(ViewKeyframeSelector, GuardsForceAKeyframeOnACoveredView) {
+    ViewKeyframeSelector::Params p;
+    p.max_consecutive_drops = 2;
+    ViewKeyframeSelector s(p);
+    const Scan scan = test::flatWall(181, test::deg2rad(120.0), 3.0);
+    s.filter(scan);
+    EXPECT_FALSE(s.filter(scan).keyframe);
+    EXPECT_FALSE(s.filter(scan).keyframe);
+    const auto d = s.filter(scan);
+    EXPECT_TRUE(d.keyframe);
+    EXPECT_EQ(d.reason, KeyframeReason::MaxDrops);
+}
+
+TEST(KeyframeSelector, ThePapersRuleMeasuresNoView) {
+    KeyframeSelector s;
+    const Scan scan = test::flatWall(181, test::deg2rad(120.0), 3.0);
+    s.filter(scan);
+    const auto d = s.filter(scan);
+    EXPECT_EQ(d.reason, KeyframeReason::Similar);
+    EXPECT_EQ(d.view_change, 0.0);
+    EXPECT_GT(d.p_common, 0.99);
 }
 
 }  // namespace

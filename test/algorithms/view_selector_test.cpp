@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "kfd/algorithms/keyframe_selector.h"
 #include "kfd/algorithms/pose.h"
+#include "kfd/algorithms/view_keyframe_selector.h"
 #include "test_scans.h"
 
 namespace kfd {
@@ -246,10 +246,10 @@ TEST(ViewSelector, RejectsBadParams) {
 }
 
 TEST(KeyframeSelectorView, GuardsStillApplyAndReasonsNameTheRule) {
-    KeyframeSelector::Params p;  // selector = view
+    ViewKeyframeSelector::Params p;
     p.max_consecutive_drops = 3;
     p.max_interval_s = 0.0;
-    KeyframeSelector s(p);
+    ViewKeyframeSelector s(p);
     const Scan a = cast(room(3.0), Pose2D{});
     std::vector<KeyframeReason> reasons;
     for (int k = 0; k < 5; ++k) reasons.push_back(s.filter(a).reason);
@@ -260,7 +260,7 @@ TEST(KeyframeSelectorView, GuardsStillApplyAndReasonsNameTheRule) {
     EXPECT_EQ(d.reason, KeyframeReason::ViewChange);
     EXPECT_GT(d.view_change, p.view.max_view_change);
     const auto world = corridor(1.0, 100.0);
-    KeyframeSelector c(p);
+    ViewKeyframeSelector c(p);
     c.filter(cast(world, Pose2D{}));
     const auto e = c.filter(cast(world, Pose2D{0.6, 0.0, 0.0}));  // beyond 0.5 m
     EXPECT_EQ(e.reason, KeyframeReason::Corridor);

@@ -19,6 +19,7 @@
 #include "kfd/algorithms/evidence_filter.h"
 #include "kfd/algorithms/keyframe_selector.h"
 #include "kfd/pipeline/stage_keys.h"
+#include "kfd/stages/core_stages.h"
 #include "test_files.h"
 
 namespace {
@@ -337,7 +338,7 @@ TEST(CliApps, FilterVersionAndEarlyExits) {
     // Each key with its defaults, read here from the Params structs: "key default kfd range
     // meaning" (the kfd column: share/kfd/default.ini, which leaves these keys out).
     const kfd::EvidenceFilter::Params ev;
-    const kfd::KeyframeSelector::Params kf;
+    const kfd::ViewKeyframeSelector::Params kf;
     for (const auto& [key, value] :
          {std::pair{"incidence_deg", kfd::keys::formatReal(ev.incidence_deg)},
           {"max_removed_fraction", kfd::keys::formatReal(ev.max_removed_fraction)},

@@ -14,8 +14,9 @@ namespace {
 
 TEST(BaselineStages, RegisteredAfterTheCoreStages) {
     EXPECT_EQ(test::allStages().names(),
-              "distance, keyframe, denoise, odometry_check, fuse, motion, dbscan, radius, sor, "
-              "shadow, decimate");
+              "distance, keyframe, denoise, view_keyframe, range_aware_denoise, "
+              "evidence_denoise, odometry_check, fuse, motion, dbscan, radius, sor, shadow, "
+              "decimate");
     StageRegistry only;
     registerBaselineStages(only);  // works without the core stages too
     EXPECT_EQ(only.names(), "motion, dbscan, radius, sor, shadow, decimate");

@@ -16,6 +16,7 @@
 
 #include "baselines/all_stages.h"
 #include "kfd/pipeline/pipeline.h"
+#include "kfd/stages/core_stages.h"
 #include "test_scans.h"
 
 namespace kfd {

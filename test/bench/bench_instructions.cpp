@@ -16,7 +16,6 @@
 #include <vector>
 
 #include "bench_scans.h"
-#include "kfd/algorithms/denoiser.h"
 #include "kfd/algorithms/keyframe_selector.h"
 #include "kfd/baselines/dbscan.h"
 #include "kfd/baselines/radius_outlier.h"
@@ -26,6 +25,7 @@
 #include "kfd/paper/distance_filter.h"
 #include "kfd/paper/histogram.h"
 #include "kfd/pipeline/pipeline.h"
+#include "kfd/stages/core_stages.h"
 
 namespace kb = kfd::bench;
 
@@ -37,29 +37,29 @@ namespace {
 kfd::Pipeline::Params viewDropParams(std::size_t temporal_scans = 0) {
     kfd::Pipeline::Params p;
     p.get<kfd::DistanceStage>() = kb::paperParams().get<kfd::DistanceStage>();
-    p.get<kfd::KeyframeStage>() = kb::viewParamsThatDrop();
-    p.get<kfd::DenoiseStage>().evidence.temporal_scans = temporal_scans;
+    p.get<kfd::ViewKeyframeStage>() = kb::viewParamsThatDrop();
+    p.get<kfd::EvidenceDenoiseStage>().temporal_scans = temporal_scans;
     return p;
 }
 
 // The evidence denoiser on the keyframes alone (temporal_scans 0: before issue 25).
 kfd::Pipeline::Params keyframesOnlyParams() {
     kfd::Pipeline::Params p = kb::paperParams(kfd::DenoiseVariant::Evidence);
-    p.get<kfd::DenoiseStage>().evidence.temporal_scans = 0;
+    p.get<kfd::EvidenceDenoiseStage>().temporal_scans = 0;
     return p;
 }
 
 // The evidence denoiser with the raw scan just before each keyframe (issue 25).
 kfd::Pipeline::Params temporalParams() {
     kfd::Pipeline::Params p = kb::paperParams(kfd::DenoiseVariant::Evidence);
-    p.get<kfd::DenoiseStage>().evidence.temporal_scans = 1;
+    p.get<kfd::EvidenceDenoiseStage>().temporal_scans = 1;
     return p;
 }
 
 // The same with the scan just after each keyframe too (next_scan, issue 25).
 kfd::Pipeline::Params nextScanParams() {
     kfd::Pipeline::Params p = temporalParams();
-    p.get<kfd::DenoiseStage>().evidence.next_scan = true;
+    p.get<kfd::EvidenceDenoiseStage>().next_scan = true;
     return p;
 }
 
@@ -88,16 +88,19 @@ struct Context {
     kfd::Histogram histogram{kfd::Histogram::Params{20}};
     kfd::DistanceFilter distance{kb::paperParams().get<kfd::DistanceStage>()};
     kfd::KeyframeSelector selector{kb::paperParams().get<kfd::KeyframeStage>()};
-    kfd::KeyframeSelector view{kb::viewParamsThatDrop()};
-    kfd::KeyframeSelector view_lo{kb::viewParamsThatDrop()};
+    kfd::ViewKeyframeSelector view{kb::viewParamsThatDrop()};
+    kfd::ViewKeyframeSelector view_lo{kb::viewParamsThatDrop()};
     std::vector<kfd::Scan> dropped_lo;  // the dropped set without odometry
-    kfd::Denoiser reference{
+    kb::StageFilter<kfd::DenoiseStage> reference{
         kb::paperParams(kfd::DenoiseVariant::Reference).get<kfd::DenoiseStage>()};
-    kfd::Denoiser range_aware{
-        kb::paperParams(kfd::DenoiseVariant::RangeAware).get<kfd::DenoiseStage>()};
-    kfd::Denoiser evidence{keyframesOnlyParams().get<kfd::DenoiseStage>()};
-    kfd::Denoiser evidence_temporal{temporalParams().get<kfd::DenoiseStage>()};
-    kfd::Denoiser evidence_next{nextScanParams().get<kfd::DenoiseStage>()};
+    kb::StageFilter<kfd::RangeAwareDenoiseStage> range_aware{
+        kb::paperParams(kfd::DenoiseVariant::RangeAware).get<kfd::RangeAwareDenoiseStage>()};
+    kb::StageFilter<kfd::EvidenceDenoiseStage> evidence{
+        keyframesOnlyParams().get<kfd::EvidenceDenoiseStage>()};
+    kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_temporal{
+        temporalParams().get<kfd::EvidenceDenoiseStage>()};
+    kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_next{
+        nextScanParams().get<kfd::EvidenceDenoiseStage>()};
     kfd::DbscanFilter dbscan{kfd::DbscanFilter::Params{0.7, 10}};
     kfd::RadiusOutlierFilter radius{kfd::RadiusOutlierFilter::Params{}};
     kfd::StatisticalOutlierFilter sor{kfd::StatisticalOutlierFilter::Params{}};

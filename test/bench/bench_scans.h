@@ -16,6 +16,7 @@
 #include "kfd/paper/distance_filter.h"
 #include "kfd/pipeline/pipeline.h"
 #include "kfd/pipeline/scan.h"
+#include "kfd/stages/core_stages.h"
 
 namespace kfd {
 namespace bench {
@@ -36,10 +37,9 @@ inline ScanGeometry mitGeometry() { return ScanGeometry{kBeams, kAperture, true}
 /// off, reference clustering (t = 5 rings, theta = 10 x resolution, m_threshold = 10).
 inline Pipeline::Params paperParams(DenoiseVariant variant = DenoiseVariant::Reference) {
     Pipeline::Params p;
-    p.stages = {"distance", "keyframe", "denoise"};
+    p.stages = {"distance", "keyframe", stageName(variant)};
     p.get<DistanceStage>().min_range = 0.1;
     p.get<DistanceStage>().max_range = kMaxRange;
-    p.get<KeyframeStage>().selector = KeyframeRule::Paper;
     p.get<KeyframeStage>().bins = 20;
     p.get<KeyframeStage>().window = 8;
     p.get<KeyframeStage>().p_pair = 0.985;
@@ -47,7 +47,6 @@ inline Pipeline::Params paperParams(DenoiseVariant variant = DenoiseVariant::Ref
     p.get<KeyframeStage>().max_interval_s = 0.0;
     p.get<KeyframeStage>().max_translation_m = 0.0;
     p.get<KeyframeStage>().max_rotation_deg = 0.0;
-    p.get<DenoiseStage>().variant = variant;
     return p;
 }
 
@@ -249,9 +248,8 @@ inline Scenario makeScenario(unsigned seed = kSeed) {
 /// kfd's view selector with every threshold out of reach: each call measures the scan against
 /// the keyframe and drops it, so the keyframe never changes (the cost of a dropped scan's
 /// decision; a keyframe adds one copy of the sampled ranges).
-inline KeyframeSelector::Params viewParamsThatDrop() {
-    KeyframeSelector::Params p;
-    p.selector = KeyframeRule::View;
+inline ViewKeyframeSelector::Params viewParamsThatDrop() {
+    ViewKeyframeSelector::Params p;
     p.max_consecutive_drops = 0;
     p.max_interval_s = 0.0;
     p.max_translation_m = 0.0;
@@ -264,6 +262,24 @@ inline KeyframeSelector::Params viewParamsThatDrop() {
     p.view.corridor_interval_s = 1e6;
     return p;
 }
+
+/// A denoising stage called as a filter (what the benchmarks time): its DenoiseResult, with
+/// the sensor's next scan when given (the evidence stage's next_scan).
+template <class S>
+class StageFilter {
+  public:
+    explicit StageFilter(const typename S::Params& p) : stage_(p) {}
+    DenoiseResult filter(Scan& scan, const Scan* next = nullptr) {
+        StageReport report;
+        stage_.finish(scan, report, chain_, next);
+        return *report.diagnostics<DenoiseResult>();
+    }
+    void observe(const Scan& scan) { stage_.observeDropped(scan); }
+
+  private:
+    S stage_;
+    ScanReport chain_{};
+};
 
 /// The scan without its odometry (what a robot without wheel encoders gives the selector).
 inline Scan laserOnly(Scan s) {

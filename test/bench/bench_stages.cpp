@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "bench_scans.h"
-#include "kfd/algorithms/denoiser.h"
 #include "kfd/algorithms/keyframe_selector.h"
 #include "kfd/baselines/dbscan.h"
 #include "kfd/baselines/radius_outlier.h"
@@ -20,6 +19,7 @@
 #include "kfd/paper/distance_filter.h"
 #include "kfd/paper/histogram.h"
 #include "kfd/pipeline/pipeline.h"
+#include "kfd/stages/core_stages.h"
 
 namespace {
 
@@ -149,7 +149,7 @@ void BM_KeyframeView(benchmark::State& state) {
     state.SetLabel(laser_only ? "laser only" : "odometry");
     std::vector<Scan> scans;
     for (const auto& s : sc.dropped) scans.push_back(laser_only ? kb::laserOnly(s) : s);
-    kfd::KeyframeSelector sel(kb::viewParamsThatDrop());
+    kfd::ViewKeyframeSelector sel(kb::viewParamsThatDrop());
     sel.filter(laser_only ? kb::laserOnly(sc.prefix.back()) : sc.prefix.back());
     std::size_t k = 0, kept = 0;
     for (auto _ : state) {
@@ -164,21 +164,24 @@ BENCHMARK(BM_KeyframeView)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 // Algorithm 2 as published (t = 5 rings, theta = 10 x resolution) + the m_threshold = 10
 // cluster filter.
 void BM_DenoiseReference(benchmark::State& state) {
-    kfd::Denoiser d(kb::paperParams(kfd::DenoiseVariant::Reference).get<kfd::DenoiseStage>());
+    kb::StageFilter<kfd::DenoiseStage> d(
+        kb::paperParams(kfd::DenoiseVariant::Reference).get<kfd::DenoiseStage>());
     runOnKeyframes(state, [&](Scan& s) { return d.filter(s).points_removed; });
 }
 BENCHMARK(BM_DenoiseReference)->Unit(benchmark::kMicrosecond);
 
 // kfd's range-aware clustering + range-adaptive cluster filter (default.ini's values).
 void BM_DenoiseRangeAware(benchmark::State& state) {
-    kfd::Denoiser d(kb::paperParams(kfd::DenoiseVariant::RangeAware).get<kfd::DenoiseStage>());
+    kb::StageFilter<kfd::RangeAwareDenoiseStage> d(
+        kb::paperParams(kfd::DenoiseVariant::RangeAware).get<kfd::RangeAwareDenoiseStage>());
     runOnKeyframes(state, [&](Scan& s) { return d.filter(s).points_removed; });
 }
 BENCHMARK(BM_DenoiseRangeAware)->Unit(benchmark::kMicrosecond);
 
 // kfd's default denoiser, on the loop keyframes (DBSCAN on the same scans below).
 void BM_DenoiseEvidence(benchmark::State& state) {
-    kfd::Denoiser d(kb::paperParams(kfd::DenoiseVariant::Evidence).get<kfd::DenoiseStage>());
+    kb::StageFilter<kfd::EvidenceDenoiseStage> d(
+        kb::paperParams(kfd::DenoiseVariant::Evidence).get<kfd::EvidenceDenoiseStage>());
     runOnLoop(state, [&](Scan& s) { return d.filter(s).points_removed; });
 }
 BENCHMARK(BM_DenoiseEvidence)->Unit(benchmark::kMicrosecond);

@@ -23,6 +23,7 @@
 #include "kfd/io/source_listing.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/stream_filter.h"
+#include "kfd/stages/core_stages.h"
 #include "test_bags.h"
 #include "test_files.h"
 
@@ -878,7 +879,7 @@ TEST(BagOutput, WithNextScanTheSameMessagesComeOutInTheSameOrder) {
     o.pipeline = kfd::kfdDefaults();
     auto off = o;
     off.output = d / "off.bag";
-    o.pipeline.get<kfd::DenoiseStage>().evidence.next_scan = true;
+    o.pipeline.get<kfd::EvidenceDenoiseStage>().next_scan = true;
     const auto a = kfd::RawlogFilter().run(o);
     const auto b = kfd::RawlogFilter().run(off);
     EXPECT_EQ(a.scans_kept, b.scans_kept);

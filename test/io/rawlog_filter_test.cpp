@@ -18,6 +18,7 @@
 #include "kfd/algorithms/evidence_filter.h"
 #include "kfd/io/rawlog_filter.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/stages/core_stages.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;
@@ -185,7 +186,7 @@ TEST(RawlogFilter, SenaSampleActionsLayoutWithNextScanWritesTheSameObjects) {
     if (!fs::exists(kSena)) GTEST_SKIP() << "MRPT sample missing (install mrpt-common): " << kSena;
     TempDir dir;
     auto on = optionsFor(kSena, dir / "on.rawlog");
-    on.pipeline.get<kfd::DenoiseStage>().evidence.next_scan = true;
+    on.pipeline.get<kfd::EvidenceDenoiseStage>().next_scan = true;
     const auto off = optionsFor(kSena, dir / "off.rawlog");
     const auto a = kfd::RawlogFilter().run(on);
     const auto b = kfd::RawlogFilter().run(off);
@@ -274,7 +275,7 @@ TEST(RawlogFilter, TwoSensorsAndAGeometryChangeWithNextScanConserveEverything) {
     auto o = optionsFor(in, dir / "out.rawlog");
     auto off = o;
     off.output = dir / "off.rawlog";
-    o.pipeline.get<kfd::DenoiseStage>().evidence.next_scan = true;
+    o.pipeline.get<kfd::EvidenceDenoiseStage>().next_scan = true;
     const auto s = kfd::RawlogFilter().run(o);
     const auto t = kfd::RawlogFilter().run(off);
     EXPECT_EQ(s.geometry_resets, 1u);
@@ -290,7 +291,7 @@ TEST(RawlogFilter, NextScanKeepsTheSameScansInTheSameOrderOnTheBundledLog) {
     const std::string log = std::string(KFD_SOURCE_DIR) + "/rawlogs/office-mit-0.752.rawlog";
     TempDir dir;
     auto on = optionsFor(log, dir / "on.rawlog");
-    on.pipeline.get<kfd::DenoiseStage>().evidence.next_scan = true;
+    on.pipeline.get<kfd::EvidenceDenoiseStage>().next_scan = true;
     on.stats_csv = dir / "on.csv";
     auto off = optionsFor(log, dir / "off.rawlog");
     off.stats_csv = dir / "off.csv";
@@ -551,7 +552,9 @@ TEST(KfdFilterCli, WithoutAConfigUsesKfdsDefaultsAndPrintsTheSensor) {
     EXPECT_NE(text.find("range noise"), std::string::npos) << text;
     ASSERT_EQ(run(quoted(KFD_FILTER_EXE) + " --print-config", &printed), 0);
     EXPECT_EQ(printed, kfd::toIni(kfd::kfdDefaults()));
-    EXPECT_NE(printed.find("variant = evidence"), std::string::npos) << printed;
+    EXPECT_NE(printed.find("pipeline = odometry_check, distance, view_keyframe, evidence_denoise"),
+              std::string::npos)
+        << printed;
 }
 
 TEST(RawlogFilter, BaselineDenoisersCountTheirNoise) {

@@ -15,6 +15,7 @@
 #include "kfd/mrpt/default_stages.h"
 #include "kfd/mrpt/stream_filter.h"
 #include "kfd/pipeline/pipeline.h"
+#include "kfd/stages/core_stages.h"
 
 namespace {
 std::atomic<std::size_t> g_allocations{0};
@@ -64,8 +65,8 @@ std::vector<kfd::Scan> randomScans(std::size_t count, std::size_t beams, unsigne
 std::size_t steadyStateAllocations(kfd::DenoiseVariant variant, std::size_t* kept_out = nullptr,
                                    bool next_scan = false) {
     kfd::Pipeline::Params p;
-    p.get<kfd::DenoiseStage>().variant = variant;
-    p.get<kfd::DenoiseStage>().evidence.next_scan = next_scan;
+    p.stages = {"distance", "view_keyframe", kfd::stageName(variant)};
+    p.get<kfd::EvidenceDenoiseStage>().next_scan = next_scan;
     p.get<kfd::KeyframeStage>().window = 3;
     kfd::Pipeline pipe(p, kfd::defaultStageRegistry());
     auto scans = randomScans(40, 1081, 7);
@@ -138,7 +139,7 @@ TEST(Allocation, FusePipelineAllocatesNothingInSteadyState) {
 TEST(Allocation, EvidencePipelineKeepingDroppedScansAllocatesNothingInSteadyState) {
     // The default denoiser with temporal_scans = 1 (issue 25): dropped scans are copied into
     // its ring, keyframes convert and align the newest.
-    ASSERT_GE(kfd::Pipeline::Params{}.get<kfd::DenoiseStage>().evidence.temporal_scans, 1u);
+    ASSERT_GE(kfd::Pipeline::Params{}.get<kfd::EvidenceDenoiseStage>().temporal_scans, 1u);
     std::size_t kept = 0;
     EXPECT_EQ(steadyStateAllocations(kfd::DenoiseVariant::Evidence, &kept), 0u);
     EXPECT_LT(kept, 40u);  // some scans were dropped and observed
@@ -163,8 +164,7 @@ TEST(Allocation, CounterSeesAllocations) {  // the test above would be vacuous w
 
 TEST(Allocation, StreamFilterAllocatesNothingInSteadyState) {
     kfd::Pipeline::Params p;
-    p.stages = {"distance", "denoise"};  // every scan takes the same path in both passes
-    p.get<kfd::DenoiseStage>().variant = kfd::DenoiseVariant::RangeAware;
+    p.stages = {"distance", "range_aware_denoise"};  // the same path in both passes
     kfd::StreamFilter f(p);
     mrpt::obs::CObservation2DRangeScan obs;
     obs.sensorLabel = "LASER";

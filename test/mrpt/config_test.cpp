@@ -3,6 +3,7 @@
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/containers/yaml.h>
+#include <algorithm>
 
 #include <filesystem>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/default_stages.h"
 #include "kfd/pipeline/stage_keys.h"
+#include "kfd/stages/core_stages.h"
 #include "kfd/stages/keyframe_stage.h"
 #include "test_files.h"
 
@@ -108,11 +110,11 @@ TEST(Config, PaperPresetsHoldThePublishedValues) {
     EXPECT_EQ(b.get<kfd::KeyframeStage>().bins, 15u);
     EXPECT_DOUBLE_EQ(b.get<kfd::KeyframeStage>().p_pair, 0.99);
     for (const auto& p : {a, b}) {
-        EXPECT_EQ(p.get<kfd::DenoiseStage>().reference.rings.rings, 5u);
-        EXPECT_DOUBLE_EQ(p.get<kfd::DenoiseStage>().reference.angle_gap_factor, 10.0);
-        EXPECT_DOUBLE_EQ(p.get<kfd::DenoiseStage>().range_aware.angle_gap_factor, 10.0);
-        EXPECT_EQ(p.get<kfd::DenoiseStage>().filter.m_threshold, 10u);
-        EXPECT_EQ(p.get<kfd::DenoiseStage>().variant, kfd::DenoiseVariant::Reference);
+        EXPECT_EQ(p.get<kfd::DenoiseStage>().clustering.rings.rings, 5u);
+        EXPECT_DOUBLE_EQ(p.get<kfd::DenoiseStage>().clustering.angle_gap_factor, 10.0);
+        EXPECT_EQ(p.get<kfd::DenoiseStage>().m_threshold, 10u);
+        // The paper's three stages, and nothing of kfd's.
+        EXPECT_EQ(p.stages, (std::vector<std::string>{"distance", "keyframe", "denoise"}));
         // The published method has no guards.
         EXPECT_EQ(p.get<kfd::KeyframeStage>().max_consecutive_drops, 0u);
         EXPECT_EQ(p.get<kfd::KeyframeStage>().max_interval_s, 0.0);
@@ -125,13 +127,15 @@ TEST(Config, YamlAndIniDefaultsAgree) {
     const auto ini = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.ini");
     const auto yml = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.yaml");
     EXPECT_EQ(kfd::toIni(ini), kfd::toIni(yml));
-    EXPECT_EQ(ini.get<kfd::DenoiseStage>().variant, kfd::DenoiseVariant::Evidence);
+    EXPECT_EQ(ini.stages, yml.stages);
 }
 
 TEST(Config, KfdDefaultsAreDefaultIniCompiledIn) {
     const auto ini = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.ini");
     EXPECT_EQ(kfd::toIni(kfd::kfdDefaults()), kfd::toIni(ini));
-    EXPECT_EQ(kfd::kfdDefaults().get<kfd::DenoiseStage>().variant, kfd::DenoiseVariant::Evidence);
+    EXPECT_EQ(kfd::kfdDefaults().stages,
+              (std::vector<std::string>{"odometry_check", "distance", "view_keyframe",
+                                        "evidence_denoise"}));
 }
 
 TEST(Config, EveryShippedNonPaperPresetUsesTheViewSelectorAndTheEvidenceDenoiser) {
@@ -143,10 +147,13 @@ TEST(Config, EveryShippedNonPaperPresetUsesTheViewSelectorAndTheEvidenceDenoiser
             SCOPED_TRACE(e.path().string());
             const auto p = kfd::loadConfigFile(e.path().string());
             const bool paper = e.path().filename().string().rfind("paper-", 0) == 0;
-            EXPECT_EQ(p.get<kfd::DenoiseStage>().variant,
-                      paper ? kfd::DenoiseVariant::Reference : kfd::DenoiseVariant::Evidence);
-            EXPECT_EQ(p.get<kfd::KeyframeStage>().selector,
-                      paper ? kfd::KeyframeRule::Paper : kfd::KeyframeRule::View);
+            auto lists = [&p](const char* stage) {
+                return std::find(p.stages.begin(), p.stages.end(), stage) != p.stages.end();
+            };
+            EXPECT_EQ(lists("denoise"), paper);
+            EXPECT_EQ(lists("keyframe"), paper);
+            EXPECT_EQ(lists("evidence_denoise"), !paper);
+            EXPECT_EQ(lists("view_keyframe"), !paper);
             ++seen;
         }
     EXPECT_GE(seen, 9u);
@@ -337,25 +344,30 @@ TEST(Config, BadViewSelectorKeysAreErrorsNamingTheKey) {
 
 TEST(Config, KeyTableIsDerivedFromTheStageRegistry) {
     const auto& reg = kfd::defaultStageRegistry();
-    std::vector<std::string> want{"pipeline"};
+    std::vector<std::string> want{"pipeline", "selector", "variant"};  // then each key once
     for (const auto& s : reg.stages())
-        for (const auto& k : s.keys) want.push_back(k.name);
+        for (const auto& k : s.keys)
+            if (std::find(want.begin(), want.end(), k.name) == want.end()) want.push_back(k.name);
     std::vector<std::string> got;
     for (const auto& k : kfd::configKeys()) got.push_back(k.name);
     EXPECT_EQ(got, want);
     EXPECT_EQ(kfd::configKeys().front().range, reg.names());
-    // Every key, and only those, printed by toIni in the same order.
+    // Every stage key, and only those, printed by toIni in the same order (the stage list
+    // carries the choice keys).
     const std::string ini = kfd::toIni(kfd::Pipeline::Params{});
+    EXPECT_EQ(ini.find("\nselector = "), std::string::npos);
     std::size_t pos = 0;
-    for (const auto& k : want) {
+    for (const auto& k : std::vector<std::string>(want.begin() + 3, want.end())) {
         const auto at = ini.find("\n" + k + " = ", pos);
         ASSERT_NE(at, std::string::npos) << k;
         pos = at + 1;
     }
     // A registry with the core stages only has only the core keys.
-    std::size_t core_keys = 1;
-    for (const auto& s : kfd::coreStageRegistry().stages()) core_keys += s.keys.size();
-    EXPECT_EQ(kfd::configKeys(kfd::coreStageRegistry()).size(), core_keys);
+    std::vector<std::string> core{"pipeline", "selector", "variant"};
+    for (const auto& s : kfd::coreStageRegistry().stages())
+        for (const auto& k : s.keys)
+            if (std::find(core.begin(), core.end(), k.name) == core.end()) core.push_back(k.name);
+    EXPECT_EQ(kfd::configKeys(kfd::coreStageRegistry()).size(), core.size());
 }
 
 // --list-keys's two defaults: the Params structs' (a C++ caller's) and kfd's (no configuration,
@@ -363,10 +375,13 @@ TEST(Config, KeyTableIsDerivedFromTheStageRegistry) {
 TEST(Config, EveryKeyCarriesItsParamsDefaultAndKfdsDefault) {
     std::map<std::string, kfd::ConfigKeyInfo> by_name;
     for (const auto& k : kfd::configKeys()) by_name[k.name] = k;
-    const kfd::KeyframeSelector::Params kf;
+    const kfd::ViewKeyframeSelector::Params kf;
     const kfd::EvidenceFilter::Params ev;
     // window: 8 in the struct, 1 in default.ini.
-    EXPECT_EQ(by_name["window"].default_value, std::to_string(kf.window));
+    EXPECT_EQ(by_name["selector"].default_value, "view");
+    EXPECT_EQ(by_name["variant"].kfd_value, "evidence");
+    EXPECT_EQ(by_name["window"].default_value,
+              std::to_string(kfd::KeyframeSelector::Params{}.window));
     EXPECT_EQ(by_name["window"].kfd_value,
               std::to_string(kfd::kfdDefaults().get<kfd::KeyframeStage>().window));
     EXPECT_NE(by_name["window"].default_value, by_name["window"].kfd_value);
@@ -383,7 +398,7 @@ TEST(Config, EveryKeyCarriesItsParamsDefaultAndKfdsDefault) {
           {kfd::kfdDefaults(), &kfd::ConfigKeyInfo::kfd_value}}) {
         const std::string ini = kfd::toIni(params);
         for (const auto& k : kfd::configKeys()) {
-            if (k.name == "pipeline") continue;
+            if (k.name == "pipeline" || k.name == "selector" || k.name == "variant") continue;
             EXPECT_NE(ini.find("\n" + k.name + " = " + k.*field + "\n"), std::string::npos)
                 << k.name;
         }
@@ -393,10 +408,25 @@ TEST(Config, EveryKeyCarriesItsParamsDefaultAndKfdsDefault) {
     EXPECT_EQ(by_name["pipeline"].kfd_value, stages);
 }
 
-TEST(Config, AngleGapFactorReachesBothDenoiseVariants) {
-    const auto p = fromIniText("[KFD]\nangle_gap_factor = 30\n");
-    EXPECT_EQ(p.get<kfd::DenoiseStage>().reference.angle_gap_factor, 30.0);
-    EXPECT_EQ(p.get<kfd::DenoiseStage>().range_aware.angle_gap_factor, 30.0);
+// selector and variant choose the stage of their role in the listed pipeline, wherever the
+// file puts them; a value that names no stage is an error naming the key.
+TEST(Config, ChoiceKeysReplaceTheStageOfTheirRole) {
+    using V = std::vector<std::string>;
+    EXPECT_EQ(fromIniText("[KFD]\nselector = paper\nvariant = reference\n").stages,
+              (V{"odometry_check", "distance", "keyframe", "denoise"}));
+    EXPECT_EQ(
+        fromIniText("[KFD]\nvariant = range_aware\npipeline = distance, evidence_denoise\n").stages,
+        (V{"distance", "range_aware_denoise"}));
+    EXPECT_EQ(fromIniText("[KFD]\npipeline = distance\nselector = paper\n").stages, V{"distance"});
+    EXPECT_EQ(errorKey("[KFD]\nselector = histogram\n"), "selector");
+}
+
+TEST(Config, AFlatKeySetsItInEveryStageThatDeclaresIt) {
+    const auto p = fromIniText("[KFD]\nangle_gap_factor = 30\nm_threshold = 7\n");
+    EXPECT_EQ(p.get<kfd::DenoiseStage>().clustering.angle_gap_factor, 30.0);
+    EXPECT_EQ(p.get<kfd::RangeAwareDenoiseStage>().clustering.angle_gap_factor, 30.0);
+    EXPECT_EQ(p.get<kfd::DenoiseStage>().m_threshold, 7u);
+    EXPECT_EQ(p.get<kfd::RangeAwareDenoiseStage>().filter.m_threshold, 7u);
     EXPECT_NE(kfd::toIni(p).find("angle_gap_factor = 30\n"), std::string::npos);
 }
 

@@ -11,6 +11,7 @@
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/stream_filter.h"
+#include "kfd/stages/core_stages.h"
 
 namespace {
 
@@ -34,7 +35,7 @@ mrpt::obs::CObservation2DRangeScan roomScan(std::size_t beams, double aperture, 
 
 kfd::Pipeline::Params paperParams() {
     kfd::Pipeline::Params p;  // built-in defaults, the paper's selector, the guards off
-    p.get<kfd::KeyframeStage>().selector = kfd::KeyframeRule::Paper;
+    p.stages = {"distance", "keyframe", "evidence_denoise"};
     p.get<kfd::KeyframeStage>().max_consecutive_drops = 0;
     p.get<kfd::KeyframeStage>().max_interval_s = 0;
     p.get<kfd::KeyframeStage>().max_translation_m = 0;
@@ -114,7 +115,7 @@ TEST(StreamFilter, CleansInPlaceKeepingBeamsAndRanges) {
     for (std::size_t i = 0; i < s.getScanSize(); ++i) invalid += !s.getScanRangeValidity(i);
     EXPECT_EQ(invalid, 1 + r.record.points_in - r.record.points_out);  // exactly those removed
     EXPECT_EQ(r.report.findOrDefault<kfd::DistanceFilter::Result>().removed_out_of_range, 1u);
-    EXPECT_GE(r.report.findOrDefault<kfd::Denoiser::Result>().points_removed, 1u);
+    EXPECT_GE(r.report.findOrDefault<kfd::DenoiseResult>().points_removed, 1u);
 }
 
 TEST(StreamFilter, RotationInPlaceStillProducesKeyframes) {
@@ -267,7 +268,7 @@ namespace {
 
 kfd::Pipeline::Params nextScanParams() {
     kfd::Pipeline::Params p;
-    p.get<kfd::DenoiseStage>().evidence.next_scan = true;
+    p.get<kfd::EvidenceDenoiseStage>().next_scan = true;
     return p;
 }
 
@@ -304,7 +305,7 @@ TEST(StreamFilter, WithNextScanAKeptScanIsPendingUntilTheNextScanFinishesIt) {
     EXPECT_FALSE(done.pending);
     EXPECT_TRUE(done.keep);
     EXPECT_EQ(done.record.index, 0u);
-    EXPECT_NE(done.report.find<kfd::Denoiser::Result>(), nullptr);
+    EXPECT_NE(done.report.find<kfd::DenoiseResult>(), nullptr);
     EXPECT_FALSE(f.takeFinished(done));
     EXPECT_EQ(f.counters().scans_kept, 1u);
     if (rb.pending) {  // the end of the log: finished without a next scan
@@ -331,4 +332,46 @@ TEST(StreamFilter, AGeometryChangeFinishesThePendingScan) {
     f.finish();
     while (f.takeFinished(done)) EXPECT_EQ(done.scan, &b);
     EXPECT_EQ(f.pendingCount(), 0u);
+}
+
+// The door holds the delay (issue 34): every scan's `done` and every then() run in input order,
+// at once when nothing is held before them, else once the held scan is finished.
+TEST(StreamFilter, TheDoorHandsBackFinishedScansAndQueuedOutputInInputOrder) {
+    kfd::StreamFilter f(nextScanParams(), {}, true);
+    std::vector<std::string> out;
+    auto a = roomScan(361, M_PI, 3.0);
+    a.timestamp = mrpt::Clock::fromDouble(100.0);
+    const auto ra = f.process(a, std::nullopt, [&](kfd::StreamResult& r) {
+        EXPECT_FALSE(r.pending);
+        EXPECT_NE(r.report.find<kfd::DenoiseResult>(), nullptr);  // finished: denoised
+        out.push_back("a");
+    });
+    ASSERT_TRUE(ra.pending);  // a keyframe waiting for its next scan
+    f.then([&] { out.push_back("after a"); });
+    EXPECT_TRUE(out.empty());           // held, and what follows it waits behind it
+    auto b = roomScan(361, M_PI, 3.0);  // the same view: dropped, and it finishes a
+    b.timestamp = mrpt::Clock::fromDouble(100.1);
+    f.process(b, std::nullopt, [&](kfd::StreamResult& r) {
+        EXPECT_FALSE(r.keep);
+        out.push_back("b");
+    });
+    EXPECT_EQ(out, (std::vector<std::string>{"a", "after a", "b"}));
+    f.then([&] { out.push_back("end"); });  // nothing held: at once
+    EXPECT_EQ(out.back(), "end");
+    f.finish();
+    EXPECT_EQ(out.size(), 4u);
+    EXPECT_EQ(f.pendingCount(), 0u);
+}
+
+TEST(StreamFilter, WithoutNextScanEveryDoneRunsDuringItsOwnProcessCall) {
+    kfd::StreamFilter f(kfd::Pipeline::Params{});
+    int calls = 0;
+    for (int k = 0; k < 3; ++k) {
+        auto s = roomScan(361, M_PI, 3.0, "LASER", 0.3 * k);
+        f.process(s, std::nullopt, [&](kfd::StreamResult& r) {
+            EXPECT_EQ(r.scan, &s);
+            ++calls;
+        });
+        EXPECT_EQ(calls, k + 1);
+    }
 }

@@ -87,11 +87,10 @@ TEST(KeyframeWindow, BadParametersNameTheirField) {
     EXPECT_EQ(field({4, 3, 1.5}), "p_pair");
 }
 
-// The selector with selector = paper and no guards is exactly the window (Formula 3), over
-// random histograms: the same verdicts, products and thresholds.
+// The paper's selector (the keyframe stage's) without guards is exactly the window (Formula 3),
+// over random histograms: the same verdicts, products and thresholds.
 TEST(KeyframeWindow, ThePaperSelectorWithoutGuardsDecidesAsTheWindow) {
     kfd::KeyframeSelector::Params p;
-    p.selector = kfd::KeyframeRule::Paper;
     p.bins = 6;
     p.window = 3;
     p.p_pair = 0.97;

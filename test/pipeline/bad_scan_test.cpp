@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "kfd/algorithms/denoiser.h"
 #include "kfd/paper/clusters.h"
 #include "kfd/pipeline/pipeline.h"
 #include "kfd/pipeline/stage_registry.h"
+#include "kfd/stages/core_stages.h"
 #include "kfd/stages/denoise_stage.h"
 #include "test_scans.h"
 
@@ -34,6 +34,7 @@ std::vector<std::vector<std::string>> stageLists() {
             if (a.name != b.name) lists.push_back({a.name, b.name});
     }
     lists.push_back({"distance", "keyframe", "denoise"});
+    lists.push_back({"distance", "view_keyframe", "evidence_denoise"});
     return lists;
 }
 
@@ -97,8 +98,7 @@ TEST(CoreBadScan, BadRangesFlaggedValidNeverMisleadAnyStage) {
                          " stages" + (list.empty() ? "" : " from " + list[0]));
             Pipeline::Params p;
             p.stages = list;
-            p.get<kfd::DenoiseStage>().variant = kfd::DenoiseVariant::RangeAware;
-            p.get<kfd::DenoiseStage>().filter.min_object_size_m = 0.3;
+            p.get<kfd::RangeAwareDenoiseStage>().filter.min_object_size_m = 0.3;
             Pipeline pipe(p);
             for (int k = 0; k < 3; ++k) {  // first scan and later ones (keyframe references)
                 Scan s = poisonedWall(720, aperture);
@@ -111,10 +111,10 @@ TEST(CoreBadScan, BadRangesFlaggedValidNeverMisleadAnyStage) {
 }
 
 TEST(CoreBadScan, TheDenoiserRemovesBeamsWithoutAUsableRange) {
-    for (const auto variant : {kfd::DenoiseVariant::Reference, kfd::DenoiseVariant::RangeAware}) {
+    for (const auto variant : {kfd::DenoiseVariant::Reference, kfd::DenoiseVariant::RangeAware,
+                               kfd::DenoiseVariant::Evidence}) {
         Pipeline::Params p;
-        p.stages = {"denoise"};
-        p.get<kfd::DenoiseStage>().variant = variant;
+        p.stages = {kfd::stageName(variant)};
         Pipeline pipe(p);
         Scan s = poisonedWall(720, kfd::kPi);
         pipe.process(s);

@@ -1,4 +1,5 @@
 #include "kfd/pipeline/pipeline.h"
+#include "kfd/stages/core_stages.h"
 
 #include <cmath>
 #include <cstring>
@@ -20,10 +21,11 @@ std::vector<std::string> stageNames(const Pipeline& p) {
     return names;
 }
 
-// The paper's method (the reference denoiser): the expectations below follow Algorithm 2.
+// The paper's denoiser (Algorithm 2) after kfd's keyframe stage: the expectations below
+// follow Algorithm 2.
 Pipeline::Params paper() {
     Pipeline::Params p;
-    p.get<DenoiseStage>().variant = DenoiseVariant::Reference;
+    p.stages = {"distance", "view_keyframe", "denoise"};
     return p;
 }
 
@@ -46,7 +48,7 @@ class RecordingStage : public Stage {
     bool process(Scan& scan, StageReport&, const ScanReport& chain) override {
         ++*calls_;
         seen_valid = scan.countValid();
-        seen_denoised = chain.find<Denoiser::Result>() != nullptr;
+        seen_denoised = chain.find<DenoiseResult>() != nullptr;
         return keep_;
     }
     void observeDropped(const Scan& scan) override {
@@ -68,10 +70,17 @@ class RecordingStage : public Stage {
     int* resets_;
 };
 
-TEST(Pipeline, DefaultStageOrder) {
+// The default pipeline names kfd's stages; the paper's are stages of their own.
+TEST(Pipeline, DefaultStageOrderNamesKfdsStages) {
     const Pipeline p;
-    EXPECT_EQ(stageNames(p), (std::vector<std::string>{"distance", "keyframe", "denoise"}));
-    EXPECT_EQ(p.params().stages, (std::vector<std::string>{"distance", "keyframe", "denoise"}));
+    const std::vector<std::string> kfds{"distance", "view_keyframe", "evidence_denoise"};
+    EXPECT_EQ(stageNames(p), kfds);
+    EXPECT_EQ(p.params().stages, kfds);
+    const Pipeline paper(withStages({"distance", "keyframe", "denoise"}));
+    EXPECT_NE(paper.find<kfd::KeyframeStage>(), nullptr);
+    EXPECT_NE(paper.find<kfd::DenoiseStage>(), nullptr);
+    EXPECT_EQ(paper.find<kfd::ViewKeyframeStage>(), nullptr);
+    EXPECT_EQ(paper.find<kfd::EvidenceDenoiseStage>(), nullptr);
 }
 
 TEST(Pipeline, CustomStageOrder) {
@@ -99,7 +108,7 @@ TEST(Pipeline, InvalidStageParamsThrow) {
     p.get<kfd::DistanceStage>().max_range = 1.0;
     EXPECT_THROW(Pipeline{p}, kfd::ParameterError);
     p = withStages({"denoise"});
-    p.get<kfd::DenoiseStage>().filter.m_threshold = 0;
+    p.get<kfd::DenoiseStage>().m_threshold = 0;
     EXPECT_THROW(Pipeline{p}, kfd::ParameterError);
 }
 
@@ -111,13 +120,13 @@ TEST(Pipeline, FirstScanRunsEveryStage) {
     EXPECT_TRUE(r.dropped_by.empty());
     EXPECT_NE(r.find<kfd::KeyframeDecision>(), nullptr);
     EXPECT_EQ(r.findOrDefault<kfd::KeyframeDecision>().reason, KeyframeReason::First);
-    EXPECT_NE(r.find<kfd::Denoiser::Result>(), nullptr);
+    EXPECT_NE(r.find<kfd::DenoiseResult>(), nullptr);
     EXPECT_EQ(r.points_in, 121u);
     EXPECT_EQ(r.findOrDefault<kfd::DistanceFilter::Result>().valid_in, 121u);
     EXPECT_EQ(r.findOrDefault<kfd::DistanceFilter::Result>().removed_out_of_range, 1u);
     EXPECT_EQ(r.findOrDefault<kfd::DistanceFilter::Result>().removed_non_finite, 1u);
-    EXPECT_EQ(r.findOrDefault<kfd::Denoiser::Result>().points_in, 119u);
-    EXPECT_EQ(r.findOrDefault<kfd::Denoiser::Result>().points_removed, 3u);
+    EXPECT_EQ(r.findOrDefault<kfd::DenoiseResult>().points_in, 119u);
+    EXPECT_EQ(r.findOrDefault<kfd::DenoiseResult>().points_removed, 3u);
     EXPECT_EQ(r.points_out, 116u);
     EXPECT_EQ(scan.countValid(), 116u);
     for (const std::size_t i : {50u, 60u, 61u, 100u, 130u}) EXPECT_EQ(scan.valid[i], 0u) << i;
@@ -131,11 +140,11 @@ TEST(Pipeline, DroppedScanStopsLaterStages) {
     second.timestamp = 100.1;
     const auto r = p.process(second);
     EXPECT_FALSE(r.keep);
-    EXPECT_EQ(r.dropped_by, "keyframe");
+    EXPECT_EQ(r.dropped_by, "view_keyframe");
     EXPECT_NE(r.find<kfd::KeyframeDecision>(), nullptr);
     EXPECT_EQ(r.findOrDefault<kfd::KeyframeDecision>().reason, KeyframeReason::Covered);
-    EXPECT_EQ(r.find<kfd::Denoiser::Result>(), nullptr);
-    EXPECT_EQ(r.findOrDefault<kfd::Denoiser::Result>().points_removed, 0u);
+    EXPECT_EQ(r.find<kfd::DenoiseResult>(), nullptr);
+    EXPECT_EQ(r.findOrDefault<kfd::DenoiseResult>().points_removed, 0u);
     // The distance stage ran before the drop; the denoise stage did not run.
     EXPECT_EQ(r.findOrDefault<kfd::DistanceFilter::Result>().removed_out_of_range, 1u);
     EXPECT_EQ(second.valid[60], 0u);
@@ -150,7 +159,7 @@ TEST(Pipeline, NoKeyframeStageKeepsEveryScan) {
         const auto r = p.process(scan);
         EXPECT_TRUE(r.keep);
         EXPECT_EQ(r.find<kfd::KeyframeDecision>(), nullptr);
-        EXPECT_NE(r.find<kfd::Denoiser::Result>(), nullptr);
+        EXPECT_NE(r.find<kfd::DenoiseResult>(), nullptr);
         EXPECT_EQ(r.points_out, 116u);
     }
 }
@@ -162,10 +171,10 @@ TEST(Pipeline, StagesRunInTheListedOrder) {
     Pipeline p(withStages({"denoise", "distance"}));
     Scan scan = noisyWall();
     const auto r = p.process(scan);
-    EXPECT_EQ(r.findOrDefault<kfd::Denoiser::Result>().points_in, 121u);
-    EXPECT_GE(r.findOrDefault<kfd::Denoiser::Result>().points_removed, 1u);
+    EXPECT_EQ(r.findOrDefault<kfd::DenoiseResult>().points_in, 121u);
+    EXPECT_GE(r.findOrDefault<kfd::DenoiseResult>().points_removed, 1u);
     EXPECT_EQ(r.findOrDefault<kfd::DistanceFilter::Result>().valid_in,
-              121u - r.findOrDefault<kfd::Denoiser::Result>().points_removed);
+              121u - r.findOrDefault<kfd::DenoiseResult>().points_removed);
 }
 
 TEST(Pipeline, CustomStageViaAdd) {
@@ -174,8 +183,8 @@ TEST(Pipeline, CustomStageViaAdd) {
     auto stage = std::make_unique<RecordingStage>("recorder", true, &calls);
     RecordingStage* rec = stage.get();
     p.add(std::move(stage));
-    EXPECT_EQ(stageNames(p),
-              (std::vector<std::string>{"distance", "keyframe", "denoise", "recorder"}));
+    EXPECT_EQ(stageNames(p), (std::vector<std::string>{"distance", "view_keyframe",
+                                                       "evidence_denoise", "recorder"}));
     Scan scan = noisyWall();
     EXPECT_TRUE(p.process(scan).keep);
     EXPECT_EQ(calls, 1);
@@ -232,7 +241,7 @@ TEST(Pipeline, EmptyPipelineKeepsEverything) {
     const auto r = p.process(scan);
     EXPECT_TRUE(r.keep);
     EXPECT_EQ(r.find<kfd::KeyframeDecision>(), nullptr);
-    EXPECT_EQ(r.find<kfd::Denoiser::Result>(), nullptr);
+    EXPECT_EQ(r.find<kfd::DenoiseResult>(), nullptr);
     EXPECT_EQ(scan.valid, before.valid);
     EXPECT_EQ(r.points_in, r.points_out);
     EXPECT_EQ(p.lastClusters(), nullptr);
@@ -252,7 +261,7 @@ TEST(Pipeline, ResetMakesTheNextScanAKeyframe) {
     const auto r = p.process(c);
     EXPECT_TRUE(r.keep);
     EXPECT_EQ(r.findOrDefault<kfd::KeyframeDecision>().reason, KeyframeReason::First);
-    EXPECT_NE(r.find<kfd::Denoiser::Result>(), nullptr);
+    EXPECT_NE(r.find<kfd::DenoiseResult>(), nullptr);
 }
 
 TEST(Pipeline, PreservesGeometryAndOnlyClearsValidFlags) {
@@ -300,13 +309,12 @@ TEST(Pipeline, LastClustersComeFromTheDenoiseStage) {
 }
 
 TEST(Pipeline, StageParamsArePassedOn) {
-    auto params = withStages({"distance", "denoise"});
+    auto params = withStages({"distance", "range_aware_denoise"});
     params.get<kfd::DistanceStage>().max_range = 5.0;  // the wall beyond 5 m goes
-    params.get<kfd::DenoiseStage>().variant = DenoiseVariant::RangeAware;
     Pipeline p(params);
     Scan scan = noisyWall();
     const auto r = p.process(scan);
-    EXPECT_EQ(r.findOrDefault<kfd::Denoiser::Result>().variant, DenoiseVariant::RangeAware);
+    EXPECT_EQ(r.findOrDefault<kfd::DenoiseResult>().variant, DenoiseVariant::RangeAware);
     EXPECT_GT(r.findOrDefault<kfd::DistanceFilter::Result>().removed_out_of_range, 1u);
     for (std::size_t i = 0; i < scan.size(); ++i) {
         if (scan.valid[i]) {
@@ -338,7 +346,7 @@ std::vector<Scan> approach(std::size_t count) {
 
 Pipeline::Params nextScan(bool on) {
     Pipeline::Params p;
-    p.get<DenoiseStage>().evidence.next_scan = on;
+    p.get<EvidenceDenoiseStage>().next_scan = on;
     return p;
 }
 
@@ -381,7 +389,7 @@ TEST(PipelineNextScan, AKeyframeIsHeldUntilTheNextScanAndFinishedByIt) {
     const ScanReport first = p.process(scans[0]);
     EXPECT_TRUE(first.pending);
     EXPECT_TRUE(first.keep);
-    EXPECT_EQ(first.find<Denoiser::Result>(), nullptr);  // the denoise stage has not run
+    EXPECT_EQ(first.find<DenoiseResult>(), nullptr);  // the denoise stage has not run
     ScanReport done;
     EXPECT_EQ(p.finished(done), nullptr);
     p.process(scans[1]);
@@ -389,8 +397,8 @@ TEST(PipelineNextScan, AKeyframeIsHeldUntilTheNextScanAndFinishedByIt) {
     ASSERT_NE(f, nullptr);
     EXPECT_EQ(f->timestamp, scans[0].timestamp);
     EXPECT_FALSE(done.pending);
-    ASSERT_NE(done.find<Denoiser::Result>(), nullptr);
-    EXPECT_TRUE(done.find<Denoiser::Result>()->next);  // the next scan was used
+    ASSERT_NE(done.find<DenoiseResult>(), nullptr);
+    EXPECT_TRUE(done.find<DenoiseResult>()->next);  // the next scan was used
     EXPECT_EQ(done.stage_count, 3u);
 }
 
@@ -403,8 +411,8 @@ TEST(PipelineNextScan, TheLastKeyframeIsFinishedWithoutANextScan) {
     const Scan* f = p.finished(done);
     ASSERT_NE(f, nullptr);
     EXPECT_TRUE(done.keep);
-    ASSERT_NE(done.find<Denoiser::Result>(), nullptr);
-    EXPECT_FALSE(done.find<Denoiser::Result>()->next);
+    ASSERT_NE(done.find<DenoiseResult>(), nullptr);
+    EXPECT_FALSE(done.find<DenoiseResult>()->next);
     EXPECT_FALSE(p.finish());  // nothing held any more
     // Exactly what the option off gives for a lone scan.
     Pipeline off(nextScan(false));
@@ -505,7 +513,7 @@ TEST(PipelineNextScan, TheStagesAfterTheHoldingOneRunOnTheFinishedScanInOrder) {
 }
 
 TEST(PipelineNextScan, ABadValueOfTheKeyNamesIt) {
-    const StageInfo& denoise = *coreStageRegistry().find("denoise");
+    const StageInfo& denoise = *coreStageRegistry().find("evidence_denoise");
     const StageKey* key = denoise.keyForField("next_scan");
     ASSERT_NE(key, nullptr);
     Pipeline::Params p;

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "kfd/pipeline/pipeline.h"
+#include "kfd/stages/core_stages.h"
 #include "test_scans.h"
 
 namespace kfd {
@@ -22,10 +23,12 @@ std::vector<std::string> keyNames(const StageInfo& s) {
 // test::noisyWall: outliers at beams 50, 100 and 130, beam 60 out of range and beam 61 NaN.
 using test::noisyWall;
 
-TEST(StageRegistry, CoreRegistryHoldsThePapersStagesInOrder) {
+TEST(StageRegistry, CoreRegistryHoldsThePapersStagesThenKfds) {
     const auto& r = coreStageRegistry();
-    EXPECT_EQ(r.names(), "distance, keyframe, denoise, odometry_check, fuse");
-    ASSERT_EQ(r.stages().size(), 5u);
+    EXPECT_EQ(r.names(),
+              "distance, keyframe, denoise, view_keyframe, range_aware_denoise, "
+              "evidence_denoise, odometry_check, fuse");
+    ASSERT_EQ(r.stages().size(), 8u);
     for (const auto& s : r.stages()) {
         EXPECT_FALSE(s.help.empty()) << s.name;
         EXPECT_FALSE(s.keys.empty()) << s.name;
@@ -37,36 +40,33 @@ TEST(StageRegistry, CoreRegistryHoldsThePapersStagesInOrder) {
 TEST(StageRegistry, EachStageOwnsItsKeys) {
     const auto& r = coreStageRegistry();
     EXPECT_EQ(keyNames(*r.find("distance")), (std::vector<std::string>{"min_range", "max_range"}));
-    EXPECT_EQ(keyNames(*r.find("keyframe")),
+    const std::vector<std::string> guards{"max_consecutive_drops", "max_interval_s",
+                                          "max_translation_m", "max_rotation_deg"};
+    auto with = [](std::vector<std::string> v, const std::vector<std::string>& more) {
+        v.insert(v.end(), more.begin(), more.end());
+        return v;
+    };
+    // The paper's stages declare the paper's keys (plus kfd's guards, off in the presets).
+    EXPECT_EQ(keyNames(*r.find("keyframe")), with({"bins", "window", "p_pair"}, guards));
+    EXPECT_EQ(keyNames(*r.find("denoise")),
+              (std::vector<std::string>{"rings", "ring_r_max", "angle_gap_factor",
+                                        "merge_distance_m", "m_threshold"}));
+    // kfd's stages their own.
+    EXPECT_EQ(keyNames(*r.find("view_keyframe")),
+              with({"view_samples", "view_tolerance_m", "view_tolerance_deg", "max_view_change",
+                    "change_tolerance_m", "change_tolerance_ratio", "max_changed_fraction",
+                    "degeneracy_ratio", "corridor_translation_m", "corridor_rotation_deg",
+                    "corridor_interval_s"},
+                   guards));
+    EXPECT_EQ(keyNames(*r.find("range_aware_denoise")),
+              (std::vector<std::string>{"angle_gap_factor", "m_threshold", "jump_lambda_deg",
+                                        "jump_sigma_m", "min_object_size_m", "min_points_floor"}));
+    EXPECT_EQ(keyNames(*r.find("evidence_denoise")),
               (std::vector<std::string>{
-                  "selector", "bins", "window", "p_pair", "max_consecutive_drops", "max_interval_s",
-                  "max_translation_m", "max_rotation_deg", "view_samples", "view_tolerance_m",
-                  "view_tolerance_deg", "max_view_change", "change_tolerance_m",
-                  "change_tolerance_ratio", "max_changed_fraction", "degeneracy_ratio",
-                  "corridor_translation_m", "corridor_rotation_deg", "corridor_interval_s"}));
-    EXPECT_EQ(keyNames(*r.find("denoise")), (std::vector<std::string>{"variant",
-                                                                      "rings",
-                                                                      "ring_r_max",
-                                                                      "angle_gap_factor",
-                                                                      "merge_distance_m",
-                                                                      "m_threshold",
-                                                                      "jump_lambda_deg",
-                                                                      "jump_sigma_m",
-                                                                      "min_object_size_m",
-                                                                      "min_points_floor",
-                                                                      "incidence_deg",
-                                                                      "sigma_m",
-                                                                      "max_gap_beams",
-                                                                      "max_small_points",
-                                                                      "temporal",
-                                                                      "pose_trans_error_m",
-                                                                      "pose_rot_error_deg",
-                                                                      "motion_error_fraction",
-                                                                      "max_removed_fraction",
-                                                                      "max_confirmed_fraction",
-                                                                      "confirm_support",
-                                                                      "temporal_scans",
-                                                                      "next_scan"}));
+                  "min_object_size_m", "incidence_deg", "sigma_m", "max_gap_beams",
+                  "max_small_points", "temporal", "pose_trans_error_m", "pose_rot_error_deg",
+                  "motion_error_fraction", "max_removed_fraction", "max_confirmed_fraction",
+                  "confirm_support", "temporal_scans", "next_scan"}));
     EXPECT_EQ(keyNames(*r.find("odometry_check")),
               (std::vector<std::string>{"frozen_changed_fraction", "jump_margin"}));
 }
@@ -116,12 +116,26 @@ TEST(StageRegistry, MaxRangeKeyTakesScanOrANumber) {
     EXPECT_NE(max->range.find("scan"), std::string::npos) << max->range;
 }
 
-TEST(StageRegistry, AngleGapKeySetsBothVariants) {
-    const StageInfo& dn = *coreStageRegistry().find("denoise");
-    PipelineParams p;
-    dn.keyForField("angle_gap_factor")->set(p.at(dn).data(), "30");
-    EXPECT_EQ(p.get<DenoiseStage>().reference.angle_gap_factor, 30.0);
-    EXPECT_EQ(p.get<DenoiseStage>().range_aware.angle_gap_factor, 30.0);
+// `selector` and `variant` choose among stages of one role; every option names a registered
+// stage, and a stage belongs to at most one role.
+TEST(StageRegistry, ChoiceKeysNameTheStagesOfARole) {
+    const auto& r = coreStageRegistry();
+    const StageChoice* selector = r.choice("selector");
+    ASSERT_NE(selector, nullptr);
+    EXPECT_EQ(selector->values(), "paper, view");
+    EXPECT_EQ(selector->find("paper")->stage, "keyframe");
+    EXPECT_EQ(selector->find("view")->stage, "view_keyframe");
+    EXPECT_EQ(selector->find("histogram"), nullptr);
+    const StageChoice* variant = r.choice("variant");
+    ASSERT_NE(variant, nullptr);
+    EXPECT_EQ(variant->values(), "reference, range_aware, evidence");
+    EXPECT_EQ(r.choiceOfStage("evidence_denoise"), variant);
+    EXPECT_EQ(r.choiceOfStage("denoise"), variant);
+    EXPECT_EQ(r.choiceOfStage("distance"), nullptr);
+    StageRegistry other;
+    registerCoreStages(other);
+    EXPECT_THROW(other.addChoice({"selector", "again", {}}), Error);
+    EXPECT_THROW(other.addChoice({"mode", "unknown stage", {{"x", "no_such_stage"}}}), Error);
 }
 
 TEST(StageRegistry, RejectsRepeatedAndEmptyNames) {
@@ -130,7 +144,7 @@ TEST(StageRegistry, RejectsRepeatedAndEmptyNames) {
     EXPECT_THROW(r.add<KeyframeStage>(), Error);
     StageInfo nameless;
     EXPECT_THROW(r.add(nameless), Error);
-    EXPECT_EQ(r.stages().size(), 5u);
+    EXPECT_EQ(r.stages().size(), 8u);
 }
 
 TEST(PipelineParams, TypedAccessCopiesAndDefaults) {
@@ -140,12 +154,12 @@ TEST(PipelineParams, TypedAccessCopiesAndDefaults) {
     EXPECT_EQ(cp.get<KeyframeStage>().window, KeyframeSelector::Params{}.window);  // defaults
     EXPECT_TRUE(p.entries().empty());  // reading does not create
     p.get<KeyframeStage>().window = 3;
-    p.get<DenoiseStage>().variant = DenoiseVariant::RangeAware;
+    p.get<DenoiseStage>().m_threshold = 4;
     ASSERT_EQ(p.entries().size(), 2u);
     PipelineParams copy = p;
     p.get<KeyframeStage>().window = 4;  // deep copy: the copy keeps its own value
     EXPECT_EQ(copy.get<KeyframeStage>().window, 3u);
-    EXPECT_EQ(copy.get<DenoiseStage>().variant, DenoiseVariant::RangeAware);
+    EXPECT_EQ(copy.get<DenoiseStage>().m_threshold, 4u);
     copy = p;
     EXPECT_EQ(copy.get<KeyframeStage>().window, 4u);
 }
@@ -166,16 +180,16 @@ TEST(ScanReport, OneStageReportPerStageWithTypedDiagnostics) {
     const ScanReport r = pipe.process(scan);
     ASSERT_EQ(r.stage_count, 3u);
     EXPECT_STREQ(r.stage_reports[0].name, "distance");
-    EXPECT_STREQ(r.stage_reports[1].name, "keyframe");
-    EXPECT_STREQ(r.stage_reports[2].name, "denoise");
+    EXPECT_STREQ(r.stage_reports[1].name, "view_keyframe");
+    EXPECT_STREQ(r.stage_reports[2].name, "evidence_denoise");
     const StageReport* d = r.stage("distance");
     ASSERT_NE(d, nullptr);
     ASSERT_NE(d->diagnostics<DistanceFilter::Result>(), nullptr);
     EXPECT_EQ(d->diagnostics<KeyframeDecision>(), nullptr);  // typed: another type is absent
     EXPECT_EQ(d->points_removed, 2u);
     EXPECT_FALSE(d->noise);
-    EXPECT_TRUE(r.stage("denoise")->noise);
-    EXPECT_EQ(r.stage("denoise")->points_removed, r.find<Denoiser::Result>()->points_removed);
+    EXPECT_TRUE(r.stage("evidence_denoise")->noise);
+    EXPECT_EQ(r.stage("evidence_denoise")->points_removed, r.find<DenoiseResult>()->points_removed);
     std::size_t removed = 0;
     double us = 0.0;
     for (const auto& s : r) {
@@ -186,7 +200,7 @@ TEST(ScanReport, OneStageReportPerStageWithTypedDiagnostics) {
     }
     EXPECT_EQ(removed, r.points_in - r.points_out);
     EXPECT_LE(us, r.microseconds);
-    EXPECT_EQ(r.noiseRemoved(), r.find<Denoiser::Result>()->points_removed);
+    EXPECT_EQ(r.noiseRemoved(), r.find<DenoiseResult>()->points_removed);
     EXPECT_EQ(r.stage("motion"), nullptr);
 }
 
@@ -198,10 +212,10 @@ TEST(ScanReport, TheDroppingStageIsMarkedAndLaterStagesAreAbsent) {
     const ScanReport r = pipe.process(b);
     ASSERT_FALSE(r.keep);
     ASSERT_EQ(r.stage_count, 2u);
-    EXPECT_TRUE(r.stage("keyframe")->dropped);
-    EXPECT_EQ(r.stage("denoise"), nullptr);
-    EXPECT_EQ(r.find<Denoiser::Result>(), nullptr);
-    EXPECT_EQ(r.findOrDefault<Denoiser::Result>().points_removed, 0u);
+    EXPECT_TRUE(r.stage("view_keyframe")->dropped);
+    EXPECT_EQ(r.stage("evidence_denoise"), nullptr);
+    EXPECT_EQ(r.find<DenoiseResult>(), nullptr);
+    EXPECT_EQ(r.findOrDefault<DenoiseResult>().points_removed, 0u);
     const ScanReport copy = r;  // a plain value: diagnostics are copied, not referenced
     Scan c = noisyWall();
     pipe.reset();

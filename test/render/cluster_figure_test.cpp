@@ -7,8 +7,8 @@
 #include <string>
 #include <utility>
 
-#include "kfd/algorithms/denoiser.h"
 #include "kfd/render/cluster_figure.h"
+#include "kfd/stages/core_stages.h"
 #include "test_scans.h"
 
 namespace {
@@ -46,6 +46,14 @@ std::size_t beamAt(const kfd::Scan& s, double angle) {
     return best;
 }
 
+// The clusters kfd's default denoising stage (evidence_denoise) finds in `scan` (denoised).
+kfd::Clusters denoised(kfd::Scan& scan) {
+    kfd::EvidenceDenoiseStage stage;
+    kfd::StageReport report;
+    stage.process(scan, report, kfd::ScanReport{});
+    return *stage.clusters();
+}
+
 }  // namespace
 
 TEST(ClusterFigure, ClusterPointsHaveTheirColourPlusXIsRightAndPlusYIsUp) {
@@ -59,17 +67,16 @@ TEST(ClusterFigure, ClusterPointsHaveTheirColourPlusXIsRightAndPlusYIsUp) {
         GTEST_SKIP() << "no off-screen OpenGL here: " << e.what();
     }
     const kfd::Scan s = wallAhead();
-    kfd::Denoiser den;  // reference variant: the wall is one cluster
-    kfd::Scan work = s;
-    den.filter(work);
-    const auto img = fig->render(s, den.clusters());
+    kfd::Scan work = s;  // kfd's default denoiser: the wall is one cluster
+    const kfd::Clusters clusters = denoised(work);
+    const auto img = fig->render(s, clusters);
     ASSERT_EQ(img.getWidth(), 400u);
     ASSERT_EQ(img.getHeight(), 400u);
 
     // A wall point on the +y side: (2, 2 tan 0.5) = (2, 1.09) m.
     const std::size_t i = beamAt(s, 0.5);
     ASSERT_TRUE(s.valid[i]);
-    const auto label = den.clusters().label[i];
+    const auto label = clusters.label[i];
     ASSERT_GE(label, 0);
     const double x = s.range[i] * std::cos(s.geometry.angle(i));
     const double y = s.range[i] * std::sin(s.geometry.angle(i));
@@ -107,11 +114,10 @@ TEST(ClusterFigure, NoisePointsAreRed) {
     const std::size_t lone = beamAt(s, -1.2);  // an isolated return far from the wall
     s.range[lone] = 1.5f;
     s.valid[lone] = 1;
-    kfd::Denoiser den;
     kfd::Scan work = s;
-    den.filter(work);
+    const kfd::Clusters clusters = denoised(work);
     ASSERT_FALSE(work.valid[lone]);  // removed as noise
-    const auto img = fig->render(s, den.clusters());
+    const auto img = fig->render(s, clusters);
     const auto [px, py] = fig->pixelOf(1.5 * std::cos(s.geometry.angle(lone)),
                                        1.5 * std::sin(s.geometry.angle(lone)));
     EXPECT_GT(py, 150);  // -y below the centre

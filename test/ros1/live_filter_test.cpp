@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "kfd/mrpt/config.h"
+#include "kfd/stages/core_stages.h"
 #include "ros1/laser_scans.h"
 
 namespace {
@@ -193,7 +194,7 @@ namespace {
 // takeReady() marked, in order, before the call's own publish.
 LiveFilter::Params nextScan() {
     LiveFilter::Params p = defaults();
-    p.pipeline.get<kfd::DenoiseStage>().evidence.next_scan = true;
+    p.pipeline.get<kfd::EvidenceDenoiseStage>().next_scan = true;
     return p;
 }
 

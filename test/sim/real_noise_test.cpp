@@ -13,6 +13,7 @@
 #include "kfd/mrpt/config.h"
 #include "kfd/sim/denoise_quality.h"
 #include "kfd/sim/noisy_log.h"
+#include "kfd/stages/core_stages.h"
 #include "test_files.h"
 #include "test_scans.h"
 
@@ -249,7 +250,7 @@ TEST(NoisyLog, WithNextScanTheSameScansAreScoredOnceFinished) {
     kfd::Pipeline::Params off =
         kfd::loadConfigFile(std::string(KFD_SOURCE_DIR) + "/share/kfd/default.ini");
     kfd::Pipeline::Params on = off;
-    on.get<kfd::DenoiseStage>().evidence.next_scan = true;
+    on.get<kfd::EvidenceDenoiseStage>().next_scan = true;
     const auto a = kfd::evaluateDenoising(o.output, s.labels, on);
     const auto b = kfd::evaluateDenoising(o.output, s.labels, off);
     EXPECT_EQ(a.scans, 600u);

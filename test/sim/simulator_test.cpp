@@ -12,6 +12,7 @@
 #include "kfd/io/rawlog_source.h"
 #include "kfd/sim/denoise_quality.h"
 #include "kfd/sim/simulator.h"
+#include "kfd/stages/core_stages.h"
 #include "test_files.h"
 
 namespace fs = std::filesystem;
@@ -153,9 +154,8 @@ TEST(DenoiseQuality, RangeAwareFindsMoreNoiseThanTheReferenceOnLabelledScans) {
     const auto s = kfd::Simulator().run(o);
     kfd::Pipeline::Params p;
     p.stages = {"distance", "denoise"};
-    p.get<kfd::DenoiseStage>().variant = kfd::DenoiseVariant::Reference;
     const auto ref = kfd::evaluateDenoising(s.rawlog, s.labels, p);
-    p.get<kfd::DenoiseStage>().variant = kfd::DenoiseVariant::RangeAware;
+    p.stages = {"distance", "range_aware_denoise"};
     const auto ra = kfd::evaluateDenoising(s.rawlog, s.labels, p);
     EXPECT_EQ(ref.scans, s.scans);
     EXPECT_EQ(ref.noise, s.noise_isolated + s.noise_clustered + s.noise_edge);

@@ -22,13 +22,13 @@
 #include "kfd/os/cancel.h"
 #include "kfd/os/output_paths.h"
 
-#include "kfd/algorithms/denoiser.h"
 #include "kfd/algorithms/scan_rate.h"
 #include "kfd/io/carmen_writer.h"
 #include "kfd/io/gz_output.h"
 #include "kfd/io/open_source.h"
 #include "kfd/io/scan_csv.h"
-#include "kfd/stages/denoise_stage.h"
+#include "kfd/stages/denoise_result.h"
+#include "kfd/stages/evidence_denoise_stage.h"
 
 namespace kfd {
 namespace {
@@ -109,23 +109,17 @@ class Run {
     void noteSensor(const CObservation2DRangeScan& scan, const StreamResult& r);
     void noteNoise(const StreamResult& r);
     void write(const mrpt::serialization::CSerializable& obj);
-    // One scan of latency (next_scan): output waits while the door holds a kept scan.
-    // Runs fn now, or queues it behind the held scan(s) (fn then owns what it writes).
+    // Output in input order, through the door (which runs fn at once unless it holds a scan
+    // for its next: fn then owns what it writes).
     template <class Fn>
     void emit(Fn&& fn) {
-        if (held_scans_ == 0)
-            fn();
-        else
-            deferred_.emplace_back(std::forward<Fn>(fn));
+        filter_.then(std::forward<Fn>(fn));
     }
     template <class Ptr>
     void writeShared(const Ptr& obj) {
         emit([this, obj] { write(*obj); });
     }
-    // The door's finished scans: their stats rows filled in; the queue runs once none is held.
-    void collectFinished();
-    void runDeferred();
-    void flushPendingAction(bool frame_kept);
+    void flushUnpairedAction(bool frame_kept);
     void reportProgress(std::uint64_t bytes_read);
 
     const RawlogFilterOptions& opts_;
@@ -138,21 +132,14 @@ class Run {
     std::optional<BagWriter> bag_;           // a bag output (instead of gz_)
     std::optional<CarmenWriter> carmen_;     // a CARMEN output (instead of gz_)
     std::optional<Pose2D> carmen_odometry_;  // the odometry of the last line written
-    std::vector<CObservation2DRangeScan::Ptr> carmen_pending_;  // kept before any odometry
-    static constexpr std::size_t kCarmenMaxPending = 1000;
-    std::shared_ptr<CActionCollection> pending_;  // action waiting for its sensory frame
-    CPose2D carry_;                               // odometry of dropped frames, not yet written
+    std::vector<CObservation2DRangeScan::Ptr> carmen_unposed_;  // kept before any odometry
+    static constexpr std::size_t kCarmenMaxUnposed = 1000;
+    std::shared_ptr<CActionCollection> unpaired_action_;  // action waiting for its sensory frame
+    CPose2D carry_;  // odometry of dropped frames, not yet written
     bool have_carry_ = false;
     std::optional<Pose2D> odometry_;  // absolute odometry, for the motion guards
     bool saw_frames_ = false, saw_observations_ = false;
-    ScanRateMeter rate_;          // the first sensor's stamps (SensorSummary::rate_hz)
-    std::size_t held_scans_ = 0;  // kept scans the door holds (pending)
-    std::vector<std::function<void()>> deferred_;  // output waiting for them, in order
-    struct HeldRow {
-        CObservation2DRangeScan::Ptr scan;  // kept alive while the door holds it
-        std::shared_ptr<ScanRecord> row;    // its stats row, filled in once finished
-    };
-    std::map<const CObservation2DRangeScan*, HeldRow> held_rows_;
+    ScanRateMeter rate_;  // the first sensor's stamps (SensorSummary::rate_hz)
 };
 
 void Run::write(const mrpt::serialization::CSerializable& obj) {
@@ -178,15 +165,14 @@ void Run::noteSensor(const CObservation2DRangeScan& scan, const StreamResult& r)
     if (scan.sensorLabel != s.label) return;
     s.odometry = s.odometry || r.record.odometry.has_value();
     rate_.add(r.record.stamp);
-    noteNoise(r);
 }
 
 void Run::noteNoise(const StreamResult& r) {
     SensorSummary& s = sum_.sensor;
     if (r.keep && r.scan && r.scan->sensorLabel == s.label)
-        if (const auto* d = r.report.find<Denoiser::Result>())
+        if (const auto* d = r.report.find<DenoiseResult>())
             if (d->variant == DenoiseVariant::Evidence) {
-                const auto& ev = opts_.pipeline.get<DenoiseStage>().evidence;
+                const auto& ev = opts_.pipeline.get<EvidenceDenoiseStage>();
                 s.range_noise_m = d->sigma;
                 s.range_noise_measured_m = d->sigma_measured;
                 s.range_noise_floor_m = ev.min_sigma_m;
@@ -196,57 +182,29 @@ void Run::noteNoise(const StreamResult& r) {
 
 bool Run::handleScan(const CObservation2DRangeScan::Ptr& ptr) {
     CObservation2DRangeScan& scan = *ptr;
-    const StreamResult r = filter_.process(scan, odometry_);
-    collectFinished();  // the scans this one finished come first
-    if (r.skipped == ScanSkipReason::None) noteSensor(scan, r);
-    if (r.pending) {  // its row (and everything after it) once the door finishes it
-        ++held_scans_;
-        auto row = std::make_shared<ScanRecord>(r.record);
-        held_rows_[&scan] = HeldRow{ptr, row};
-        if (csv_.isOpen()) emit([this, row] { asRawlogError([&] { csv_.write(*row); }); });
-        return true;
-    }
-    if (csv_.isOpen()) {
-        if (held_scans_ == 0)
-            asRawlogError([&] { csv_.write(r.record); });
-        else
-            emit([this, row = r.record] { asRawlogError([&] { csv_.write(row); }); });
-    }
-    return r.keep;
-}
-
-void Run::collectFinished() {
-    StreamResult f;
-    while (filter_.takeFinished(f)) {
-        noteNoise(f);
-        const auto it = held_rows_.find(f.scan);
-        if (it == held_rows_.end()) continue;
-        *it->second.row = f.record;
-        held_rows_.erase(it);
-        --held_scans_;
-    }
-    if (held_scans_ > 0 || deferred_.empty()) return;
-    runDeferred();
-}
-
-void Run::runDeferred() {
-    auto queue = std::move(deferred_);
-    deferred_.clear();
-    for (auto& fn : queue) fn();
+    // Its row once finished (ptr keeps the scan alive while the door holds it).
+    return filter_
+        .process(scan, odometry_,
+                 [this, ptr](StreamResult& done) {
+                     if (done.skipped == ScanSkipReason::None) noteSensor(*ptr, done);
+                     noteNoise(done);
+                     if (csv_.isOpen()) asRawlogError([&] { csv_.write(done.record); });
+                 })
+        .keep;
 }
 
 void Run::handleActions(const std::shared_ptr<CActionCollection>& acts) {
     // Two actions in a row (no frame between): the first stands on its own.
-    if (pending_) flushPendingAction(true);
-    pending_ = acts;
+    if (unpaired_action_) flushUnpairedAction(true);
+    unpaired_action_ = acts;
 }
 
-// Writes the pending action (with any carried odometry composed in) or, when its frame was
+// Writes the unpaired action (with any carried odometry composed in) or, when its frame was
 // dropped, folds its motion into the carry for the next kept action.
-void Run::flushPendingAction(bool frame_kept) {
-    if (!pending_) return;
-    auto acts = pending_;
-    pending_.reset();
+void Run::flushUnpairedAction(bool frame_kept) {
+    if (!unpaired_action_) return;
+    auto acts = unpaired_action_;
+    unpaired_action_.reset();
     auto mv = acts->getBestMovementEstimation();
     if (!frame_kept) {
         if (mv) {
@@ -301,7 +259,7 @@ void Run::handleFrame(const std::shared_ptr<CSensoryFrame>& sf) {
         }
     }
     const bool frame_kept = !(scans > 0 && sf->size() == 0);
-    flushPendingAction(frame_kept);
+    flushUnpairedAction(frame_kept);
     if (frame_kept)
         writeShared(sf);
     else
@@ -401,11 +359,11 @@ void Run::handleEntry(const SourceEntry& e) {
             break;
         case SourceEntry::Kind::Observation:
             saw_observations_ = true;
-            flushPendingAction(true);
+            flushUnpairedAction(true);
             handleObservation(e);
             break;
         case SourceEntry::Kind::Other:
-            flushPendingAction(true);
+            flushUnpairedAction(true);
             writeShared(e.other);
             break;
         case SourceEntry::Kind::Native:  // another topic of a bag
@@ -445,9 +403,9 @@ void Run::handleObservation(const SourceEntry& e) {
 void Run::handleCarmenEntry(const SourceEntry& e) {
     std::optional<Pose2D> odo = e.odometry;
     if (odo && !finitePose(odo->x, odo->y, odo->phi)) odo.reset();
-    if (odo && !carmen_pending_.empty()) {
-        for (const auto& scan : carmen_pending_) writeCarmenScan(scan, *odo);
-        carmen_pending_.clear();
+    if (odo && !carmen_unposed_.empty()) {
+        for (const auto& scan : carmen_unposed_) writeCarmenScan(scan, *odo);
+        carmen_unposed_.clear();
     }
     auto scanOrOdometry = [&](const mrpt::obs::CObservation::Ptr& obs) {
         if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(obs)) {
@@ -458,15 +416,15 @@ void Run::handleCarmenEntry(const SourceEntry& e) {
             if (odo || carmen_odometry_) {
                 writeCarmenScan(scan, odo ? *odo : *carmen_odometry_);
             } else {
-                if (carmen_pending_.size() == kCarmenMaxPending)
+                if (carmen_unposed_.size() == kCarmenMaxUnposed)
                     throw RawlogError(
                         "a CARMEN output needs the robot's odometry (a FLASER line holds it): "
                         "the first " +
-                            std::to_string(kCarmenMaxPending) + " kept scans of " + opts_.input +
+                            std::to_string(kCarmenMaxUnposed) + " kept scans of " + opts_.input +
                             " have none (a laser-only log): write a .rawlog" +
                             (sum_.input_format == LogFormat::Bag ? " or a .bag" : ""),
                         opts_.output);
-                carmen_pending_.push_back(scan);
+                carmen_unposed_.push_back(scan);
             }
             return true;
         }
@@ -508,17 +466,13 @@ void Run::writeCarmenOdometry(const Pose2D& odo, double stamp, bool always) {
 }
 
 void Run::finish() {
-    filter_.finish();  // the last kept scan, when held for its next: finished without it
-    collectFinished();
-    held_scans_ = 0;  // nothing is held any more: whatever waits goes out
-    held_rows_.clear();
-    runDeferred();
-    if (!carmen_pending_.empty())
+    filter_.finish();  // the last kept scan, when held for its next, and what waits after it
+    if (!carmen_unposed_.empty())
         throw RawlogError("a CARMEN output needs the robot's odometry (a FLASER line holds it): " +
                               opts_.input + " has none (a laser-only log): write a .rawlog" +
                               (sum_.input_format == LogFormat::Bag ? " or a .bag" : ""),
                           opts_.output);
-    flushPendingAction(true);
+    flushUnpairedAction(true);
     if (have_carry_) {  // the last frames were dropped: keep their motion as a final action
         CActionCollection acts;
         CActionRobotMovement2D m;

@@ -4,6 +4,7 @@
 #include <mrpt/containers/yaml.h>
 #include <mrpt/system/string_utils.h>
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -20,22 +21,44 @@ namespace {
 
 using mrpt::system::trim;
 
-const StageKey* findKey(const StageRegistry& registry, const std::string& name,
-                        const StageInfo** stage) {
+// Every stage of `registry` that declares key `name` (a flat key sets it in each: e.g.
+// m_threshold in denoise and range_aware_denoise, the guards in both keyframe stages).
+std::vector<std::pair<const StageInfo*, const StageKey*>> findKey(const StageRegistry& registry,
+                                                                  const std::string& name) {
+    std::vector<std::pair<const StageInfo*, const StageKey*>> found;
     for (const auto& s : registry.stages())
         for (const auto& k : s.keys)
-            if (k.name == name) {
-                *stage = &s;
-                return &k;
-            }
-    return nullptr;
+            if (k.name == name) found.emplace_back(&s, &k);
+    return found;
+}
+
+// Each key name once, in registration order: "pipeline", the choice keys, then every stage's.
+std::vector<std::string> keyNames(const StageRegistry& registry) {
+    std::vector<std::string> names{"pipeline"};
+    for (const auto& c : registry.choices()) names.push_back(c.key);
+    for (const auto& st : registry.stages())
+        for (const auto& k : st.keys)
+            if (std::find(names.begin(), names.end(), k.name) == names.end())
+                names.push_back(k.name);
+    return names;
 }
 
 std::string knownKeyList(const StageRegistry& registry) {
-    std::string s = "pipeline";  // configKeys()'s order, without its values
-    for (const auto& st : registry.stages())
-        for (const auto& k : st.keys) s += ", " + k.name;
+    std::string s;  // configKeys()'s order, without its values
+    for (const auto& n : keyNames(registry)) s += (s.empty() ? "" : ", ") + n;
     return s;
+}
+
+// A choice key: the listed stage of its role replaced by the chosen one.
+void applyChoice(Pipeline::Params& p, const StageChoice& c, const std::string& value) {
+    const StageChoice::Option* chosen = c.find(value);
+    if (!chosen)
+        throw ConfigError(c.key, "unknown " + c.key + " '" + value + "' (" + c.values() + ")");
+    for (auto& st : p.stages)
+        if (c.ofStage(st)) st = chosen->stage;
+    for (std::size_t i = 0; i < p.stages.size(); ++i)  // listed twice now: keep the first
+        for (std::size_t j = i + 1; j < p.stages.size(); ++j)
+            if (p.stages[j] == p.stages[i]) p.stages.erase(p.stages.begin() + j--);
 }
 
 std::vector<std::string> parseStageList(const std::string& text, const StageRegistry& registry) {
@@ -156,24 +179,58 @@ std::string scalarText(const mrpt::containers::yaml& node, const std::string& ke
 
 }  // namespace
 
+namespace {
+
+std::string stageList(const Pipeline::Params& p, const char* sep) {
+    std::string s;
+    for (const auto& st : p.stages) s += (s.empty() ? "" : sep) + st;
+    return s;
+}
+
+// The value of choice `c` in `p`: the option of the stage of its role that `p` lists ("" when
+// none is listed).
+std::string choiceValue(const Pipeline::Params& p, const StageChoice& c) {
+    for (const auto& st : p.stages)
+        if (const auto* o = c.ofStage(st)) return o->value;
+    return "";
+}
+
+// The value of key `name` in `p`: from the first stage declaring it that `p` lists, else the
+// first declaring it; the stage's parameters set in `p`, else its defaults.
+std::string keyValue(const Pipeline::Params& p, const StageRegistry& registry,
+                     const std::string& name) {
+    const auto found = findKey(registry, name);
+    auto from = found.front();
+    for (const auto& f : found)
+        if (std::find(p.stages.begin(), p.stages.end(), f.first->name) != p.stages.end()) {
+            from = f;
+            break;
+        }
+    if (const StageParams* set = p.find(from.first->name)) return from.second->get(set->data());
+    return from.second->get(from.first->defaults()->data());
+}
+
+}  // namespace
+
 std::vector<ConfigKeyInfo> configKeys(const StageRegistry& registry) {
     const Pipeline::Params plain, kfd = kfdDefaults();
-    auto stageList = [](const Pipeline::Params& p) {
-        std::string s;
-        for (const auto& st : p.stages) s += (s.empty() ? "" : ",") + st;
-        return s;
-    };
-    // A key's value in `p`: the stage's parameters set there, else the stage's defaults.
-    auto value = [](const Pipeline::Params& p, const StageInfo& stage, const StageKey& k) {
-        if (const StageParams* set = p.find(stage.name)) return k.get(set->data());
-        return k.get(stage.defaults()->data());
-    };
     std::vector<ConfigKeyInfo> v;
-    v.push_back({"pipeline", "stages in order, comma separated", registry.names(), stageList(plain),
-                 stageList(kfd)});
-    for (const auto& s : registry.stages())
-        for (const auto& k : s.keys)
-            v.push_back({k.name, k.help, k.range, value(plain, s, k), value(kfd, s, k)});
+    v.push_back({"pipeline", "stages in order, comma separated", registry.names(),
+                 stageList(plain, ","), stageList(kfd, ",")});
+    for (const auto& c : registry.choices())
+        v.push_back({c.key, c.help, c.values(), choiceValue(plain, c), choiceValue(kfd, c)});
+    for (const auto& name : keyNames(registry)) {
+        const auto found = findKey(registry, name);
+        if (found.empty()) continue;  // pipeline and the choices, above
+        std::string help = found.front().second->help;
+        if (found.size() > 1) {
+            help += " (stages:";
+            for (const auto& f : found) help += " " + f.first->name;
+            help += ")";
+        }
+        v.push_back({name, help, found.front().second->range, keyValue(plain, registry, name),
+                     keyValue(kfd, registry, name)});
+    }
     return v;
 }
 
@@ -188,14 +245,31 @@ void applyConfigKey(Pipeline::Params& p, const std::string& key, const std::stri
         p.stages = parseStageList(value, registry);
         return;
     }
-    const StageInfo* stage = nullptr;
-    const StageKey* k = findKey(registry, key, &stage);
-    if (!k) throw ConfigError(key, "unknown key (known keys: " + knownKeyList(registry) + ")");
+    if (const StageChoice* c = registry.choice(key)) {
+        applyChoice(p, *c, trim(value));
+        return;
+    }
+    const auto found = findKey(registry, key);
+    if (found.empty())
+        throw ConfigError(key, "unknown key (known keys: " + knownKeyList(registry) + ")");
     try {
-        k->set(p.at(*stage).data(), trim(value));  // values reach the stages trimmed
+        for (const auto& [stage, k] : found)
+            k->set(p.at(*stage).data(), trim(value));  // values reach the stages trimmed
     } catch (const ParameterError& e) {
         throw ConfigError(key, e.detail());
     }
+}
+
+void applyConfigKeys(Pipeline::Params& p,
+                     const std::vector<std::pair<std::string, std::string>>& values,
+                     const StageRegistry& registry) {
+    // "pipeline" first, then the choice keys (which edit its list), then the stages' keys.
+    auto rank = [&registry](const std::string& key) {
+        return key == "pipeline" ? 0 : registry.choice(key) ? 1 : 2;
+    };
+    for (int r = 0; r < 3; ++r)
+        for (const auto& [key, value] : values)
+            if (rank(key) == r) applyConfigKey(p, key, value, registry);
 }
 
 void validateConfig(const Pipeline::Params& p, const StageRegistry& registry) {
@@ -227,7 +301,7 @@ Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg, const std::st
     }
     const StageRegistry& registry = defaultStageRegistry();
     Pipeline::Params p = base ? *base : kfdDefaults();
-    for (const auto& [name, value] : values) applyConfigKey(p, name, value, registry);
+    applyConfigKeys(p, values, registry);
     validateConfig(p, registry);
     return p;
 }
@@ -238,10 +312,12 @@ Pipeline::Params loadYaml(const mrpt::containers::yaml& doc, const Pipeline::Par
     if (!root.isMap()) throw ConfigError("kfd", "must be a map of kfd keys");
     const StageRegistry& registry = defaultStageRegistry();
     Pipeline::Params p = base ? *base : kfdDefaults();
+    std::vector<std::pair<std::string, std::string>> values;
     for (const auto& kv : root.asMap()) {
         const std::string name = std::string(kv.first.internalAsStr());
-        applyConfigKey(p, name, scalarText(mrpt::containers::yaml(kv.second), name), registry);
+        values.emplace_back(name, scalarText(mrpt::containers::yaml(kv.second), name));
     }
+    applyConfigKeys(p, values, registry);
     validateConfig(p, registry);
     return p;
 }
@@ -282,16 +358,12 @@ Pipeline::Params loadConfigFile(const std::string& path, const std::string& sect
 }
 
 std::string toIni(const Pipeline::Params& p, const std::string& section) {
+    const StageRegistry& registry = defaultStageRegistry();
     std::string s = "[" + section + "]\n";
-    std::string stages;
-    for (const auto& st : p.stages) stages += (stages.empty() ? "" : ", ") + st;
-    s += "pipeline = " + stages + "\n";
-    for (const auto& stage : defaultStageRegistry().stages()) {
-        const StageParams* set = p.find(stage.name);
-        const auto defaults = set ? nullptr : stage.defaults();
-        const void* params = set ? set->data() : defaults->data();
-        for (const auto& k : stage.keys) s += k.name + " = " + k.get(params) + "\n";
-    }
+    s += "pipeline = " + stageList(p, ", ") + "\n";
+    for (const auto& name : keyNames(registry))
+        if (!findKey(registry, name).empty())
+            s += name + " = " + keyValue(p, registry, name) + "\n";
     return s;
 }
 

@@ -6,13 +6,13 @@
 #include <cstring>
 #include <utility>
 
-#include "kfd/algorithms/denoiser.h"
 #include "kfd/algorithms/keyframe_selector.h"
 #include "kfd/io/source.h"
 #include "kfd/mrpt/default_stages.h"
 #include "kfd/mrpt/scan_check.h"
 #include "kfd/paper/distance_filter.h"
 #include "kfd/pipeline/format.h"
+#include "kfd/stages/denoise_result.h"
 
 namespace kfd {
 namespace {
@@ -141,7 +141,43 @@ void StreamFilter::collectFinished(Sensor& s) {
     mrpt::obs::CObservation2DRangeScan& obs = *res.scan;
     writeBack(done->valid.data(), std::min(done->size(), obs.getScanSize()), obs);
     record(res);
+    for (InOrder& w : in_order_)  // a process(.., done) call waits for it
+        if (w.held && w.scan == res.scan) {
+            w.result = std::move(res);
+            w.held = false;
+            return;
+        }
     finished_.push_back(std::move(res));
+}
+
+StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& scan,
+                                   const std::optional<Pose2D>& odometry, OnFinished done) {
+    StreamResult r = process(scan, odometry);
+    drain();  // what this scan finished
+    InOrder w;
+    w.scan = &scan;
+    w.held = r.pending;
+    w.result = r;
+    w.done = std::move(done);
+    in_order_.push_back(std::move(w));
+    drain();
+    return r;
+}
+
+void StreamFilter::then(std::function<void()> fn) {
+    InOrder w;
+    w.fn = std::move(fn);
+    in_order_.push_back(std::move(w));
+    drain();
+}
+
+void StreamFilter::drain() {
+    while (!in_order_.empty() && !in_order_.front().held) {
+        InOrder w = std::move(in_order_.front());
+        in_order_.pop_front();
+        if (w.fn) w.fn();
+        if (w.done) w.done(w.result);
+    }
 }
 
 bool StreamFilter::takeFinished(StreamResult& out) {
@@ -160,6 +196,7 @@ void StreamFilter::finish() {
               [](const StreamResult& a, const StreamResult& b) {
                   return a.record.index < b.record.index;
               });
+    drain();
 }
 
 std::size_t StreamFilter::pendingCount() const {
@@ -174,7 +211,7 @@ void StreamFilter::record(StreamResult& res) {
     ScanRecord& rec = res.record;
     const auto* kf = rep.find<KeyframeDecision>();
     const auto d = rep.findOrDefault<DistanceFilter::Result>();
-    const auto n = rep.findOrDefault<Denoiser::Result>();
+    const auto n = rep.findOrDefault<DenoiseResult>();
     if (kf) {
         rec.reason = toString(kf->reason);
         rec.p_common = kf->p_common;

@@ -3,8 +3,6 @@
 #include <chrono>
 #include <string>
 
-#include "kfd/stages/denoise_stage.h"
-
 namespace kfd {
 
 PipelineParams::PipelineParams(const PipelineParams& o) : stages(o.stages) {
@@ -200,8 +198,9 @@ void Pipeline::reset() {
 }
 
 const Clusters* Pipeline::lastClusters() const {
-    const auto* d = find<DenoiseStage>();
-    return d ? &d->algorithm().clusters() : nullptr;
+    for (const auto& s : stages_)
+        if (const Clusters* c = s->clusters()) return c;
+    return nullptr;
 }
 
 }  // namespace kfd

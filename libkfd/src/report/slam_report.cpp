@@ -341,7 +341,9 @@ namespace {
 // stage): configured -> used. Empty when none was lowered.
 std::string gateText(const IcpSlamSummary& s) {
     const auto& stages = s.pipeline.stages;
-    if (std::find(stages.begin(), stages.end(), "keyframe") == stages.end()) return {};
+    if (std::find(stages.begin(), stages.end(), "keyframe") == stages.end() &&
+        std::find(stages.begin(), stages.end(), "view_keyframe") == stages.end())
+        return {};
     std::string lowered;
     if (s.guard_translation_m != s.guard_translation_m_configured)
         lowered += format("%g -> %g m", s.guard_translation_m_configured, s.guard_translation_m);

@@ -4,6 +4,7 @@
 
 #include <fstream>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -72,19 +73,16 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
                                  const Pipeline::Params& pipeline, bool laser_only) {
     const auto labels = readLabels(labels_csv);
     const auto source = openSource(rawlog);
-    StreamFilter filter(pipeline, {}, true);  // handles held scans (next_scan)
+    StreamFilter filter(pipeline, {}, true);  // the door holds a scan for its next (next_scan)
     filter.setLaserOnly(laser_only);
     DenoiseQuality q;
-    // A scan's flags before the door and its labels, until it is scored (after the door, or
-    // once the door finishes a scan it held for its next: the denoise key next_scan).
+    // A scan's flags before the door and its labels, scored once the door finished it.
     struct Scored {
         mrpt::obs::CObservation2DRangeScan::Ptr scan;
         std::vector<std::uint8_t> before;
         std::vector<NoiseKind> kind;
         std::vector<NoiseModel> model;
     };
-    Scored now;
-    std::map<const mrpt::obs::CObservation2DRangeScan*, Scored> held;
     auto tally = [&](const Scored& s) {
         const auto& scan = s.scan;
         ++q.scored;
@@ -112,45 +110,29 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
             }
         }
     };
-    auto collect = [&] {
-        StreamResult f;
-        while (filter.takeFinished(f)) {
-            q.microseconds += f.report.microseconds;  // its whole time, held part included
-            const auto it = held.find(f.scan);
-            if (it == held.end()) continue;
-            if (f.keep) tally(it->second);
-            held.erase(it);
-        }
-    };
     SourceEntry e;
     auto score = [&](const mrpt::obs::CObservation2DRangeScan::Ptr& scan) {
         const std::size_t n = scan->getScanSize();
-        now.scan = scan;
-        now.before.resize(n);
-        now.kind.assign(n, NoiseKind::Clean);
-        now.model.assign(n, NoiseModel::None);
-        for (std::size_t i = 0; i < n; ++i) now.before[i] = scan->getScanRangeValidity(i);
+        auto now = std::make_shared<Scored>();
+        now->scan = scan;
+        now->before.resize(n);
+        now->kind.assign(n, NoiseKind::Clean);
+        now->model.assign(n, NoiseModel::None);
+        for (std::size_t i = 0; i < n; ++i) now->before[i] = scan->getScanRangeValidity(i);
         if (const auto it = labels.find(q.scans); it != labels.end())
             for (const auto& l : it->second) {
                 if (l.beam >= n) throw SimulationError("labels do not fit the rawlog");
-                now.kind[l.beam] = l.kind;
-                now.model[l.beam] = l.model;
+                now->kind[l.beam] = l.kind;
+                now->model[l.beam] = l.model;
             }
-        const auto r = filter.process(*scan, e.odometry);
         ++q.scans;
-        collect();
-        if (r.pending) {  // scored once finished
-            held[scan.get()] = std::move(now);
-            now = Scored{};
-            return;
-        }
-        q.microseconds += r.report.microseconds;
-        if (!r.keep) return;  // dropped: the SLAM never sees it, nothing to score
-        tally(now);
+        filter.process(*scan, e.odometry, [&, now](StreamResult& f) {
+            q.microseconds += f.report.microseconds;  // its whole time, held part included
+            if (f.keep) tally(*now);  // dropped: the SLAM never sees it, nothing to score
+        });
     };
     while (source->next(e)) e.forEachScan(score);
     filter.finish();  // the last keyframe, when held for its next scan
-    collect();
     if (q.scans == 0) throw SimulationError("no scans in " + rawlog);
     if (!labels.empty() && labels.rbegin()->first >= q.scans)
         throw SimulationError("labels refer to more scans than the rawlog holds");

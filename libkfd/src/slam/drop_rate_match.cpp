@@ -40,28 +40,18 @@ std::vector<ScanStamp> scanOdometry(const std::string& rawlog, const SourceOptio
 }
 
 // The drop rate (%) of a pre-filter over the log, as the real run would see it (the same
-// skipped start, the same door, odometry or none): the pre-filter alone, no ICP. With the
-// denoise key next_scan a kept scan may come back pending (its keep decision is final): it is
-// kept alive until the door finishes it, and the counters are complete after finish().
+// skipped start, the same door, odometry or none): the pre-filter alone, no ICP. The door keeps
+// each scan alive until it is finished (the callback holds it); the counters are complete
+// after finish().
 double pipelineDropPct(const std::string& rawlog, const SourceOptions& options,
                        const Pipeline::Params& pipeline, std::size_t skip_scans, bool laser_only) {
     StreamFilter filter(pipeline, {}, /*one_scan_latency=*/true);
     filter.setLaserOnly(laser_only);
-    std::vector<CObservation2DRangeScan::Ptr> held;  // pending in the door (one per sensor)
-    const auto release = [&] {
-        StreamResult done;
-        while (filter.takeFinished(done))
-            held.erase(std::remove_if(held.begin(), held.end(),
-                                      [&](const auto& p) { return p.get() == done.scan; }),
-                       held.end());
-    };
     forEachRunScan(rawlog, options, skip_scans,
                    [&](const CObservation2DRangeScan::Ptr& scan, std::optional<Pose2D> odo) {
-                       if (filter.process(*scan, odo).pending) held.push_back(scan);
-                       release();
+                       filter.process(*scan, odo, [scan](StreamResult&) {});
                    });
     filter.finish();
-    release();
     return filter.counters().notKeptPercent();
 }
 

@@ -53,7 +53,7 @@ namespace fs = std::filesystem;
 using mrpt::obs::CObservation2DRangeScan;
 
 // At most this many dropped scans wait for a re-match (since ICP's last accepted correction).
-constexpr std::size_t kMaxHeld = 64;
+constexpr std::size_t kMaxRematch = 64;
 
 // Runs fn, a call into MRPT; what MRPT throws becomes a SlamError that says what kfd was doing
 // (doing(), called only then), then MRPT's message (kfd::plainMessage: no banner, no stack).
@@ -103,30 +103,24 @@ class Run {
     void initBuilder();
     void openOutputs();
     void loop();
-    // A step in two phases. The pre-filter phase (prefilterStep: the door for its scans) may
-    // leave a kept scan pending (the denoise key next_scan); the step then waits in waiting_,
-    // and the steps after it behind it, until the door finishes that scan (the sensor's next
-    // scan, or finish() at the end of the log). The builder phase (runStep: the map builder,
-    // its verdict, the re-match, the step's outputs) runs for the waiting steps in input order
-    // once nothing before them is pending. Without next_scan nothing is pending: every step
-    // runs its builder phase right after its pre-filter phase, as before.
+    // A step in two phases. The pre-filter phase (prefilterStep: the door for its scans)
+    // hands the builder phase (runStep: the map builder, its verdict, the re-match, the step's
+    // outputs) to the door, which runs it once the step's scans are finished: at once, or,
+    // with next_scan, when the sensor's next scan finishes a kept one (the steps after it wait
+    // behind it, in input order).
     struct DoorScan {
-        CObservation2DRangeScan::Ptr scan;  // kept alive (and unchanged) while pending
-        bool keep = false, pending = false;
+        CObservation2DRangeScan::Ptr scan;  // kept alive (and unchanged) until finished
+        bool keep = false;
         ScanSkipReason skipped = ScanSkipReason::None;
-        ScanRecord record;  // final once the door finished it
+        ScanRecord record;  // the door's finished record
     };
-    struct WaitingStep {
+    struct DoorStep {
         IcpSlamStep step;
         std::vector<DoorScan> scans;  // the step's 2D scans, in the step's order
-        std::size_t pending = 0;      // of them, still pending in the door
     };
-    std::deque<WaitingStep> waiting_;  // oldest first
     void prefilterStep(const IcpSlamStep& step, const SourceEntry& e);
-    void collectFinished();
-    void runReadySteps();
-    void runStep(WaitingStep& w);
-    void step(WaitingStep& w);
+    void runStep(DoorStep& w);
+    void step(DoorStep& w);
     template <class Process>
     void timed(Process&& process);
     template <class Process>
@@ -173,22 +167,22 @@ class Run {
     // Re-matching (rematch()): the scans the pre-filter dropped since ICP last accepted a
     // correction, each with the odometry the map builder had then; after a rejected correction
     // they go through ICP in order, then the rejected scan again. Their scans.csv rows wait in
-    // pending_ (from the first held scan on) until ICP accepts a correction or they are
-    // replayed.
-    struct Held {
+    // unwritten_ (from the first scan kept for a re-match on) until ICP accepts a correction or
+    // they are replayed.
+    struct RematchScan {
         CObservation2DRangeScan::Ptr scan;
         std::optional<mrpt::poses::CPose2D> odometry;  // the builder's, when it had one
-        std::size_t row;                               // its entry in pending_
+        std::size_t row;                               // its entry in unwritten_
     };
-    struct PendingRow {
+    struct UnwrittenRow {
         ScanRecord record;
         Pose2D pose;
         std::size_t trajectory_index;
     };
-    std::vector<Held> held_;
-    std::size_t held_this_step_ = 0;  // held_ entries added by the current step
-    std::vector<PendingRow> pending_;
-    void flushPending();
+    std::vector<RematchScan> rematch_;
+    std::size_t rematch_this_step_ = 0;  // rematch_ entries added by the current step
+    std::vector<UnwrittenRow> unwritten_;
+    void flushUnwritten();
     // The odometry the map builder last got (MRPT's CMetricMapBuilderICP accumulates the
     // actions' pose changes, or takes an odometry observation as it is), and its stamp.
     std::optional<mrpt::poses::CPose2D> builder_odometry_;
@@ -219,8 +213,9 @@ void Run::timed(Process&& process) {
     builder_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// A call into the map builder with the step's scans; after drops (scans held since ICP's last
-// accepted correction, from earlier steps) under the gap check's minimum for that one call.
+// A call into the map builder with the step's scans; after drops (scans kept for a re-match since
+// ICP's last accepted correction, from earlier steps) under the gap check's minimum for that one
+// call.
 template <class Process>
 void Run::match(bool after_drops, Process&& process) {
     if (after_drops) builder_.ICP_options.minICPgoodnessToAccept = icp_->gapMinimum();

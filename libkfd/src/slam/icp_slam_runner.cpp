@@ -79,19 +79,14 @@ void Run::loop() {
             continue;
         }
         if (skipper.skip(st)) continue;
-        prefilterStep(st, e);
         const std::size_t steps_before = step_no_;
-        runReadySteps();
+        prefilterStep(st, e);
         if (opts_.on_progress && step_no_ / 500 != steps_before / 500)
             progress(static_cast<double>(source_->bytesRead()) / total_bytes);
     }
     // The end of the log: the door finishes the scans it holds (next_scan), and the steps
-    // waiting for them run; the door's counters are then complete.
+    // behind them run; the door's counters are then complete.
     prefilter_->finish();
-    collectFinished();
-    runReadySteps();
-    if (!waiting_.empty())  // the door finished every scan it held: a broken invariant
-        throw std::logic_error("kfd-icp-slam: a step still waits for the pre-filter at the end");
     if (sum_.entries == 0 && skipper.skipped() == 0)
         throw SlamError("no entries in " + sum_.rawlog + ": not a rawlog?", sum_.rawlog);
     sum_.scans_skipped_start = skipper.skipped();
@@ -106,52 +101,31 @@ void Run::loop() {
 }
 
 // A step's pre-filter phase: its scans through the door (every mode, `none` included), in
-// order; the step waits in waiting_ for its builder phase. The scans the door finishes now
-// (held before, next_scan) go to their waiting steps.
+// order; its builder phase runs when the door has finished them (at once without next_scan;
+// the door keeps the steps in input order).
 void Run::prefilterStep(const IcpSlamStep& st, const SourceEntry& e) {
-    waiting_.push_back(WaitingStep{st, {}, 0});
-    WaitingStep& w = waiting_.back();  // a deque: push_back keeps references
+    auto w = std::make_shared<DoorStep>(DoorStep{st, {}});
     const auto door = [&](const mrpt::obs::CObservation::Ptr& o) {
         auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(o);
         if (!scan) return;
-        StreamResult r = prefilter_->process(*scan, e.odometry);
-        w.scans.push_back({scan, r.keep, r.pending, r.skipped, std::move(r.record)});
-        w.pending += r.pending ? 1 : 0;
-        collectFinished();  // e.g. the sensor's scan before this one
+        const std::size_t k = w->scans.size();
+        w->scans.push_back(DoorScan{scan, false, ScanSkipReason::None, ScanRecord{}});
+        prefilter_->process(*scan, e.odometry, [w, k](StreamResult& r) {
+            DoorScan& d = w->scans[k];
+            d.keep = r.keep;
+            d.skipped = r.skipped;
+            d.record = std::move(r.record);
+        });
     };
     if (st.observation)
         door(st.observation);
     else
         for (const auto& o : *st.frame) door(o);
-}
-
-// The scans the door finished (pending before): their final decision and record, in their
-// waiting step.
-void Run::collectFinished() {
-    StreamResult done;
-    while (prefilter_->takeFinished(done)) {
-        for (WaitingStep& w : waiting_)
-            for (DoorScan& d : w.scans)
-                if (d.pending && d.scan.get() == done.scan) {
-                    d.pending = false;
-                    d.keep = done.keep;
-                    d.record = std::move(done.record);
-                    --w.pending;
-                }
-    }
-}
-
-// The builder phase of the waiting steps, in input order, up to the first one still pending.
-void Run::runReadySteps() {
-    while (!waiting_.empty() && waiting_.front().pending == 0) {
-        WaitingStep w = std::move(waiting_.front());
-        waiting_.pop_front();
-        runStep(w);
-    }
+    prefilter_->then([this, w] { runStep(*w); });
 }
 
 // A step's builder phase: the map builder, ICP's verdict, a re-match, the step's outputs.
-void Run::runStep(WaitingStep& w) {
+void Run::runStep(DoorStep& w) {
     const IcpSlamStep& st = w.step;
     const double builder_s0 = builder_s_;
     logs_->beginStep(st.observation, st.action.get(), st.frame.get());
@@ -165,9 +139,9 @@ void Run::runStep(WaitingStep& w) {
 
 // One step's scans as the door decided them (admitScan), the kept ones and the odometry to the
 // map builder.
-void Run::step(WaitingStep& w) {
+void Run::step(DoorStep& w) {
     step_scans_.clear();
-    held_this_step_ = 0;
+    rematch_this_step_ = 0;
     IcpSlamStep& st = w.step;
     auto next = w.scans.begin();  // the step's scans, in the order of the pre-filter phase
     if (st.observation) {
@@ -183,7 +157,7 @@ void Run::step(WaitingStep& w) {
             }
         }
         if (process)
-            match(!held_.empty() && !held_this_step_,
+            match(!rematch_.empty() && !rematch_this_step_,
                   [&] { builder_.processObservation(st.observation); });
         return;
     }
@@ -201,9 +175,9 @@ void Run::step(WaitingStep& w) {
             builder_odometry_.value_or(mrpt::poses::CPose2D()) + mv->poseChange->getMeanVal();
         builder_odometry_t_ = mv->timestamp;
     }
-    for (std::size_t k = held_.size() - held_this_step_; k < held_.size(); ++k)
-        held_[k].odometry = builder_odometry_;
-    match(held_.size() > held_this_step_ && scanCount(st),
+    for (std::size_t k = rematch_.size() - rematch_this_step_; k < rematch_.size(); ++k)
+        rematch_[k].odometry = builder_odometry_;
+    match(rematch_.size() > rematch_this_step_ && scanCount(st),
           [&] { builder_.processActionObservation(*action, *st.frame); });
 }
 

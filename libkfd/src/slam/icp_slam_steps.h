@@ -35,9 +35,9 @@ class IcpSlamSteps {
     bool feed(const SourceEntry& e, IcpSlamStep& step) {
         using Kind = SourceEntry::Kind;
         step = IcpSlamStep();
-        if (pending_) {  // an action waiting for its frame
+        if (waiting_action_) {  // an action waiting for its frame
             if (e.kind != Kind::Frame) return false;
-            step.action = std::move(pending_);
+            step.action = std::move(waiting_action_);
             step.frame = e.frame;
             return true;
         }
@@ -50,12 +50,12 @@ class IcpSlamSteps {
             step.frame = e.frame;
             return true;
         }
-        if (e.kind == Kind::Action) pending_ = e.action;
+        if (e.kind == Kind::Action) waiting_action_ = e.action;
         return false;
     }
 
   private:
-    mrpt::obs::CActionCollection::Ptr pending_;
+    mrpt::obs::CActionCollection::Ptr waiting_action_;
 };
 
 // The log's source; what cannot be opened or read is a SlamError naming the log.

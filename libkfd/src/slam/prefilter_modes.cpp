@@ -22,11 +22,14 @@ std::vector<PrefilterModeInfo> buildModes() {
     v.push_back(mode(PrefilterMode::None, "none", {}, "no pre-filter: plain ICP-SLAM"));
     v.push_back(mode(PrefilterMode::Odometry, "odometry", {"motion"},
                      defaultStageRegistry().find("motion")->help));
-    v.push_back(mode(PrefilterMode::Keyframe, "keyframe", {"distance", "keyframe"},
-                     "keyframe extraction only (distance + keyframe stages)"));
-    PrefilterModeInfo kfd = mode(PrefilterMode::Kfd, "kfd", {"distance", "keyframe", "denoise"},
-                                 "the full method: the [KFD] section's pipeline (default "
-                                 "distance, keyframe, denoise)");
+    v.push_back(mode(PrefilterMode::Keyframe, "keyframe", {"distance", "view_keyframe"},
+                     "keyframe extraction only (distance + the [KFD] pipeline's keyframe "
+                     "stage)"));
+    PrefilterModeInfo kfd =
+        mode(PrefilterMode::Kfd, "kfd",
+             {"odometry_check", "distance", "view_keyframe", "evidence_denoise"},
+             "the full method: the [KFD] section's pipeline (default "
+             "odometry_check, distance, view_keyframe, evidence_denoise)");
     kfd.uses_kfd_stages = true;
     v.push_back(kfd);
     v.push_back(mode(PrefilterMode::Dbscan, "dbscan", {"distance", "dbscan"}));
@@ -61,8 +64,16 @@ PrefilterMode parsePrefilterMode(const std::string& s) {
 
 Pipeline::Params pipelineForMode(PrefilterMode mode, const Pipeline::Params& kfd) {
     Pipeline::Params p = kfd;
-    for (const auto& info : prefilterModes())
-        if (info.mode == mode && !info.uses_kfd_stages) p.stages = info.stages;
+    const StageRegistry& reg = defaultStageRegistry();
+    for (const auto& info : prefilterModes()) {
+        if (info.mode != mode || info.uses_kfd_stages) continue;
+        p.stages = info.stages;
+        // A stage with a role (selector, variant): the one the [KFD] pipeline chose, if any.
+        for (auto& st : p.stages)
+            if (const StageChoice* c = reg.choiceOfStage(st))
+                for (const auto& listed : kfd.stages)
+                    if (c->ofStage(listed)) st = listed;
+    }
     return p;
 }
 

@@ -1,5 +1,6 @@
 #include "run_config.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -7,6 +8,7 @@
 
 #include "kfd/os/output_paths.h"
 #include "kfd/stages/keyframe_stage.h"
+#include "kfd/stages/view_keyframe_stage.h"
 
 namespace kfd::icp_slam {
 namespace {
@@ -79,13 +81,23 @@ void resolvePaths(const IcpSlamOptions& opts, const mrpt::config::CConfigFile& c
 
 void applySlamGate(const mrpt::config::CConfigFile& cfg, Pipeline::Params& kfd,
                    IcpSlamSummary& sum) {
-    auto& kf = kfd.get<KeyframeStage>();
+    // Both keyframe stages' guards are lowered; the summary reports the listed stage's
+    // (kfd's view_keyframe when the pipeline lists neither).
+    const bool paper =
+        std::find(kfd.stages.begin(), kfd.stages.end(), KeyframeStage::kName) != kfd.stages.end();
+    const KeyframeGuards::Params& kf =
+        paper ? static_cast<const KeyframeGuards::Params&>(kfd.get<KeyframeStage>())
+              : kfd.get<ViewKeyframeStage>();
     sum.guard_translation_m_configured = kf.max_translation_m;
     sum.guard_rotation_deg_configured = kf.max_rotation_deg;
     const double gate_m = cfg.read_double(kSect, "localizationLinDistance", 0.2);
     const double gate_deg = cfg.read_double(kSect, "localizationAngDistance", 5.0);
-    if (gate_m > 0.0 && kf.max_translation_m > gate_m) kf.max_translation_m = gate_m;
-    if (gate_deg > 0.0 && kf.max_rotation_deg > gate_deg) kf.max_rotation_deg = gate_deg;
+    for (KeyframeGuards::Params* g :
+         {static_cast<KeyframeGuards::Params*>(&kfd.get<KeyframeStage>()),
+          static_cast<KeyframeGuards::Params*>(&kfd.get<ViewKeyframeStage>())}) {
+        if (gate_m > 0.0 && g->max_translation_m > gate_m) g->max_translation_m = gate_m;
+        if (gate_deg > 0.0 && g->max_rotation_deg > gate_deg) g->max_rotation_deg = gate_deg;
+    }
     sum.guard_translation_m = kf.max_translation_m;
     sum.guard_rotation_deg = kf.max_rotation_deg;
 }

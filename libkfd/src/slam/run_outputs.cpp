@@ -31,20 +31,20 @@ void Run::writeStep(double builder_ms) {
         const double t = stampForOutput(s.stamp);
         if (s.odometry) res_.odometry.push_back(StampedPose{t, *s.odometry});
         traj.push_back(StampedPose{t, p});
-        pending_.push_back({s, p, traj.size() - 1});
+        unwritten_.push_back({s, p, traj.size() - 1});
     }
-    if (held_.empty()) flushPending();
+    if (rematch_.empty()) flushUnwritten();
 }
 
 // The rows waiting for a possible re-match, to scans.csv.
-void Run::flushPending() {
-    for (const PendingRow& row : pending_) csv_.write(row.record, row.pose);
-    pending_.clear();
+void Run::flushUnwritten() {
+    for (const UnwrittenRow& row : unwritten_) csv_.write(row.record, row.pose);
+    unwritten_.clear();
 }
 
 void Run::closeOutputs() {
-    held_.clear();
-    flushPending();
+    rematch_.clear();
+    flushUnwritten();
     std::sort(res_.keyframes.begin(), res_.keyframes.end());
     logs_->finish(builder_, res_.map_origin, opts_.write_map, sum_.notices);
     csv_.close();

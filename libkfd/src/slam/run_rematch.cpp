@@ -1,5 +1,5 @@
 // kfd-icp-slam's re-matching: ICP's verdict on a step, the scans dropped since its last accepted
-// correction held, and replayed through ICP after a rejection.
+// correction kept for a re-match, and replayed through ICP after a rejection.
 #include "icp_slam_run.h"
 
 namespace kfd::icp_slam {
@@ -12,7 +12,7 @@ void Run::noteIcp() {
     switch (icp_->count(sum_)) {
         case Verdict::Accepted:
             rejected_streak_ = 0;
-            held_.clear();  // nothing to re-match before an accepted correction
+            rematch_.clear();  // nothing to re-match before an accepted correction
             break;
         case Verdict::Rejected:
             if (rejected_streak_++ == 0) streak_start_ = stamp;
@@ -50,21 +50,21 @@ void Run::feedOdometry(const mrpt::poses::CPose2D& odometry) {
 // through ICP in their order, each from the odometry the builder had then, and the step's
 // kept scans again from their own, so that ICP bridges the odometry in the log's own steps
 // (MRPT's builder leaves its map and its last correction untouched by a rejection). Their
-// rows say "icp_rematch". No replay of a replay: held_ is emptied either way.
+// rows say "icp_rematch". No replay of a replay: rematch_ is emptied either way.
 void Run::rematch(const IcpSlamStep& st) {
-    if (!recovering_ || held_.empty()) return;
+    if (!recovering_ || rematch_.empty()) return;
     ++rematches_;
     const auto pose_now = [&] {
         const auto m = builder_.getCurrentPoseEstimation()->getMeanVal();
         return Pose2D{m.x() + res_.map_origin.x, m.y() + res_.map_origin.y, m.yaw()};
     };
     bool corrected = false;  // did a replayed scan move the pose?
-    for (const Held& h : held_) {
-        if (h.row >= pending_.size()) break;  // the step's own (a frame of several scans)
+    for (const RematchScan& h : rematch_) {
+        if (h.row >= unwritten_.size()) break;  // the step's own (a frame of several scans)
         if (h.odometry) feedOdometry(*h.odometry);
         icp_->clear();
         timed([&] { builder_.processObservation(h.scan); });
-        PendingRow& row = pending_[h.row];
+        UnwrittenRow& row = unwritten_[h.row];
         row.record.kept = true;
         row.record.reason = "icp_rematch";
         if (icp_->ran()) {
@@ -78,7 +78,7 @@ void Run::rematch(const IcpSlamStep& st) {
         res_.keyframes.push_back(row.trajectory_index);
         ++kept_for_rematch_;
     }
-    held_.clear();
+    rematch_.clear();
     // Nothing corrected (every replay rejected, or under the SLAM's gate): the same prior on
     // the same map would give the same fit; the scan stays rejected and the recovery goes on.
     if (!corrected) return;
@@ -110,13 +110,13 @@ bool Run::admitScan(DoorScan& r) {
         ++kept_for_recovery_;
     }
     if (!r.keep && r.skipped == ScanSkipReason::None) {
-        // held for a re-match (a frame's odometry follows with its action: step())
-        if (held_.size() == kMaxHeld) {  // a long gap: the oldest rows go out, none held
-            held_.clear();
-            flushPending();
+        // kept for a re-match (a frame's odometry follows with its action: step())
+        if (rematch_.size() == kMaxRematch) {  // a long gap: the oldest rows go out, none kept
+            rematch_.clear();
+            flushUnwritten();
         }
-        held_.push_back({scan, builder_odometry_, pending_.size() + step_scans_.size()});
-        ++held_this_step_;
+        rematch_.push_back({scan, builder_odometry_, unwritten_.size() + step_scans_.size()});
+        ++rematch_this_step_;
     }
     step_scans_.push_back(std::move(r.record));
     return r.keep;

@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "kfd/pipeline/error.h"
@@ -48,11 +49,18 @@ std::vector<ConfigKeyInfo> configKeys(const StageRegistry& registry);
 /// configKeys(defaultStageRegistry()).
 const std::vector<ConfigKeyInfo>& configKeys();
 
-/// Sets one key (e.g. "window" = "3") in `p`: "pipeline" takes a comma-separated stage list,
-/// every other key belongs to a stage of `registry`. ConfigError naming the key on an unknown
-/// key or a bad value.
+/// Sets one key (e.g. "window" = "3") in `p`: "pipeline" takes a comma-separated stage list;
+/// a choice key of `registry` (`selector`, `variant`) replaces the listed stage of its role by
+/// the one chosen; every other key sets that key of every stage of `registry` that declares it
+/// (e.g. m_threshold: denoise and range_aware_denoise). ConfigError naming the key on an
+/// unknown key or a bad value.
 void applyConfigKey(Pipeline::Params& p, const std::string& key, const std::string& value,
                     const StageRegistry& registry);
+/// applyConfigKey for each (key, value): "pipeline" first, then the choice keys, then the
+/// stages' keys, so that the file's order does not matter.
+void applyConfigKeys(Pipeline::Params& p,
+                     const std::vector<std::pair<std::string, std::string>>& values,
+                     const StageRegistry& registry);
 /// Validates every stage's parameters set in `p` once (each stage's own checks); ConfigError
 /// naming the user's key for the stage's kfd::ParameterError.
 void validateConfig(const Pipeline::Params& p, const StageRegistry& registry);

@@ -67,6 +67,17 @@ struct StreamResult {
 ///
 /// Without it nothing is ever pending and takeFinished() returns false. The counters count a
 /// pending scan once it is finished.
+///
+/// **The door holds the delay** (issue 34): a driver that gives each scan a `done` callback
+/// and queues its other output with then() never sees a pending scan. Every scan's finished
+/// result and every then() run in input order, at once when nothing is held before them:
+///
+///     kfd.process(*scan, odometryPose, [&slam, scan](kfd::StreamResult& r) {
+///         if (r.keep) slam.processScan(*scan);  // finished: removals marked, record final
+///     });
+///     kfd.then([&] { writer.write(odometryEntry); });  // after that scan, in input order
+///     ...
+///     kfd.finish();  // the end of the stream: whatever is held is finished and handed back
 class StreamFilter {
   public:
     /// Builds stages for a new sensor; lets callers add custom stages (e.g. baselines).
@@ -91,6 +102,20 @@ class StreamFilter {
     StreamResult process(mrpt::obs::CObservation2DRangeScan& scan,
                          const std::optional<Pose2D>& odometry = std::nullopt);
 
+    /// What a driver does with a scan's finished result (called once, in input order).
+    using OnFinished = std::function<void(StreamResult&)>;
+    /// process(), handing the scan's result to `done` once finished: at once, or, when a
+    /// stage waits for the sensor's next scan (next_scan), when that scan, finish(), reset()
+    /// or a geometry change finishes it; never before anything given earlier (a later scan's
+    /// `done` and every then() wait behind a held scan). The observation must stay alive and
+    /// unchanged until `done` ran (capture its shared pointer). Returns the result as known
+    /// now (`keep` is final; the record and removals of a held scan are not).
+    StreamResult process(mrpt::obs::CObservation2DRangeScan& scan,
+                         const std::optional<Pose2D>& odometry, OnFinished done);
+    /// Runs `fn` in input order: at once when no scan is held, else after the held scans'
+    /// `done` calls (a driver's output that must follow them, e.g. the next log entry).
+    void then(std::function<void()> fn);
+
     /// What every call so far added up to (the figures of kfd-filter's and kfd-icp-slam's
     /// summaries).
     const ScanCounters& counters() const { return counters_; }
@@ -103,7 +128,8 @@ class StreamFilter {
     /// The next finished scan that was pending, in the order they were finished (with several
     /// sensors that may differ from the input order: record.index has it); false when none.
     bool takeFinished(StreamResult& out);
-    /// Finishes every sensor's pending scan without a next scan (the end of a log).
+    /// Finishes every sensor's pending scan without a next scan (the end of a log); the `done`
+    /// and then() calls waiting behind them run.
     void finish();
     /// Scans pending now (returned pending, not yet finished).
     std::size_t pendingCount() const;
@@ -131,6 +157,18 @@ class StreamFilter {
     // The sensor's pending scan, when its pipeline finished it: marks its removals in the
     // observation, records it and queues it for takeFinished().
     void collectFinished(Sensor& s);
+
+    // One entry per process(.., done) and then() call, in input order; the front ones run as
+    // soon as they are no longer held (drain()).
+    struct InOrder {
+        const mrpt::obs::CObservation2DRangeScan* scan = nullptr;  // held: the scan it waits for
+        bool held = false;
+        StreamResult result;
+        OnFinished done;
+        std::function<void()> fn;
+    };
+    std::deque<InOrder> in_order_;
+    void drain();
 
     Pipeline::Params params_;
     StageFactory extra_;

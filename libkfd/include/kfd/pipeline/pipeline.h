@@ -13,23 +13,22 @@
 #include "kfd/pipeline/scan.h"
 #include "kfd/pipeline/stage.h"
 #include "kfd/pipeline/stage_registry.h"
-#include "kfd/stages/denoise_stage.h"
-#include "kfd/stages/distance_stage.h"
-#include "kfd/stages/keyframe_stage.h"
 
 namespace kfd {
 
 /// The stage list and every configured stage's parameters, typed:
 ///
 ///     kfd::Pipeline::Params p;
-///     p.stages = {"distance", "keyframe", "denoise"};
+///     p.stages = {"distance", "keyframe", "denoise"};  // the paper's three stages
 ///     p.get<kfd::KeyframeStage>().window = 3;  // S::Params of stage class S
 ///
 /// Stages whose parameters were never set run with their Params defaults.
 class PipelineParams {
   public:
-    /// Stage names in order, each at most once (see StageRegistry::names()).
-    std::vector<std::string> stages{"distance", "keyframe", "denoise"};
+    /// Stage names in order, each at most once (see StageRegistry::names()). By default the
+    /// distance filter and kfd's keyframe and denoising stages (kfdDefaults() adds the
+    /// odometry check).
+    std::vector<std::string> stages{"distance", "view_keyframe", "evidence_denoise"};
 
     PipelineParams() = default;
     PipelineParams(const PipelineParams& o);
@@ -134,7 +133,8 @@ class Pipeline {
             if (const auto* t = dynamic_cast<const S*>(s.get())) return t;
         return nullptr;
     }
-    /// The denoise stage's clusters of the last denoised scan, or nullptr without that stage.
+    /// The clusters of the last scan the first clustering stage denoised (Stage::clusters()),
+    /// or nullptr without such a stage.
     const Clusters* lastClusters() const;
 
   private:

@@ -16,9 +16,11 @@
 
 namespace kfd {
 
+struct Clusters;  // kfd/paper/clusters.h
+
 /// What one stage did to one scan: its name, whether it dropped the scan, the valid beams it
 /// invalidated, the time it took, and its typed diagnostics (e.g. KeyframeDecision,
-/// Denoiser::Result), stored by value so a report stays valid after later scans.
+/// DenoiseResult), stored by value so a report stays valid after later scans.
 class StageReport {
   public:
     /// Room for a stage's diagnostics; larger types are rejected at compile time.
@@ -130,6 +132,9 @@ class Stage {
                         const Scan* /*next*/) {
         return process(scan, report, chain);
     }
+    /// A clustering stage's clusters of the last scan it denoised (labels per beam, noise
+    /// flags; e.g. for kfd-render), else nullptr.
+    virtual const Clusters* clusters() const { return nullptr; }
 };
 
 /// A stage around a denoising algorithm `Algo` (Params, and Result filter(Scan&) with a

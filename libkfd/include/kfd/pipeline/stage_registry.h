@@ -30,6 +30,27 @@ struct StageInfo {
     const StageKey* keyForField(std::string_view field) const;
 };
 
+/// A flat key that chooses which of several stages of one role the pipeline runs, e.g.
+/// `selector` (paper -> keyframe, view -> view_keyframe) and `variant` (the denoising stages):
+/// setting it replaces the listed stage of that role by the chosen one (no effect when the
+/// pipeline lists none).
+struct StageChoice {
+    std::string key;   // e.g. "selector"
+    std::string help;  // one line
+    struct Option {
+        std::string value;  // e.g. "paper"
+        std::string stage;  // e.g. "keyframe"
+    };
+    std::vector<Option> options;
+
+    /// The stage chosen by `value`, or nullptr.
+    const Option* find(std::string_view value) const;
+    /// The option that runs stage `stage`, or nullptr.
+    const Option* ofStage(std::string_view stage) const;
+    /// "paper, view".
+    std::string values() const;
+};
+
 /// A set of stages by name. Registration is explicit (registerCoreStages(),
 /// registerBaselineStages(), kfd::defaultStageRegistry() in the MRPT layer): static
 /// initialisers in a static library would be dropped by the linker.
@@ -62,6 +83,16 @@ class StageRegistry {
     /// "distance, keyframe, denoise, ..." (registration order).
     std::string names() const;
 
+    /// Registers a choice key (kfd::Error when its key is taken or an option names a stage
+    /// not registered).
+    void addChoice(StageChoice choice);
+    /// Every choice key, in registration order.
+    const std::vector<StageChoice>& choices() const { return choices_; }
+    /// The choice whose key is `key`, or nullptr.
+    const StageChoice* choice(std::string_view key) const;
+    /// The choice one of whose options runs stage `stage` (the stage's role), or nullptr.
+    const StageChoice* choiceOfStage(std::string_view stage) const;
+
     /// The typed Params inside `p`; kfd::Error when `p` holds another type.
     template <class P>
     static const P& paramsOf(const StageParams& p, const char* stage) {
@@ -72,13 +103,15 @@ class StageRegistry {
 
   private:
     std::vector<StageInfo> stages_;
+    std::vector<StageChoice> choices_;
 };
 
 /// A registry filled by `registrars` in order, e.g. {registerCoreStages, registerBaselineStages}.
 StageRegistry makeStageRegistry(std::initializer_list<void (*)(StageRegistry&)> registrars);
 
-/// Registers the paper's stages: distance (Algorithm 1), keyframe (Sec. 3.1), denoise
-/// (Sec. 3.2), in that order.
+/// Registers the core stages: the paper's distance (Algorithm 1), keyframe (Sec. 3.1) and
+/// denoise (Sec. 3.2), kfd's view_keyframe, range_aware_denoise, evidence_denoise,
+/// odometry_check and fuse, and the choice keys `selector` and `variant`.
 void registerCoreStages(StageRegistry& registry);
 
 /// A registry holding the core stages only (what Pipeline uses unless told otherwise).

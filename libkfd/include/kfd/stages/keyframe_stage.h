@@ -1,4 +1,4 @@
-// Keyframe extraction (Sec. 3.1) as a pipeline stage, named "keyframe".
+// The paper's keyframe extraction (Sec. 3.1, Formula 3) as a pipeline stage, named "keyframe".
 #pragma once
 
 #include <vector>
@@ -8,19 +8,18 @@
 
 namespace kfd {
 
-/// Drops the scans that are not keyframes; never changes a beam. Diagnostics: KeyframeDecision.
+/// Drops the scans whose histogram is similar to the window's (Formula 3); never changes a
+/// beam. kfd's guards (0 = off; off in the paper presets) force a keyframe.
+/// Diagnostics: KeyframeDecision.
 class KeyframeStage : public Stage {
   public:
     static constexpr const char* kName = "keyframe";
     static constexpr const char* kHelp =
-        "keyframe extraction: drop scans the last keyframe covers (selector = view, kfd's "
-        "default) or similar to the window (selector = paper: Sec. 3.1, Formula 3)";
+        "the paper's keyframe extraction (Sec. 3.1, Formula 3): drop scans whose range "
+        "histogram correlates with the last m keyframes'";
     using Params = KeyframeSelector::Params;
-    /// Keys: selector, bins, window, p_pair, max_consecutive_drops, max_interval_s,
-    /// max_translation_m, max_rotation_deg, and the view selector's (view_samples,
-    /// view_tolerance_m, view_tolerance_deg, max_view_change, change_tolerance_m,
-    /// change_tolerance_ratio, max_changed_fraction, degeneracy_ratio, corridor_translation_m,
-    /// corridor_rotation_deg, corridor_interval_s).
+    /// Keys: bins, window, p_pair, and the guards max_consecutive_drops, max_interval_s,
+    /// max_translation_m, max_rotation_deg.
     static std::vector<StageKey> keys();
 
     explicit KeyframeStage(const Params& p = {}) : algo_(p) {}

@@ -89,26 +89,24 @@ class LiveFilter {
     /// The next finished keyframe to publish, oldest first; false when none.
     bool takeReady(sensor_msgs::LaserScan::Ptr& out);
     /// Keyframes held now, waiting for their next scan.
-    std::size_t heldCount() const { return held_.size(); }
+    std::size_t heldCount() const { return door_.pendingCount(); }
     const LiveCounters& counters() const { return counters_; }
     const StreamFilter& door() const { return door_; }
     const Params& params() const { return params_; }
 
   private:
-    // A keyframe held for its next scan: the message to publish and its observation (the door
-    // marks its removals there once finished).
-    struct Held {
-        mrpt::obs::CObservation2DRangeScan::Ptr obs;
-        sensor_msgs::LaserScan::Ptr message;
+    // One message through the door: whether the door finished it during process() (then the
+    // caller's message is marked), else the copy the door's callback marks and queues for
+    // takeReady() once finished.
+    struct Delivery {
+        bool finished = false, keep = false;
+        sensor_msgs::LaserScan::Ptr copy;
     };
-    // What the door finished: marked into the held messages, queued for takeReady().
-    void collectFinished();
     // Marks a kept scan's removals in its message and counts it; the beams marked.
     std::size_t markKept(sensor_msgs::LaserScan& m, const mrpt::obs::CObservation2DRangeScan& o);
 
     Params params_;
     StreamFilter door_;
-    std::vector<Held> held_;                         // at most one per frame
     std::deque<sensor_msgs::LaserScan::Ptr> ready_;  // finished, to publish, oldest first
     std::map<std::string, double> last_stamp_;       // per frame_id
     double last_clock_ = -1.0;                       // onClock's last time (< 0: none yet)

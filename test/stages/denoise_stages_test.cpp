@@ -1,8 +1,11 @@
-#include "kfd/algorithms/denoiser.h"
+#include "kfd/stages/denoise_stage.h"
+#include "kfd/stages/evidence_denoise_stage.h"
+#include "kfd/stages/range_aware_denoise_stage.h"
 
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -39,12 +42,44 @@ bool isOutlierBeam(std::size_t i) {
     return false;
 }
 
-Denoiser::Params variant(DenoiseVariant v) {
-    Denoiser::Params p;
-    p.variant = v;
-    return p;
+// One of the clustering stages with its default parameters, called as a denoiser: the
+// stage's own diagnostics back (DenoiseResult) and its clusters.
+class Denoiser {
+  public:
+    explicit Denoiser(DenoiseVariant v) {
+        if (v == DenoiseVariant::Reference)
+            stage_ = std::make_unique<DenoiseStage>();
+        else if (v == DenoiseVariant::RangeAware)
+            stage_ = std::make_unique<RangeAwareDenoiseStage>();
+        else
+            stage_ = std::make_unique<EvidenceDenoiseStage>();
+    }
+    template <class S>
+    explicit Denoiser(const typename S::Params& p, S* /*type*/) : stage_(std::make_unique<S>(p)) {}
+    DenoiseResult filter(Scan& scan) {
+        StageReport report;
+        const ScanReport chain{};
+        EXPECT_TRUE(stage_->process(scan, report, chain));  // a denoiser never drops a scan
+        EXPECT_TRUE(report.noise);
+        const auto* r = report.diagnostics<DenoiseResult>();
+        EXPECT_NE(r, nullptr);
+        EXPECT_EQ(report.points_removed, r->points_removed);
+        return *r;
+    }
+    const Clusters& clusters() const { return *stage_->clusters(); }
+
+  private:
+    std::unique_ptr<Stage> stage_;
+};
+
+DenoiseVariant variant(DenoiseVariant v) { return v; }
+
+template <class S>
+DenoiseResult run(const typename S::Params& p, Scan& scan) {
+    return Denoiser(p, static_cast<S*>(nullptr)).filter(scan);
 }
 
+// The paper's denoise stage and kfd's range_aware_denoise on the same hand-made scans.
 class DenoiserBothVariants : public ::testing::TestWithParam<DenoiseVariant> {};
 
 TEST_P(DenoiserBothVariants, RemovesOutliersAndKeepsTheWallWhole) {
@@ -154,7 +189,7 @@ TEST_P(DenoiserBothVariants, ReusedDenoiserForgetsThePreviousScan) {
     EXPECT_EQ(d.clusters().label.size(), 360u);
 }
 
-INSTANTIATE_TEST_SUITE_P(Denoiser, DenoiserBothVariants,
+INSTANTIATE_TEST_SUITE_P(Stage, DenoiserBothVariants,
                          ::testing::Values(DenoiseVariant::Reference, DenoiseVariant::RangeAware),
                          [](const ::testing::TestParamInfo<DenoiseVariant>& param_info) {
                              return std::string(param_info.param == DenoiseVariant::Reference
@@ -171,7 +206,7 @@ Scan wallAndFarSmallObject() {
     return scan;
 }
 
-TEST(Denoiser, ReferenceRemovesFarSmallObject) {
+TEST(DenoiseStage, RemovesAFarSmallObjectBelowTheFixedBar) {
     // The paper's fixed bar: 4 points < m_threshold = 10.
     Scan scan = wallAndFarSmallObject();
     Denoiser d(variant(DenoiseVariant::Reference));
@@ -181,7 +216,7 @@ TEST(Denoiser, ReferenceRemovesFarSmallObject) {
     EXPECT_EQ(scan.countValid(), 121u);
 }
 
-TEST(Denoiser, RangeAwareKeepsFarSmallObject) {
+TEST(RangeAwareDenoiseStage, KeepsAFarSmallObjectWideEnough) {
     // 4 beams at 8 m span 0.56 m >= 0.1 m: the bar is the floor of 3 points.
     Scan scan = wallAndFarSmallObject();
     Denoiser d(variant(DenoiseVariant::RangeAware));
@@ -191,102 +226,107 @@ TEST(Denoiser, RangeAwareKeepsFarSmallObject) {
     EXPECT_EQ(scan.countValid(), 125u);
 }
 
-TEST(Denoiser, ReferenceIgnoresMinObjectSize) {
-    auto p = variant(DenoiseVariant::Reference);
-    p.filter.min_object_size_m = 0.1;
-    p.filter.min_points_floor = 1;
+TEST(DenoiseStage, IgnoresMinObjectSizeItHasNone) {
+    // The paper's fixed bar: the range-aware stage's min_object_size_m is not the paper's.
     Scan scan = wallAndFarSmallObject();
-    EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 4u);
+    EXPECT_EQ(run<DenoiseStage>(DenoiseStage::Params{}, scan).points_removed, 4u);
 }
 
-TEST(Denoiser, MThresholdIsConfigurable) {
-    auto p = variant(DenoiseVariant::Reference);
-    p.filter.m_threshold = 4;  // the 4-point object now reaches the bar
+TEST(DenoiseStage, MThresholdIsConfigurable) {
+    DenoiseStage::Params p;
+    p.m_threshold = 4;  // the 4-point object now reaches the bar
     Scan scan = wallAndFarSmallObject();
-    EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 0u);
-    p.filter.m_threshold = 5;
+    EXPECT_EQ(run<DenoiseStage>(p, scan).points_removed, 0u);
+    p.m_threshold = 5;
     scan = wallAndFarSmallObject();
-    EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 4u);
+    EXPECT_EQ(run<DenoiseStage>(p, scan).points_removed, 4u);
 }
 
-TEST(Denoiser, MinPointsFloorIsConfigurable) {
+TEST(RangeAwareDenoiseStage, MinPointsFloorIsConfigurable) {
     // The far object's range-adaptive bar is the floor: 4 points pass a floor of 4, not of 5.
-    auto p = variant(DenoiseVariant::RangeAware);
+    RangeAwareDenoiseStage::Params p;
     p.filter.min_points_floor = 4;
     Scan scan = wallAndFarSmallObject();
-    EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 0u);
+    EXPECT_EQ(run<RangeAwareDenoiseStage>(p, scan).points_removed, 0u);
     p.filter.min_points_floor = 5;
     scan = wallAndFarSmallObject();
-    EXPECT_EQ(Denoiser(p).filter(scan).points_removed, 4u);
+    EXPECT_EQ(run<RangeAwareDenoiseStage>(p, scan).points_removed, 4u);
 }
 
-TEST(Denoiser, ReferenceResultReportsRingsAndBlocks) {
+TEST(DenoiseStage, ResultReportsRingsAndBlocks) {
     Scan scan = wallAndFarSmallObject();
-    auto p = variant(DenoiseVariant::Reference);
-    p.reference.rings.r_max = 20.0;  // r_1 = 8.94 m: everything in ring 1
-    const auto res = Denoiser(p).filter(scan);
+    DenoiseStage::Params p;
+    p.clustering.rings.r_max = 20.0;  // r_1 = 8.94 m: everything in ring 1
+    const auto res = run<DenoiseStage>(p, scan);
+    EXPECT_EQ(res.variant, DenoiseVariant::Reference);
     EXPECT_DOUBLE_EQ(res.r_max, 20.0);
     EXPECT_EQ(res.blocks, 2u);
     EXPECT_EQ(res.merges, 0u);
     EXPECT_NEAR(res.theta_threshold, test::deg2rad(10.0), 1e-12);
 }
 
-TEST(Denoiser, AngleGapFactorReachesBothVariants) {
-    // With theta = 30 deg the far object (22 deg from the wall) joins the wall's block in the
-    // reference variant (everything in ring 1 with r_max = 20 m) and is no longer removed.
-    auto p = variant(DenoiseVariant::Reference);
-    p.reference.rings.r_max = 20.0;
-    p.reference.angle_gap_factor = p.range_aware.angle_gap_factor = 30.0;
+TEST(DenoiseStage, AngleGapFactorWidensTheBlocks) {
+    // With theta = 30 deg the far object (22 deg from the wall) joins the wall's block
+    // (everything in ring 1 with r_max = 20 m) and is no longer removed.
+    DenoiseStage::Params p;
+    p.clustering.rings.r_max = 20.0;
+    p.clustering.angle_gap_factor = 30.0;
     Scan scan = wallAndFarSmallObject();
-    auto res = Denoiser(p).filter(scan);
+    const auto res = run<DenoiseStage>(p, scan);
     EXPECT_EQ(res.clusters, 1u);
     EXPECT_NEAR(res.theta_threshold, test::deg2rad(30.0), 1e-12);
-    p.variant = DenoiseVariant::RangeAware;
+    RangeAwareDenoiseStage::Params q;
+    q.clustering.angle_gap_factor = 30.0;
     scan = wallAndFarSmallObject();
-    res = Denoiser(p).filter(scan);
-    EXPECT_NEAR(res.theta_threshold, test::deg2rad(30.0), 1e-12);
+    EXPECT_NEAR(run<RangeAwareDenoiseStage>(q, scan).theta_threshold, test::deg2rad(30.0), 1e-12);
 }
 
-TEST(Denoiser, DefaultsAreKfdsEvidenceVariantAndThePapersParameters) {
-    const Denoiser d;
-    EXPECT_EQ(d.params().variant, DenoiseVariant::Evidence);
-    EXPECT_EQ(d.params().reference.rings.rings, 5u);
-    EXPECT_EQ(d.params().filter.m_threshold, 10u);
-    EXPECT_DOUBLE_EQ(d.params().reference.angle_gap_factor, 10.0);
-    EXPECT_DOUBLE_EQ(d.params().range_aware.angle_gap_factor, 10.0);
+TEST(DenoiseStage, DefaultsAreThePapers) {
+    const DenoiseStage::Params p;
+    EXPECT_EQ(p.clustering.rings.rings, 5u);
+    EXPECT_EQ(p.m_threshold, 10u);
+    EXPECT_DOUBLE_EQ(p.clustering.angle_gap_factor, 10.0);
+    EXPECT_DOUBLE_EQ(RangeAwareDenoiseStage::Params{}.clustering.angle_gap_factor, 10.0);
+    EXPECT_DOUBLE_EQ(RangeAwareDenoiseStage::Params{}.filter.min_object_size_m, 0.10);
 }
 
-TEST(Denoiser, VariantNames) {
+TEST(DenoiseStage, EachStageReportsItsVariant) {
+    for (const auto v :
+         {DenoiseVariant::Reference, DenoiseVariant::RangeAware, DenoiseVariant::Evidence}) {
+        Scan scan = wallWithOutliers();
+        EXPECT_EQ(Denoiser(v).filter(scan).variant, v);
+    }
     EXPECT_EQ(std::string(toString(DenoiseVariant::Reference)), "reference");
     EXPECT_EQ(std::string(toString(DenoiseVariant::RangeAware)), "range_aware");
-    EXPECT_EQ(parseDenoiseVariant("reference"), DenoiseVariant::Reference);
-    EXPECT_EQ(parseDenoiseVariant("range_aware"), DenoiseVariant::RangeAware);
-    for (const auto v : {DenoiseVariant::Reference, DenoiseVariant::RangeAware})
-        EXPECT_EQ(parseDenoiseVariant(toString(v)), v);
+    EXPECT_EQ(std::string(toString(DenoiseVariant::Evidence)), "evidence");
 }
 
-TEST(Denoiser, UnknownVariantNameThrows) {
-    for (const char* s : {"", "Reference", "range-aware", "rangeaware", "ring", " reference"})
-        EXPECT_THROW(parseDenoiseVariant(s), kfd::ParameterError) << '"' << s << '"';
-}
-
-TEST(Denoiser, RejectsBadParams) {
+TEST(DenoiseStage, RejectsBadParams) {
     auto bad = [](auto mutate) {
-        Denoiser::Params p;
+        DenoiseStage::Params p;
         mutate(p);
-        EXPECT_THROW(Denoiser{p}, kfd::ParameterError);
+        EXPECT_THROW(DenoiseStage{p}, kfd::ParameterError);
+    };
+    bad([](auto& p) { p.m_threshold = 0; });
+    bad([](auto& p) { p.clustering.rings.rings = 0; });
+    bad([](auto& p) { p.clustering.rings.r_max = -1.0; });
+    bad([](auto& p) { p.clustering.angle_gap_factor = 0.0; });
+    bad([](auto& p) { p.clustering.merge_distance_m = -1.0; });
+}
+
+TEST(RangeAwareDenoiseStage, RejectsBadParams) {
+    auto bad = [](auto mutate) {
+        RangeAwareDenoiseStage::Params p;
+        mutate(p);
+        EXPECT_THROW(RangeAwareDenoiseStage{p}, kfd::ParameterError);
     };
     bad([](auto& p) { p.filter.m_threshold = 0; });
     bad([](auto& p) { p.filter.min_points_floor = 0; });
     bad([](auto& p) { p.filter.min_object_size_m = -0.1; });
     bad([](auto& p) { p.filter.min_object_size_m = std::nan(""); });
-    bad([](auto& p) { p.reference.rings.rings = 0; });
-    bad([](auto& p) { p.reference.rings.r_max = -1.0; });
-    bad([](auto& p) { p.reference.angle_gap_factor = 0.0; });
-    bad([](auto& p) { p.range_aware.angle_gap_factor = 0.0; });
-    bad([](auto& p) { p.reference.merge_distance_m = -1.0; });
-    bad([](auto& p) { p.range_aware.jump_lambda_deg = 90.0; });
-    bad([](auto& p) { p.range_aware.jump_sigma_m = -0.01; });
+    bad([](auto& p) { p.clustering.angle_gap_factor = 0.0; });
+    bad([](auto& p) { p.clustering.jump_lambda_deg = 90.0; });
+    bad([](auto& p) { p.clustering.jump_sigma_m = -0.01; });
 }
 
 }  // namespace

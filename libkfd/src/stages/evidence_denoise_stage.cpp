@@ -1,0 +1,72 @@
+#include "kfd/stages/evidence_denoise_stage.h"
+
+#include "kfd/pipeline/stage_keys.h"
+
+namespace kfd {
+
+std::vector<StageKey> EvidenceDenoiseStage::keys() {
+    using P = Params;
+    return {
+        keys::real<P>("min_object_size_m", "min_object_size_m",
+                      "width of the smallest object kept without support (m)", 0, 100, false,
+                      [](P& p) -> double& { return p.min_object_size_m; }),
+        keys::real<P>("incidence_deg", "incidence_deg", "breakpoint incidence limit lambda (deg)",
+                      0, 89.9, true, [](P& p) -> double& { return p.incidence_deg; }),
+        keys::real<P>("sigma_m", "sigma_m", "sensor range noise (m), 0 = estimated from the scans",
+                      0, 10, false, [](P& p) -> double& { return p.sigma_m; }),
+        keys::count<P>("max_gap_beams", "max_gap_beams", "missing beams a surface may span", 0, 16,
+                       [](P& p) -> std::size_t& { return p.max_gap_beams; }),
+        keys::count<P>("max_small_points", "max_small_points",
+                       "segments of at most this many points may be small", 0, 1000,
+                       [](P& p) -> std::size_t& { return p.max_small_points; }),
+        keys::boolean<P>("temporal", "temporal",
+                         "compare with the previous keyframe (needs odometry)",
+                         [](P& p) -> bool& { return p.temporal; }),
+        keys::real<P>("pose_trans_error_m", "pose_trans_error_m",
+                      "odometry translation error of one keyframe step (m)", 0, 10, false,
+                      [](P& p) -> double& { return p.pose_trans_error_m; }),
+        keys::real<P>("pose_rot_error_deg", "pose_rot_error_deg",
+                      "odometry rotation error of one keyframe step (deg)", 0, 90, false,
+                      [](P& p) -> double& { return p.pose_rot_error_deg; }),
+        keys::real<P>("motion_error_fraction", "motion_error_fraction",
+                      "odometry error per metre and per radian of the step", 0, 10, false,
+                      [](P& p) -> double& { return p.motion_error_fraction; }),
+        keys::real<P>("max_removed_fraction", "max_removed_fraction",
+                      "largest share of a scan's valid returns removed (step 5)", 0, 1, true,
+                      [](P& p) -> double& { return p.max_removed_fraction; }),
+        keys::real<P>("max_confirmed_fraction", "max_confirmed_fraction",
+                      "removal beyond the bound kept up to this share when the raw "
+                      "scan just before confirms it (step 5; 0 = off)",
+                      0, 1, false, [](P& p) -> double& { return p.max_confirmed_fraction; }),
+        keys::real<P>("confirm_support", "confirm_support",
+                      "... when it supports this share of the other returns it judged", 0, 1, true,
+                      [](P& p) -> double& { return p.confirm_support; }),
+        keys::count<P>("temporal_scans", "temporal_scans",
+                       "raw scans kept before a keyframe (the dropped ones) as "
+                       "temporal evidence with margins from their alignment; 0 = keyframes only",
+                       0, 16, [](P& p) -> std::size_t& { return p.temporal_scans; }),
+        keys::boolean<P>("next_scan", "next_scan",
+                         "also confirm a keyframe against the scan just after it (one "
+                         "scan of latency: the keyframe is output when the next scan arrives)",
+                         [](P& p) -> bool& { return p.next_scan; })};
+}
+
+bool EvidenceDenoiseStage::finish(Scan& scan, StageReport& report, const ScanReport&,
+                                  const Scan* next) {
+    DenoiseResult res = startDenoising(scan, DenoiseVariant::Evidence);
+    // Marks its segments' noise flags and removes their points itself.
+    const auto r = filter_.filter(scan, clusters_, next);
+    res.points_removed += r.points_removed;
+    res.temporal = r.temporal;
+    res.sigma = r.sigma;
+    res.sigma_measured = r.sigma_measured;
+    res.free_points = r.free_points;
+    res.stale_references = r.stale_references;
+    res.capped = r.capped;
+    res.confirmed = r.confirmed;
+    res.recent = r.recent;
+    res.next = r.next;
+    return endDenoising(clusters_, res, report);
+}
+
+}  // namespace kfd
