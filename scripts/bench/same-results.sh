@@ -2,7 +2,8 @@
 # Checks that a change left kfd's results as they were: runs the tools of two builds (e.g. the
 # last landed commit's and the working tree's) on the real logs and compares what they write.
 #   kfd-filter    every format (rawlog, ROS 1 bag, CARMEN): the output (decompressed), the
-#                 summary (but paths and times), the per-scan decisions (kept, reason)
+#                 summary (but paths and times), the per-scan decisions (kept, reason); the
+#                 paper's presets on two logs (every per-scan column but the time)
 #   kfd-icp-slam  a few modes and options: trajectory.tum, log_estimated_path.txt, summary.json
 #                 (but times and paths)
 #   kfd-render    one scan's figure (PNG bytes)
@@ -28,6 +29,8 @@ verdict() {  # label, then a command that succeeds when both sides agree
   if "$@" >/dev/null 2>&1; then echo "same  $label"; else echo "DIFF  $label"; status=1; fi
 }
 same_file() { cmp -s "$1" "$2"; }
+# Each build with its own tree's configuration (a change may respell it: issue 34's stage names).
+src_of() { sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$1/CMakeCache.txt"; }
 same_gz() { cmp -s <(zcat "$1") <(zcat "$2"); }
 same_text() { diff <(grep -Ev "$3" "$1") <(grep -Ev "$3" "$2"); }
 same_cols() { diff <(tail -n +2 "$1" | cut -d, -f"$3") <(tail -n +2 "$2" | cut -d, -f"$3"); }  # no header
@@ -58,9 +61,28 @@ for spec in aces/aces.rawlog intel/intel.rawlog fr079/fr079.rawlog mit-csail/mit
   verdict "kfd-filter $spec: per-scan decisions" same_cols "$tmp/old-$n.csv" "$tmp/new-$n.csv" 1-5
 done
 
+# The paper's presets (issue 34: the paper's stages run only the paper), each build with its own
+# tree's preset: the output, the summary and every per-scan column but the time.
+for preset in paper-mit-0.752 paper-mit-0.575; do
+  for spec in mit-csail/mit-csail.rawlog fr079/fr079.rawlog; do
+    in="$data/$spec"
+    [ -f "$in" ] || continue
+    n="$preset-${spec//\//_}"
+    for side in old new; do
+      b="$old"
+      [ $side = new ] && b="$new"
+      "$b/apps/kfd-filter" -q -i "$in" -o "$tmp/$side-$n.rawlog" --stats "$tmp/$side-$n.csv" \
+        -c "$(src_of "$b")/share/kfd/$preset.ini" >"$tmp/$side-$n.txt" 2>&1 || true
+    done
+    verdict "kfd-filter $preset $spec: output rawlog" same_gz "$tmp/old-$n.rawlog" "$tmp/new-$n.rawlog"
+    verdict "kfd-filter $preset $spec: summary" same_text "$tmp/old-$n.txt" "$tmp/new-$n.txt" \
+      '^  (output|time) '
+    verdict "kfd-filter $preset $spec: per-scan rows" same_cols "$tmp/old-$n.csv" "$tmp/new-$n.csv" \
+      1-14,16-
+  done
+done
+
 # kfd-icp-slam: modes, a matched drop rate, laser only, a bag, a skipped start.
-# Each build with its own tree's configuration (a change may respell it: issue 34's stage names).
-src_of() { sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$1/CMakeCache.txt"; }
 cfg_old="$(src_of "$old")/share/kfd-icp-slam/sick-180-5hz.ini"
 cfg_new="$(src_of "$new")/share/kfd-icp-slam/sick-180-5hz.ini"
 slam() {  # name, log, options...
