@@ -1,4 +1,4 @@
-// LD_PRELOAD counter of bag chunk decompressions (docs/RESULTS.md, "Reading bags (issue 23)"):
+// LD_PRELOAD counter of bag chunk decompressions (docs/CHANGELOG.md, "Reading bags (issue 23)"):
 // prints at exit how often bz2 and lz4 decompression started. rosbag_storage's one-shot calls
 // (BZ2_bzBuffToBuffDecompress, roslz4_buffToBuffDecompress) start a stream internally, so the
 // stream counts are the total decompressions (kfd's own and rosbag_storage's).

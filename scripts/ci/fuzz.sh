@@ -26,7 +26,7 @@ artifacts="$build/artifacts/$target"
 mkdir -p "$corpus" "$artifacts"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 # ASan's default fast (frame-pointer) unwinding on malloc: full stacks (fast_unwind_on_malloc=0)
-# cut every target's rate 2-7 times (fuzz_bag 150 -> 22 inputs/s, docs/RESULTS.md). The leak
+# cut every target's rate 2-7 times (fuzz_bag 150 -> 22 inputs/s, docs/CHANGELOG.md). The leak
 # suppressions name third-party libraries, and the allocating frame, always recorded, is in them.
 # allocator_may_return_null: an impossible malloc returns null, as glibc's does, instead of
 # stopping the run: OpenCV's images (an image observation in a rawlog) allocate with malloc,

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Denoisers on real scans with injected labelled noise (the issue-11 tables of docs/RESULTS.md,
+# Denoisers on real scans with injected labelled noise (the issue-11 tables of docs/CHANGELOG.md,
 # "On real scans with injected noise"): kfd-inject adds noise to each real log (seed 2), then
 # kfd-denoise-eval scores every method on the noisy copy and on the clean log. Every method
 # runs alone (pipeline = the method), with share/kfd/default.ini's parameters.

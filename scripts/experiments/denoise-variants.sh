@@ -2,7 +2,7 @@
 # Variants of the default pipeline (share/kfd/default.ini with keys appended) on real logs with
 # injected labelled noise (kfd-inject, all its models, seed SEED) and on the clean logs;
 # kfd-denoise-eval scores the kept scans only (what the SLAM sees). Issue 25's tables in
-# docs/RESULTS.md. Development runs use SEED=1; 7 and 11 were held out.
+# docs/CHANGELOG.md. Development runs use SEED=1; 7 and 11 were held out.
 # Usage: SEED=11 bash scripts/experiments/denoise-variants.sh NAME[:KEY=VALUE[,KEY=VALUE...]] ... [-- LOG ...]
 #   e.g. SEED=11 bash scripts/experiments/denoise-variants.sh before:max_confirmed_fraction=0 default \
 #          next:next_scan=true -- fr079 aces          (default logs: the six)

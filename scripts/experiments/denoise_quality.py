@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Denoising quality on simulated logs with labelled noise (docs/RESULTS.md, issue 4 part 3).
+"""Denoising quality on simulated logs with labelled noise (docs/CHANGELOG.md, issue 4 part 3).
 
 Simulates the office world (MIT sensor class, 40 Hz, 1081 beams) at three noise levels, runs
 every denoiser on every scan (no keyframe stage) with kfd-denoise-eval, and prints a Markdown

@@ -1,7 +1,7 @@
 // Bounded work per scan for the neighbour-based baselines: a 65 536-beam scan whose points all
 // lie within each other's radius (the case that took 8 GB and minutes before the caps) runs
 // each baseline with O(n) memory; DBSCAN's work counters prove it never gathers more than
-// min_pts neighbours per point. Timings are in docs/RESULTS.md, not asserted here.
+// min_pts neighbours per point. Timings are in docs/CHANGELOG.md, not asserted here.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -14,7 +14,7 @@
 namespace kfd {
 
 /// Why: on real scans with injected noise, clustering by size alone finds few outliers and
-/// removes real points (docs/RESULTS.md). A one-beam spike 0.2 m in front of a wall, a burst of
+/// removes real points (docs/CHANGELOG.md). A one-beam spike 0.2 m in front of a wall, a burst of
 /// 20 beams at 1 m and a chair leg look alike to a clusterer; what differs is the evidence:
 ///  - spatial: does a return continue a surface of its neighbours?
 ///  - temporal: did the last keyframes see the same place, or see *through* it?
@@ -102,7 +102,7 @@ class EvidenceFilter {
         bool temporal = true;              // use the previous keyframe (step 3)
         // Pose margins (step 3), wide enough for the steps between SLAM keyframes: with 2 cm,
         // 0.5 deg and 10 % the denoiser found more spikes but made ICP worse on two of four
-        // logs (docs/RESULTS.md, "Do no harm").
+        // logs (docs/CHANGELOG.md, "Do no harm").
         double pose_trans_error_m = 0.05;    // m: odometry error of one step
         double pose_rot_error_deg = 1.0;     // deg: the same, in rotation
         double motion_error_fraction = 0.2;  // error per metre / per radian of odometry step
@@ -113,7 +113,7 @@ class EvidenceFilter {
         std::size_t refine_samples = 128;    // returns used per step (every n/128-th)
         double refine_gate_m = 1.0;          // m: pairing gate of the first step (halved after)
         /// Largest share of a scan's valid returns removed (step 5), in (0, 1]; 1 = no bound.
-        /// 5 %: issue 22's bound; real bursts cover 0.3-1.2 % of a log's returns (RESULTS).
+        /// 5 %: issue 22's bound; real bursts cover 0.3-1.2 % of a log's returns (CHANGELOG).
         double max_removed_fraction = 0.05;
         /// Step 5's exception for bursts: removals beyond max_removed_fraction are kept, up to
         /// max_confirmed_fraction of the valid returns, when the raw scan just before (step 3b)
@@ -125,7 +125,7 @@ class EvidenceFilter {
         /// [0, 16]; 0 = keyframes only (no copies, the behaviour before issue 25). 1: on six
         /// real logs with injected noise (seed 7, kept scans) every kind's recall rose (isolated
         /// +1 to +8 points) at -0.04 to +0.16 points of real returns kept on the clean logs;
-        /// 2 gave the same within 0.5 points (docs/RESULTS.md, issue 25).
+        /// 2 gave the same within 0.5 points (docs/CHANGELOG.md, issue 25).
         std::size_t temporal_scans = 1;
         /// Step 3c: also confirm a keyframe against the raw scan just after it. Costs one scan
         /// of latency (kfd::Pipeline holds the keyframe until the next scan; a node publishes

@@ -43,7 +43,7 @@ const char* toString(OdometryVerdict v);
 ///    the step is a jump: this scan gets no odometry, and later odometry is rebased so that the
 ///    jump is taken out (the pose carries on from the previous scan). Steps at the log's pace
 ///    are never tested: on the Freiburg logs a test of every step flagged ordinary 0.1 m steps
-///    (a point between beams on a grazing wall; docs/RESULTS.md).
+///    (a point between beams on a grazing wall; docs/CHANGELOG.md).
 /// A corridor (where moving along it changes no beam) passes both tests: nothing contradicts.
 class OdometryCheck {
   public:

@@ -34,7 +34,7 @@ struct ViewMeasure {
 /// so no point is transformed. Near walls a turn counts little, in a wide hall it counts as
 /// much as it moves the far points. (A first form that also divided the translation by
 /// a + r tan b let the robot drive far in open spaces and lost to the motion filter: see
-/// docs/RESULTS.md, issue 12.)
+/// docs/CHANGELOG.md, issue 12.)
 ///
 /// Without odometry: the share of sampled beams, valid in both, whose range changed by more
 /// than change_tolerance_m + change_tolerance_ratio * r since the keyframe (a per-beam change
