@@ -2,8 +2,8 @@
 // bag like a fast scanner's (/scan at 35 Hz with 1079 beams over 172 degrees, or SCAN_HZ, BEAMS and
 // FOV_DEG and uniform range noise of NOISE_M, beside multi-echo scans, an IMU at 200 Hz, odometry
 // and /tf at 50 Hz; kfd::test::writeFastScannerBag) with chunks of COMPRESSION (none, bz2 or lz4):
-// the bag of several high-rate topics of docs/CHANGELOG.md's "Reading bags (issue 23)", and with `40
-// 1081 270 0.01` the simulated 40 Hz scanner of "kfd_node live (issue 24)".
+// the bag of several high-rate topics of docs/CHANGELOG.md's "Reading bags (issue 23)", and with
+// `40 1081 270 0.01` the simulated 40 Hz scanner of "kfd_node live (issue 24)".
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
