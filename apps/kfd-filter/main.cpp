@@ -32,8 +32,8 @@ std::string rangeNoise(const kfd::SensorSummary& sn) {
            cm(floor) + "; without the floor " + cm(measured) + ")";
 }
 
-void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSummary& s) {
-    const double removed = static_cast<double>(s.points_removed_noise);
+// The summary's lines on what was read and written, and the sensor.
+void printInputAndSensor(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSummary& s) {
     std::printf("kfd-filter summary\n");
     const std::string read = s.input_format == kfd::LogFormat::Rawlog
                                  ? s.layout
@@ -55,6 +55,11 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
                 "thresholds\n",
                 rangeNoise(sn).c_str());
     }
+}
+
+// The lines on the scans and points: kept, dropped, removed, the odometry check, the denoiser.
+void printScansAndPoints(const kfd::RawlogFilterSummary& s) {
+    const double removed = static_cast<double>(s.points_removed_noise);
     std::printf("  scans    in %zu, kept %zu, dropped %zu (%.1f %%)\n", s.scans_in, s.scans_kept,
                 s.scans_dropped, s.droppedPercent());
     if (s.scans_corridor)
@@ -84,6 +89,10 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
         std::printf("; above the bound but confirmed by the scan just before on %s",
                     kfd::plural(s.scans_denoise_confirmed, "scan").c_str());
     if (s.points_removed_noise) std::printf("\n");
+}
+
+// The line on the output's objects (CARMEN lines, bag messages or MRPT objects).
+void printObjects(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSummary& s) {
     if (s.output_format == kfd::LogFormat::Carmen)
         std::printf(
             "  lines    out %zu (FLASER/RLASER for the kept scans, ODOM), scans dropped %zu\n",
@@ -105,6 +114,10 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
                         s.input_format == kfd::LogFormat::Carmen ? "CARMEN line" : "bag message")
                 .c_str(),
             s.objects_out, s.objects_dropped, s.actions_merged);
+}
+
+// The lines on what the door and the source skipped or repaired.
+void printRepairs(const kfd::RawlogFilterSummary& s) {
     if (s.scans_skipped) {
         std::printf("  skipped  %zu (bad geometry, dropped from the output):", s.scans_skipped);
         for (std::size_t r = 1; r < kfd::kScanSkipReasons; ++r)
@@ -140,6 +153,13 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
             "  odometry %s more than 1 s outside the odometry's time span: no odometry for "
             "them\n",
             kfd::plural(src.scans_without_odometry, "scan").c_str());
+}
+
+void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSummary& s) {
+    printInputAndSensor(o, s);
+    printScansAndPoints(s);
+    printObjects(o, s);
+    printRepairs(s);
     std::printf("  time     wall %.2f s, filter %.3f s (%.1f us per scan)\n", s.wall_seconds,
                 s.filter_seconds, s.scans_in ? 1e6 * s.filter_seconds / s.scans_in : 0.0);
 }
@@ -187,6 +207,93 @@ void printWindowSuggestion(const std::vector<double>& a) {
     if (!s.note.empty()) std::printf("note: %s\n", s.note.c_str());
 }
 
+// kfd-filter's flags beyond RawlogFilterOptions.
+struct Flags {
+    std::string config;
+    bool print_config = false, list_keys = false, list = false;
+    std::vector<double> window;
+    std::string compression = "input", removed_as = "nan";
+};
+
+void addInputOutputOptions(kfd::app::Cli& cli, kfd::RawlogFilterOptions& opts, Flags& f) {
+    cli.option("-i,--input", opts.input,
+               "input log: rawlog (either MRPT layout, plain or gzip),\n"
+               "ROS 1 bag, or CARMEN log (.clf/.log, plain or gzip)")
+        ->type_name("FILE");
+    cli.option("-o,--output", opts.output,
+               "output, its format by its name: X.rawlog, X.bag (for a bag\n"
+               "input), X.clf or X.log (CARMEN; X.clf.gz, X.log.gz: gzip);\n"
+               "written to a temporary file, then renamed")
+        ->type_name("FILE");
+    kfd::app::addSourceOptions(cli, opts.source, f.list, opts.laser_only, " (the output keeps it)");
+    cli.option("--removed-as", f.removed_as, "bag output: removed points as nan or inf (REP 117)")
+        ->type_name("MARK")
+        ->check(CLI::IsMember({"nan", "inf"}))
+        ->capture_default_str();
+    cli.option("--bag-compression", f.compression,
+               "bag output's chunks: input (the input bag's), none, lz4 or bz2")
+        ->type_name("C")
+        ->check(CLI::IsMember({"input", "none", "lz4", "bz2"}))
+        ->capture_default_str();
+}
+
+void addConfigOptions(kfd::app::Cli& cli, kfd::RawlogFilterOptions& opts, Flags& f) {
+    cli.option("-c,--config", f.config,
+               ".ini ([KFD] section) or .yaml configuration;\n"
+               "default: kfd's defaults (= share/kfd/default.ini, compiled in);\n"
+               "the paper's exact method: share/kfd/paper-mit-*.ini")
+        ->type_name("FILE");
+    cli.option("--stats", opts.stats_csv,
+               "per-scan CSV, kfd-icp-slam's scans.csv columns: index, timestamp,\n"
+               "sensor, kept, reason, P_common, points and clusters removed,\n"
+               "microseconds, view change, degeneracy, corridor, odometry\n"
+               "(docs/USAGE.md lists them)")
+        ->type_name("FILE");
+    cli.option("--compress", opts.compress_level, "gzip level of the output, 0-9")
+        ->type_name("N")
+        ->check(kfd::app::inRange(0, 9))
+        ->capture_default_str();
+    cli.addQuiet();
+    cli.flag("--print-config", f.print_config, "print the effective configuration and exit");
+    cli.flag("--list-keys", f.list_keys,
+             "list every configuration key with its defaults, range and\n"
+             "meaning, then exit");
+    cli.option("--suggest-window", f.window,
+               "Formulas 4-5: suggest the window m for speed V (m/s) and\n"
+               "scan rate F (Hz), then exit",
+               2, 3)
+        ->option_text("V F [P_PAIR]");
+}
+
+// The run: one of the listing and printing flags, or the log filtered and its summary.
+void run(kfd::app::Cli& cli, kfd::RawlogFilterOptions& opts, const Flags& f) {
+    if (f.list_keys) return printKeys();
+    if (!f.window.empty()) return printWindowSuggestion(f.window);
+    if (f.list) {
+        if (opts.input.empty()) throw kfd::app::UsageError("--list: no input log (-i)");
+        return kfd::app::printListing(opts.input, opts.source);
+    }
+    opts.bag.removed = kfd::parseRemovedMark(f.removed_as);
+    opts.bag.compression = kfd::parseBagCompression(f.compression);
+    opts.pipeline = f.config.empty() ? kfd::kfdDefaults() : kfd::loadConfigFile(f.config);
+    if (f.print_config) {
+        std::fputs(kfd::toIni(opts.pipeline).c_str(), stdout);
+        return;
+    }
+    if (opts.input.empty()) throw kfd::app::UsageError("no input log (-i)");
+    if (opts.output.empty()) throw kfd::app::UsageError("no output (-o)");
+    kfd::app::checkOutputPaths({{"input log", opts.input}, {"configuration", f.config}},
+                               {{"output", opts.output}, {"stats file", opts.stats_csv}});
+    if (auto* progress = cli.progress())
+        opts.on_progress = [progress](const kfd::RawlogProgress& p) {
+            progress->update(
+                p.bytes_total ? static_cast<double>(p.bytes_read) / p.bytes_total : 0.0, p.scans_in,
+                p.scans_kept);
+        };
+    const auto summary = kfd::RawlogFilter().run(opts);
+    printSummary(opts, summary);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -205,82 +312,10 @@ int main(int argc, char** argv) {
         "Exit status: 0 on success, 1 on bad input or configuration (an output that is an input\n"
         "included), 2 on bad usage, 130/143 when interrupted (no output is left).");
     kfd::RawlogFilterOptions opts;
-    std::string config;
-    bool print_config = false, list_keys = false;
-    std::vector<double> window;
-    bool list = false;
-    std::string compression = "input", removed_as = "nan";
-    cli.option("-i,--input", opts.input,
-               "input log: rawlog (either MRPT layout, plain or gzip),\n"
-               "ROS 1 bag, or CARMEN log (.clf/.log, plain or gzip)")
-        ->type_name("FILE");
-    cli.option("-o,--output", opts.output,
-               "output, its format by its name: X.rawlog, X.bag (for a bag\n"
-               "input), X.clf or X.log (CARMEN; X.clf.gz, X.log.gz: gzip);\n"
-               "written to a temporary file, then renamed")
-        ->type_name("FILE");
-    kfd::app::addSourceOptions(cli, opts.source, list, opts.laser_only, " (the output keeps it)");
-    cli.option("--removed-as", removed_as, "bag output: removed points as nan or inf (REP 117)")
-        ->type_name("MARK")
-        ->check(CLI::IsMember({"nan", "inf"}))
-        ->capture_default_str();
-    cli.option("--bag-compression", compression,
-               "bag output's chunks: input (the input bag's), none, lz4 or bz2")
-        ->type_name("C")
-        ->check(CLI::IsMember({"input", "none", "lz4", "bz2"}))
-        ->capture_default_str();
-    cli.option("-c,--config", config,
-               ".ini ([KFD] section) or .yaml configuration;\n"
-               "default: kfd's defaults (= share/kfd/default.ini, compiled in);\n"
-               "the paper's exact method: share/kfd/paper-mit-*.ini")
-        ->type_name("FILE");
-    cli.option("--stats", opts.stats_csv,
-               "per-scan CSV, kfd-icp-slam's scans.csv columns: index, timestamp,\n"
-               "sensor, kept, reason, P_common, points and clusters removed,\n"
-               "microseconds, view change, degeneracy, corridor, odometry\n"
-               "(docs/USAGE.md lists them)")
-        ->type_name("FILE");
-    cli.option("--compress", opts.compress_level, "gzip level of the output, 0-9")
-        ->type_name("N")
-        ->check(kfd::app::inRange(0, 9))
-        ->capture_default_str();
-    cli.addQuiet();
-    cli.flag("--print-config", print_config, "print the effective configuration and exit");
-    cli.flag("--list-keys", list_keys,
-             "list every configuration key with its defaults, range and\n"
-             "meaning, then exit");
-    cli.option("--suggest-window", window,
-               "Formulas 4-5: suggest the window m for speed V (m/s) and\n"
-               "scan rate F (Hz), then exit",
-               2, 3)
-        ->option_text("V F [P_PAIR]");
+    Flags f;
+    addInputOutputOptions(cli, opts, f);
+    addConfigOptions(cli, opts, f);
     cli.addVersion(KFD_VERSION);
     cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP
-    return cli.run(argc, argv, [&] {
-        if (list_keys) return printKeys();
-        if (!window.empty()) return printWindowSuggestion(window);
-        if (list) {
-            if (opts.input.empty()) throw kfd::app::UsageError("--list: no input log (-i)");
-            return kfd::app::printListing(opts.input, opts.source);
-        }
-        opts.bag.removed = kfd::parseRemovedMark(removed_as);
-        opts.bag.compression = kfd::parseBagCompression(compression);
-        opts.pipeline = config.empty() ? kfd::kfdDefaults() : kfd::loadConfigFile(config);
-        if (print_config) {
-            std::fputs(kfd::toIni(opts.pipeline).c_str(), stdout);
-            return;
-        }
-        if (opts.input.empty()) throw kfd::app::UsageError("no input log (-i)");
-        if (opts.output.empty()) throw kfd::app::UsageError("no output (-o)");
-        kfd::app::checkOutputPaths({{"input log", opts.input}, {"configuration", config}},
-                                   {{"output", opts.output}, {"stats file", opts.stats_csv}});
-        if (auto* progress = cli.progress())
-            opts.on_progress = [progress](const kfd::RawlogProgress& p) {
-                progress->update(
-                    p.bytes_total ? static_cast<double>(p.bytes_read) / p.bytes_total : 0.0,
-                    p.scans_in, p.scans_kept);
-            };
-        const auto summary = kfd::RawlogFilter().run(opts);
-        printSummary(opts, summary);
-    });
+    return cli.run(argc, argv, [&] { run(cli, opts, f); });
 }

@@ -13,6 +13,19 @@ echo "$out" | grep -q "log not found: no-such-log" || { echo "installed kfd-comp
 cmake -S "$here" -B "$tmp/consumer" -DCMAKE_PREFIX_PATH="$tmp/prefix" >/dev/null
 cmake --build "$tmp/consumer" >/dev/null
 "$tmp/consumer/consumer"
+# Without ROS: find_package(kfd) and kfd::mrpt need none of ROS 1's bag libraries or headers
+# (here made unfindable); the component bag asks for them (its REQUIRED form fails then).
+cmake -S "$here" -B "$tmp/no-ros" -DCMAKE_PREFIX_PATH="$tmp/prefix" \
+  -DCMAKE_DISABLE_FIND_PACKAGE_KfdRos1=TRUE -DCMAKE_DISABLE_FIND_PACKAGE_KfdRosNode=TRUE >/dev/null
+cmake --build "$tmp/no-ros" --target consumer >/dev/null
+"$tmp/no-ros/consumer"
+mkdir -p "$tmp/bag-needs-ros"
+printf 'cmake_minimum_required(VERSION 3.22)\nproject(p LANGUAGES CXX)\nfind_package(kfd REQUIRED COMPONENTS bag)\n' \
+  >"$tmp/bag-needs-ros/CMakeLists.txt"
+if cmake -S "$tmp/bag-needs-ros" -B "$tmp/bag-needs-ros/b" -DCMAKE_PREFIX_PATH="$tmp/prefix" \
+  -DCMAKE_DISABLE_FIND_PACKAGE_KfdRos1=TRUE >/dev/null 2>&1; then
+  echo "find_package(kfd COMPONENTS bag) succeeded without ROS 1's bag libraries" >&2; exit 1
+fi
 # A kfd built with the ROS 1 node exports kfd::ros1 (find_package(kfd COMPONENTS ros1)).
 if [ -x "$build/apps/kfd_node" ]; then
   [ -x "$tmp/consumer/consumer_ros1" ] || { echo "kfd::ros1 not exported" >&2; exit 1; }

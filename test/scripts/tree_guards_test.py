@@ -2,6 +2,9 @@
 fail on a hand-made one:
   - the paper's folder (libkfd/.../paper) includes only std headers, itself, and the framework's
     scan and error types: nothing of kfd's own algorithms, no OS or MRPT header;
+  - the paper's stages (distance, keyframe, denoise) include only the paper, the framework,
+    the stages' shared headers and the keyframe rule with its guards (off in the paper
+    presets): nothing of kfd's view selector or denoisers;
   - no OS header in the algorithm folders (paper, algorithms, stages, pipeline);
   - no Python file inserts into sys.path (shared test support is imported by name);
   - scripts/ci/longest.py finds functions and files by their length, comments and strings
@@ -18,6 +21,11 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 LONGEST = os.path.join(ROOT, "scripts", "ci", "longest.py")
 ALGORITHM_FOLDERS = ("paper", "algorithms", "stages", "pipeline")
 PAPER_MAY_INCLUDE = re.compile(r'^(<[a-z_]+>|"kfd/paper/[a-z_]+\.h"|"kfd/pipeline/(scan|error)\.h")$')
+PAPER_STAGES = ("distance_stage", "keyframe_stage", "denoise_stage")
+PAPER_STAGE_MAY_INCLUDE = re.compile(
+    r'^(<[a-z_]+>|"kfd/(paper|pipeline)/[a-z_]+\.h"|"kfd/stages/(%s|denoise_result)\.h"|'
+    r'"guard_keys\.h"|"kfd/algorithms/(keyframe_selector|keyframe_guards)\.h")$'
+    % "|".join(PAPER_STAGES))
 OS_HEADERS = re.compile(r"^<(unistd|fcntl|signal|dirent|pthread|sys/.*|filesystem|fstream|"
                         r"mrpt/.*|ros/.*|rosbag/.*)(\.h)?>$")
 
@@ -38,6 +46,12 @@ def includes(path):
 def paper_violations(root):
     return ["%s: %s" % (os.path.relpath(p, root), i) for p in folder_files(root, "paper")
             for i in includes(p) if not PAPER_MAY_INCLUDE.match(i)]
+
+
+def paper_stage_violations(root):
+    return ["%s: %s" % (os.path.relpath(p, root), i) for p in folder_files(root, "stages")
+            if os.path.splitext(os.path.basename(p))[0] in PAPER_STAGES
+            for i in includes(p) if not PAPER_STAGE_MAY_INCLUDE.match(i)]
 
 
 def os_violations(root):
@@ -70,6 +84,11 @@ class TreeGuards(unittest.TestCase):
         self.assertTrue(list(folder_files(ROOT, "paper")), "no paper folder")
         self.assertEqual(paper_violations(ROOT), [])
 
+    def test_the_papers_stages_run_only_the_paper(self):
+        self.assertEqual(len([p for p in folder_files(ROOT, "stages")
+                              if os.path.splitext(os.path.basename(p))[0] in PAPER_STAGES]), 6)
+        self.assertEqual(paper_stage_violations(ROOT), [])
+
     def test_the_algorithm_folders_include_no_os_header(self):
         self.assertEqual(os_violations(ROOT), [])
 
@@ -81,6 +100,13 @@ class TreeGuards(unittest.TestCase):
             write(t, "libkfd/src/paper/a.cpp", '#include "kfd/paper/a.h"\n#include <vector>\n')
             write(t, "libkfd/include/kfd/paper/a.h", '#include "kfd/pipeline/scan.h"\n')
             self.assertEqual(paper_violations(t), [])
+            write(t, "libkfd/src/stages/denoise_stage.cpp",
+                  '#include "kfd/stages/denoise_stage.h"\n#include "kfd/paper/clusters.h"\n')
+            self.assertEqual(paper_stage_violations(t), [])
+            write(t, "libkfd/include/kfd/stages/denoise_stage.h",
+                  '#include "kfd/algorithms/evidence_filter.h"\n')
+            self.assertEqual(paper_stage_violations(t), [
+                'libkfd/include/kfd/stages/denoise_stage.h: "kfd/algorithms/evidence_filter.h"'])
             write(t, "libkfd/include/kfd/paper/b.h", '#include "kfd/algorithms/view_selector.h"\n')
             write(t, "libkfd/src/algorithms/c.cpp", "#include <unistd.h>\n")
             # the offending line built from parts: the repository itself holds none
