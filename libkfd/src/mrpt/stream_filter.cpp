@@ -243,7 +243,13 @@ void StreamFilter::record(StreamResult& res) {
                                              : DenoiseBound::None;
     rec.points_out = rep.points_out;
     rec.microseconds = rep.microseconds;
+    count(res);
+}
 
+// The counters of a recorded scan.
+void StreamFilter::count(const StreamResult& res) {
+    const ScanReport& rep = res.report;
+    const ScanRecord& rec = res.record;
     ScanCounters& c = counters_;
     c.stamps_backwards += res.stamp_backwards ? 1 : 0;
     c.geometry_resets += res.geometry_reset ? 1 : 0;

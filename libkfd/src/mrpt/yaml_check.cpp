@@ -36,10 +36,12 @@ std::vector<std::string> splitLines(const std::string& text) {
     return lines;
 }
 
-void checkYaml(const std::string& text) {
-    if (text.size() > kMaxConfigBytes)
-        throw ConfigError("",
-                          "YAML file larger than " + std::to_string(kMaxConfigBytes) + " bytes");
+namespace {
+
+// 1. Encoding: UTF-8 (RFC 3629: no overlong forms, no surrogates, at most U+10FFFF), an
+//    optional byte-order mark at the very start only. 2. Characters: no control character
+//    but tab, CR and LF (C0, DEL, C1). Returns where the text after the byte-order mark starts.
+std::size_t checkEncoding(const std::string& text) {
     // 1. Encoding: UTF-8 (RFC 3629: no overlong forms, no surrogates, at most U+10FFFF), an
     //    optional byte-order mark at the very start only. 2. Characters: no control character
     //    but tab, CR and LF (C0, DEL, C1).
@@ -78,6 +80,54 @@ void checkYaml(const std::string& text) {
             throw ConfigError("", "YAML: control character or byte-order mark" + where());
         i += len;
     }
+    return body;
+}
+
+// One line of the subset (step 3) with its comment stripped: ConfigError on an unterminated
+// quote.
+std::string stripComment(const std::string& raw, const std::string& at) {
+    std::string line;
+    char quote = 0;
+    for (std::size_t k = 0; k < raw.size(); ++k) {
+        const char c = raw[k];
+        if (quote) {
+            if (c == quote) quote = 0;
+        } else if (c == '\'' || c == '"') {
+            quote = c;
+        } else if (c == '#' && (k == 0 || raw[k - 1] == ' ' || raw[k - 1] == '\t')) {
+            break;
+        }
+        line += c;
+    }
+    if (quote) throw ConfigError("", "YAML: unterminated quote" + at);
+    return line;
+}
+
+// The characters and lists of a line's content (step 3): none of { } & * ! % ? | > @ `, no
+// nested or unbalanced list.
+void checkContent(const std::string& content, const std::string& at) {
+    if (content.rfind("---", 0) == 0 || content.rfind("...", 0) == 0)
+        throw ConfigError("", "YAML: document markers (---, ...) are not supported" + at);
+    int depth = 0;
+    for (const char c : content) {
+        if (std::string("{}&*!%?|>@`").find(c) != std::string::npos)
+            throw ConfigError("", std::string("YAML: '") + c +
+                                      "' is not supported (kfd reads a map of plain "
+                                      "values and lists)" +
+                                      at);
+        if (c == '[' && ++depth > 1) throw ConfigError("", "YAML: nested list" + at);
+        if (c == ']' && --depth < 0) throw ConfigError("", "YAML: unbalanced ']'" + at);
+    }
+    if (depth != 0) throw ConfigError("", "YAML: unterminated list" + at);
+}
+
+}  // namespace
+
+void checkYaml(const std::string& text) {
+    if (text.size() > kMaxConfigBytes)
+        throw ConfigError("",
+                          "YAML file larger than " + std::to_string(kMaxConfigBytes) + " bytes");
+    const std::size_t body = checkEncoding(text);
     // 3. The subset kfd's keys need: a map of scalars (or the same under one `kfd:` key),
     //    values plain or quoted scalars, flow lists [a, b] or block lists (- a). Outside
     //    comments none of { } & * ! % ? | > @ ` (flow maps, anchors, aliases, tags,
@@ -91,20 +141,7 @@ void checkYaml(const std::string& text) {
         const std::string& raw = lines[ln];
         const std::string at = " at line " + std::to_string(ln + 1);
         // Strip a comment: '#' at the start or after a blank, outside quotes.
-        std::string line;
-        char quote = 0;
-        for (std::size_t k = 0; k < raw.size(); ++k) {
-            const char c = raw[k];
-            if (quote) {
-                if (c == quote) quote = 0;
-            } else if (c == '\'' || c == '"') {
-                quote = c;
-            } else if (c == '#' && (k == 0 || raw[k - 1] == ' ' || raw[k - 1] == '\t')) {
-                break;
-            }
-            line += c;
-        }
-        if (quote) throw ConfigError("", "YAML: unterminated quote" + at);
+        const std::string line = stripComment(raw, at);
         std::size_t indent = 0;
         while (indent < line.size() && (line[indent] == ' ' || line[indent] == '\t')) {
             if (line[indent] == '\t') throw ConfigError("", "YAML: tab in indentation" + at);
@@ -112,19 +149,7 @@ void checkYaml(const std::string& text) {
         }
         const std::string content = trim(line);
         if (content.empty()) continue;
-        if (content.rfind("---", 0) == 0 || content.rfind("...", 0) == 0)
-            throw ConfigError("", "YAML: document markers (---, ...) are not supported" + at);
-        int depth = 0;
-        for (const char c : content) {
-            if (std::string("{}&*!%?|>@`").find(c) != std::string::npos)
-                throw ConfigError("", std::string("YAML: '") + c +
-                                          "' is not supported (kfd reads a map of plain "
-                                          "values and lists)" +
-                                          at);
-            if (c == '[' && ++depth > 1) throw ConfigError("", "YAML: nested list" + at);
-            if (c == ']' && --depth < 0) throw ConfigError("", "YAML: unbalanced ']'" + at);
-        }
-        if (depth != 0) throw ConfigError("", "YAML: unterminated list" + at);
+        checkContent(content, at);
         if (content[0] == '-') {  // block list item of the key above
             if (indent == 0 && parent.empty())
                 throw ConfigError("", "YAML: a list is not a map" + at);

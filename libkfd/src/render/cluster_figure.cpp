@@ -69,66 +69,97 @@ std::pair<int, int> ClusterFigure::pixelOf(double x, double y) const {
             static_cast<int>(std::lround(0.5 * opts_.height - y * s))};
 }
 
-mrpt::img::CImage ClusterFigure::render(const Scan& scan, const Clusters& c) {
-    using namespace mrpt::opengl;
-    if (!OSMesaMakeCurrent(impl_->ctx, impl_->buffer.data(), GL_UNSIGNED_BYTE, opts_.width,
-                           opts_.height))
-        throw RenderError("cannot make the OSMesa context current");
-    COpenGLScene scene;
-    double extent = opts_.half_extent_m;
-    auto pts = CPointCloudColoured::Create();
-    auto noise = CPointCloudColoured::Create();
-    pts->setPointSize(opts_.point_size);
-    noise->setPointSize(2.0f * opts_.point_size);
+namespace {
+
+// The clustered points (each cluster its colour) and the noise points (red, larger, above),
+// and how far they reach (m) when the figure fits the scan.
+double scanPoints(const Scan& scan, const Clusters& c, bool fit,
+                  mrpt::opengl::CPointCloudColoured& pts,
+                  mrpt::opengl::CPointCloudColoured& noise) {
+    double extent = 0.0;
     for (std::size_t i = 0; i < scan.size() && i < c.label.size(); ++i) {
         if (!scan.valid[i] || c.label[i] < 0) continue;
         const double a = scan.geometry.angle(i), r = scan.range[i];
         const float x = static_cast<float>(r * std::cos(a)),
                     y = static_cast<float>(r * std::sin(a));
         const bool is_noise = c.noise[static_cast<std::size_t>(c.label[i])] != 0;
-        const auto col = colourOf(c.label[i], is_noise);
+        const auto col = ClusterFigure::colourOf(c.label[i], is_noise);
         (is_noise ? noise : pts)
-            ->insertPoint({x, y, is_noise ? 0.02f : 0.0f, col[0], col[1], col[2]});
-        if (opts_.half_extent_m <= 0)
-            extent = std::max({extent, std::abs(double(x)), std::abs(double(y))});
+            .insertPoint({x, y, is_noise ? 0.02f : 0.0f, col[0], col[1], col[2]});
+        if (fit) extent = std::max({extent, std::abs(double(x)), std::abs(double(y))});
     }
+    return extent;
+}
+
+// Formulas 6-8's ring boundaries r_i = sqrt(i) r_max / sqrt(t), as circles of 180 segments.
+mrpt::opengl::CSetOfLines::Ptr ringLines(std::size_t rings, double r_max) {
+    auto lines = mrpt::opengl::CSetOfLines::Create();
+    lines->setColor_u8(200, 200, 235);
+    for (std::size_t i = 1; i <= rings; ++i) {
+        const double ri = std::sqrt(double(i) / double(rings)) * r_max;
+        for (int k = 0; k < 180; ++k) {
+            const double a0 = 2 * kPi * k / 180, a1 = 2 * kPi * (k + 1) / 180;
+            lines->appendLine(ri * std::cos(a0), ri * std::sin(a0), -0.005, ri * std::cos(a1),
+                              ri * std::sin(a1), -0.005);
+        }
+    }
+    return lines;
+}
+
+// The sensor at the origin (an arrow) and a 1 m scale bar at the bottom left.
+mrpt::opengl::CSetOfLines::Ptr markLines(double he, double half_extent) {
+    auto marks = mrpt::opengl::CSetOfLines::Create();
+    marks->setColor_u8(0, 0, 0);
+    marks->setLineWidth(2.0f);
+    marks->appendLine(-0.15, -0.1, 0.01, 0.25, 0.0, 0.01);
+    marks->appendLine(0.25, 0.0, 0.01, -0.15, 0.1, 0.01);
+    marks->appendLine(-0.15, 0.1, 0.01, -0.15, -0.1, 0.01);
+    const double bx = -he * 0.9, by = -half_extent * 0.9;
+    marks->appendLine(bx, by, 0.01, bx + 1.0, by, 0.01);
+    marks->appendLine(bx, by - 0.05, 0.01, bx, by + 0.05, 0.01);
+    marks->appendLine(bx + 1.0, by - 0.05, 0.01, bx + 1.0, by + 0.05, 0.01);
+    return marks;
+}
+
+// The legend, in a bitmap font on the rendered image.
+void drawLegend(mrpt::img::CImage& img, bool rings) {
+    const mrpt::img::TColor black(0, 0, 0), red(230, 20, 20);
+    img.selectTextFont("6x13");
+    img.textOut(8, 6, "clusters: one colour each", black);
+    img.filledRectangle(8, 24, 16, 32, red);
+    img.textOut(22, 22, "removed as noise", black);
+    img.textOut(8, 38, "1 m grid; bar (bottom left) = 1 m; sensor at centre", black);
+    if (rings) img.textOut(8, 54, "rings: equal-area boundaries", black);
+}
+
+}  // namespace
+
+mrpt::img::CImage ClusterFigure::render(const Scan& scan, const Clusters& c) {
+    using namespace mrpt::opengl;
+    if (!OSMesaMakeCurrent(impl_->ctx, impl_->buffer.data(), GL_UNSIGNED_BYTE, opts_.width,
+                           opts_.height))
+        throw RenderError("cannot make the OSMesa context current");
+    COpenGLScene scene;
+    auto pts = CPointCloudColoured::Create();
+    auto noise = CPointCloudColoured::Create();
+    pts->setPointSize(opts_.point_size);
+    noise->setPointSize(2.0f * opts_.point_size);
+    const bool fit = opts_.half_extent_m <= 0;
+    const double extent = std::max(opts_.half_extent_m, scanPoints(scan, c, fit, *pts, *noise));
     half_extent_ = opts_.half_extent_m > 0 ? opts_.half_extent_m : std::max(1.0, 1.05 * extent);
     const double he = half_extent_ * std::max(1.0, double(opts_.width) / opts_.height);
-
     auto grid =
         CGridPlaneXY::Create(static_cast<float>(-std::ceil(he)), static_cast<float>(std::ceil(he)),
                              static_cast<float>(-std::ceil(half_extent_)),
                              static_cast<float>(std::ceil(half_extent_)), -0.01f, 1.0f);
     grid->setColor_u8(220, 220, 220);
     scene.insert(grid);
-    if (opts_.ring_r_max > 0 && opts_.rings > 0) {  // Formulas 6-8: r_i = sqrt(i) r_max / sqrt(t)
-        auto rings = CSetOfLines::Create();
-        rings->setColor_u8(200, 200, 235);
-        for (std::size_t i = 1; i <= opts_.rings; ++i) {
-            const double ri = std::sqrt(double(i) / double(opts_.rings)) * opts_.ring_r_max;
-            for (int k = 0; k < 180; ++k) {
-                const double a0 = 2 * kPi * k / 180, a1 = 2 * kPi * (k + 1) / 180;
-                rings->appendLine(ri * std::cos(a0), ri * std::sin(a0), -0.005, ri * std::cos(a1),
-                                  ri * std::sin(a1), -0.005);
-            }
-        }
-        scene.insert(rings);
-    }
-    auto marks = CSetOfLines::Create();  // sensor at the origin and a 1 m scale bar
-    marks->setColor_u8(0, 0, 0);
-    marks->setLineWidth(2.0f);
-    marks->appendLine(-0.15, -0.1, 0.01, 0.25, 0.0, 0.01);
-    marks->appendLine(0.25, 0.0, 0.01, -0.15, 0.1, 0.01);
-    marks->appendLine(-0.15, 0.1, 0.01, -0.15, -0.1, 0.01);
-    const double bx = -he * 0.9, by = -half_extent_ * 0.9;
-    marks->appendLine(bx, by, 0.01, bx + 1.0, by, 0.01);
-    marks->appendLine(bx, by - 0.05, 0.01, bx, by + 0.05, 0.01);
-    marks->appendLine(bx + 1.0, by - 0.05, 0.01, bx + 1.0, by + 0.05, 0.01);
-    scene.insert(marks);
+    if (opts_.ring_r_max > 0 && opts_.rings > 0)
+        scene.insert(ringLines(opts_.rings, opts_.ring_r_max));
+    scene.insert(markLines(he, half_extent_));
     scene.insert(pts);
     scene.insert(noise);
     scene.getViewport()->setCustomBackgroundColor({1.0f, 1.0f, 1.0f, 1.0f});
-
     auto& cam = impl_->fbo->getCamera(scene);
     cam.setOrthogonal(true);
     cam.setAzimuthDegrees(-90.0f);
@@ -141,14 +172,7 @@ mrpt::img::CImage ClusterFigure::render(const Scan& scan, const Clusters& c) {
     } catch (const std::exception& e) {
         throw RenderError(std::string("rendering failed: ") + e.what());
     }
-    // Legend (bitmap font, drawn on the rendered image).
-    const mrpt::img::TColor black(0, 0, 0), red(230, 20, 20);
-    img.selectTextFont("6x13");
-    img.textOut(8, 6, "clusters: one colour each", black);
-    img.filledRectangle(8, 24, 16, 32, red);
-    img.textOut(22, 22, "removed as noise", black);
-    img.textOut(8, 38, "1 m grid; bar (bottom left) = 1 m; sensor at centre", black);
-    if (opts_.ring_r_max > 0) img.textOut(8, 54, "rings: equal-area boundaries", black);
+    drawLegend(img, opts_.ring_r_max > 0);
     return img;
 }
 

@@ -67,6 +67,44 @@ std::map<std::size_t, std::vector<Label>> readLabels(const std::string& path) {
     return out;
 }
 
+// A scan's flags before the door and its labels, scored once the door finished it.
+struct Scored {
+    mrpt::obs::CObservation2DRangeScan::Ptr scan;
+    std::vector<std::uint8_t> before;
+    std::vector<NoiseKind> kind;
+    std::vector<NoiseModel> model;
+};
+
+// Adds a kept scan's verdicts to q: every beam valid before the door, clean or noise (by kind,
+// model and range band), removed or not.
+void tally(const Scored& s, DenoiseQuality& q) {
+    const auto& scan = s.scan;
+    ++q.scored;
+    for (std::size_t i = 0, n = s.before.size(); i < n; ++i) {
+        if (!s.before[i]) continue;
+        ++q.points;
+        const bool removed = !scan->getScanRangeValidity(i);
+        const auto ki = static_cast<std::size_t>(s.kind[i]);
+        if (s.kind[i] == NoiseKind::Clean) {
+            ++q.clean;
+            q.removed_clean += removed;
+            const double range = scan->getScanRange(i);
+            std::size_t band = 0;
+            while (band + 1 < q.kBandStartM.size() && range >= q.kBandStartM[band + 1]) ++band;
+            ++q.clean_by_band[band];
+            q.removed_clean_by_band[band] += removed;
+        } else {
+            ++q.noise;
+            ++q.noise_by_kind[ki];
+            q.removed_noise += removed;
+            q.removed_by_kind[ki] += removed;
+            const auto mi = static_cast<std::size_t>(s.model[i]);
+            ++q.noise_by_model[mi];
+            q.removed_by_model[mi] += removed;
+        }
+    }
+}
+
 }  // namespace
 
 DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& labels_csv,
@@ -76,40 +114,6 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
     StreamFilter filter(pipeline, {}, true);  // the door holds a scan for its next (next_scan)
     filter.setLaserOnly(laser_only);
     DenoiseQuality q;
-    // A scan's flags before the door and its labels, scored once the door finished it.
-    struct Scored {
-        mrpt::obs::CObservation2DRangeScan::Ptr scan;
-        std::vector<std::uint8_t> before;
-        std::vector<NoiseKind> kind;
-        std::vector<NoiseModel> model;
-    };
-    auto tally = [&](const Scored& s) {
-        const auto& scan = s.scan;
-        ++q.scored;
-        for (std::size_t i = 0, n = s.before.size(); i < n; ++i) {
-            if (!s.before[i]) continue;
-            ++q.points;
-            const bool removed = !scan->getScanRangeValidity(i);
-            const auto ki = static_cast<std::size_t>(s.kind[i]);
-            if (s.kind[i] == NoiseKind::Clean) {
-                ++q.clean;
-                q.removed_clean += removed;
-                const double range = scan->getScanRange(i);
-                std::size_t band = 0;
-                while (band + 1 < q.kBandStartM.size() && range >= q.kBandStartM[band + 1]) ++band;
-                ++q.clean_by_band[band];
-                q.removed_clean_by_band[band] += removed;
-            } else {
-                ++q.noise;
-                ++q.noise_by_kind[ki];
-                q.removed_noise += removed;
-                q.removed_by_kind[ki] += removed;
-                const auto mi = static_cast<std::size_t>(s.model[i]);
-                ++q.noise_by_model[mi];
-                q.removed_by_model[mi] += removed;
-            }
-        }
-    };
     SourceEntry e;
     auto score = [&](const mrpt::obs::CObservation2DRangeScan::Ptr& scan) {
         const std::size_t n = scan->getScanSize();
@@ -128,7 +132,7 @@ DenoiseQuality evaluateDenoising(const std::string& rawlog, const std::string& l
         ++q.scans;
         filter.process(*scan, e.odometry, [&, now](StreamResult& f) {
             q.microseconds += f.report.microseconds;  // its whole time, held part included
-            if (f.keep) tally(*now);  // dropped: the SLAM never sees it, nothing to score
+            if (f.keep) tally(*now, q);  // dropped: the SLAM never sees it, nothing to score
         });
     };
     while (source->next(e)) e.forEachScan(score);

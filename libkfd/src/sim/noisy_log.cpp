@@ -20,7 +20,10 @@ namespace kfd {
 
 namespace fs = std::filesystem;
 
-NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
+namespace {
+
+// The two outputs' names, checked before anything is written.
+NoisyLogSummary outputNames(const NoisyLogOptions& o) {
     NoisyLogSummary sum;
     if (o.input.empty() || o.output.empty()) throw SimulationError("give an input and an output");
     const fs::path out(o.output);
@@ -30,6 +33,34 @@ NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
                      {{"output rawlog", sum.rawlog}, {"labels", sum.labels}});
     checkOutputName({"output rawlog", sum.rawlog}, {".rawlog"},
                     "kfd-inject writes an MRPT rawlog (.rawlog)");
+    return sum;
+}
+
+// An entry of the input as the rawlog holds it (a bag's other topics have no place there).
+void writeEntry(GzOutputStream& f, const SourceEntry& e) {
+    switch (e.kind) {
+        case SourceEntry::Kind::Frame:
+            if (e.action) f.write(*e.action);
+            f.write(*e.frame);
+            break;
+        case SourceEntry::Kind::Action:
+            f.write(*e.action);
+            break;
+        case SourceEntry::Kind::Observation:
+            f.write(*e.observation);
+            break;
+        case SourceEntry::Kind::Other:
+            f.write(*e.other);
+            break;
+        case SourceEntry::Kind::Native:  // another topic of a bag: not in a rawlog
+            break;
+    }
+}
+
+}  // namespace
+
+NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
+    NoisyLogSummary sum = outputNames(o);
     RealNoiseInjector noise;
     try {
         noise.initialize(o.noise);
@@ -75,23 +106,7 @@ NoisyLogSummary writeNoisyLog(const NoisyLogOptions& o) {
     while (source->next(e)) {
         throwIfCancelled();
         e.forEachScan(inject);
-        switch (e.kind) {
-            case SourceEntry::Kind::Frame:
-                if (e.action) f.write(*e.action);
-                f.write(*e.frame);
-                break;
-            case SourceEntry::Kind::Action:
-                f.write(*e.action);
-                break;
-            case SourceEntry::Kind::Observation:
-                f.write(*e.observation);
-                break;
-            case SourceEntry::Kind::Other:
-                f.write(*e.other);
-                break;
-            case SourceEntry::Kind::Native:  // another topic of a bag: not in a rawlog
-                break;
-        }
+        writeEntry(f, e);
         if (o.on_progress && ++n % std::max<std::size_t>(1, o.progress_every) == 0)
             o.on_progress(static_cast<double>(source->bytesRead()) / total, sum.scans);
     }

@@ -89,7 +89,11 @@ SensorModel sensorModel(const std::string& name) {
     throw SimulationError("unknown sensor '" + name + "' (known: mit, gazebo)");
 }
 
-SimulationSummary Simulator::run(const SimulationOptions& o) {
+namespace {
+
+// The four outputs' names, checked before anything is written: no output is an input or
+// another output, and the rawlog is a .rawlog.
+SimulationSummary outputNames(const SimulationOptions& o) {
     SimulationSummary sum;
     const fs::path out(o.output);
     const std::string stem = (out.parent_path() / out.stem()).string();
@@ -97,8 +101,6 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
     sum.ground_truth = stem + ".gt.tum";
     sum.odometry = stem + ".odom.tum";
     sum.labels = stem + ".labels.csv";
-    // Before anything is written: no output is an input or another output. Each output is
-    // written under a temporary name beside it and renamed once all four are complete.
     checkOutputPaths({{"gridmap", o.gridmap}, {"route", o.route}},
                      {{"output rawlog", sum.rawlog},
                       {"ground truth", sum.ground_truth},
@@ -107,6 +109,76 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
     if (!sum.rawlog.empty())
         checkOutputName({"output rawlog", sum.rawlog}, {".rawlog"},
                         "kfd-simulate writes an MRPT rawlog (.rawlog)");
+    return sum;
+}
+
+// The simulated laser, as MRPT's scan whose ranges each step fills in.
+mrpt::obs::CObservation2DRangeScan laserOf(const SensorModel& sensor) {
+    mrpt::obs::CObservation2DRangeScan scan;
+    scan.sensorLabel = "LASER";
+    scan.aperture = static_cast<float>(sensor.fov_deg * kDeg);
+    scan.maxRange = static_cast<float>(sensor.max_range);
+    scan.rightToLeft = true;
+    scan.stdError = static_cast<float>(sensor.range_sigma);
+    return scan;
+}
+
+// One step's odometry: the true increment, corrupted (two draws of `gauss`); adds its length
+// to the distance travelled.
+void driftOdometry(const SimulationOptions& o, const Pose2D& from, const Pose2D& to,
+                   std::mt19937& rng, std::normal_distribution<double>& gauss,
+                   mrpt::poses::CPose2D& odo, double& distance_m) {
+    const Pose2D d = between(from, to);
+    const double len = std::hypot(d.x, d.y);
+    const double f_t = 1.0 + o.odo_trans_sigma * gauss(rng);
+    const double dphi =
+        d.phi + o.odo_rot_sigma * std::abs(d.phi) * gauss(rng) + o.odo_drift_deg_per_m * kDeg * len;
+    odo = odo + mrpt::poses::CPose2D(d.x * f_t, d.y * f_t, dphi);
+    distance_m += len;
+}
+
+// The scan at the true pose: ray casting without MRPT's own noise (it draws from MRPT's
+// global, unseeded random generator), then the range noise from our seeded generator, the
+// sensor's range limits and the injected noise (`kinds`: what each beam became).
+void simulateScan(World& world, const SensorModel& sensor, const Pose2D& pose,
+                  mrpt::Clock::time_point stamp, std::mt19937& rng,
+                  std::normal_distribution<double>& gauss, NoiseInjector& noise,
+                  mrpt::obs::CObservation2DRangeScan& scan, Scan& core,
+                  std::vector<NoiseKind>& kinds) {
+    world.grid.laserScanSimulator(scan, mrpt::poses::CPose2D(pose.x, pose.y, pose.phi), 0.5f,
+                                  sensor.beams, 0.0f);
+    scan.timestamp = stamp;
+    toCore(scan, core);
+    for (std::size_t i = 0; i < core.size(); ++i)
+        if (core.valid[i]) core.range[i] += static_cast<float>(sensor.range_sigma * gauss(rng));
+    for (std::size_t i = 0; i < core.size(); ++i)
+        if (core.valid[i] &&
+            (core.range[i] < sensor.min_range || core.range[i] >= sensor.max_range))
+            core.valid[i] = 0;
+    noise.apply(core, kinds, rng);
+    for (std::size_t i = 0; i < core.size(); ++i) {
+        scan.setScanRange(i, core.range[i]);
+        scan.setScanRangeValidity(i, core.valid[i] != 0);
+    }
+}
+
+// The labels of scan k's noisy beams, counted by kind.
+void writeLabels(OutputFile& labels, std::size_t k, double t, const std::vector<NoiseKind>& kinds,
+                 SimulationSummary& sum) {
+    for (std::size_t i = 0; i < kinds.size(); ++i) {
+        if (kinds[i] == NoiseKind::Clean) continue;
+        labels << std::to_string(k) + ',' + std::to_string(t) + ',' + std::to_string(i) + ',' +
+                      toString(kinds[i]) + '\n';
+        sum.noise_isolated += kinds[i] == NoiseKind::Isolated;
+        sum.noise_clustered += kinds[i] == NoiseKind::Clustered;
+        sum.noise_edge += kinds[i] == NoiseKind::Edge;
+    }
+}
+
+}  // namespace
+
+SimulationSummary Simulator::run(const SimulationOptions& o) {
+    SimulationSummary sum = outputNames(o);
     World world;
     SensorModel sensor;
     NoiseInjector noise;
@@ -120,69 +192,33 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
     if (!(o.speed_mps > 0) || !(o.turn_rate_dps > 0))
         throw SimulationError("speed and turn rate must be > 0");
     if (o.output.empty()) throw SimulationError("no output rawlog given");
-
     const auto gt =
         sample(world, sensor.rate_hz, o.speed_mps, o.turn_rate_dps * kDeg, o.duration_s);
     std::mt19937 rng(o.seed);
     std::normal_distribution<double> gauss(0.0, 1.0);
-
+    // Each output is written under a temporary name beside it and renamed once all four are
+    // complete; every byte through kfd's checked writers (a full disk is a WriteError).
+    const fs::path out(o.output);
     std::error_code mk;
     if (!out.parent_path().empty()) fs::create_directories(out.parent_path(), mk);
     TempOutputFile tmp(sum.rawlog), tmp_gt(sum.ground_truth), tmp_odo(sum.odometry),
         tmp_labels(sum.labels);
-    // Every byte through kfd's checked writers: a full disk is a WriteError naming the file.
     GzOutputStream f(tmp.path(), sum.rawlog, 1);
     OutputFile labels(tmp_labels.path(), sum.labels);
     labels << "scan,timestamp,beam,kind\n";
-
     Trajectory gt_traj, odo_traj;
     mrpt::poses::CPose2D odo;  // drifting odometry, starts at the origin
     const double t0 = 1700000000.0;
     Scan core;
     std::vector<NoiseKind> kinds;
-    mrpt::obs::CObservation2DRangeScan scan;
-    scan.sensorLabel = "LASER";
-    scan.aperture = static_cast<float>(sensor.fov_deg * kDeg);
-    scan.maxRange = static_cast<float>(sensor.max_range);
-    scan.rightToLeft = true;
-    scan.stdError = static_cast<float>(sensor.range_sigma);
-
+    mrpt::obs::CObservation2DRangeScan scan = laserOf(sensor);
     for (std::size_t k = 0; k < gt.size(); ++k) {
         throwIfCancelled();
         const double t = t0 + static_cast<double>(k) / sensor.rate_hz;
         const auto stamp = mrpt::Clock::fromDouble(t);
-        if (k > 0) {  // odometry: the true increment, corrupted
-            const Pose2D d = between(gt[k - 1], gt[k]);
-            const double len = std::hypot(d.x, d.y);
-            const double f_t = 1.0 + o.odo_trans_sigma * gauss(rng);
-            const double dphi = d.phi + o.odo_rot_sigma * std::abs(d.phi) * gauss(rng) +
-                                o.odo_drift_deg_per_m * kDeg * len;
-            odo = odo + mrpt::poses::CPose2D(d.x * f_t, d.y * f_t, dphi);
-            sum.distance_m += len;
-        }
-        // Ray casting without MRPT's own noise (it draws from MRPT's global, unseeded random
-        // generator); the range noise is added below from our seeded generator.
-        world.grid.laserScanSimulator(scan, mrpt::poses::CPose2D(gt[k].x, gt[k].y, gt[k].phi), 0.5f,
-                                      sensor.beams, 0.0f);
-        scan.timestamp = stamp;
-        toCore(scan, core);
-        for (std::size_t i = 0; i < core.size(); ++i)
-            if (core.valid[i]) core.range[i] += static_cast<float>(sensor.range_sigma * gauss(rng));
-        for (std::size_t i = 0; i < core.size(); ++i)
-            if (core.valid[i] &&
-                (core.range[i] < sensor.min_range || core.range[i] >= sensor.max_range))
-                core.valid[i] = 0;
-        noise.apply(core, kinds, rng);
-        for (std::size_t i = 0; i < core.size(); ++i) {
-            scan.setScanRange(i, core.range[i]);
-            scan.setScanRangeValidity(i, core.valid[i] != 0);
-            if (kinds[i] == NoiseKind::Clean) continue;
-            labels << std::to_string(k) + ',' + std::to_string(t) + ',' + std::to_string(i) + ',' +
-                          toString(kinds[i]) + '\n';
-            sum.noise_isolated += kinds[i] == NoiseKind::Isolated;
-            sum.noise_clustered += kinds[i] == NoiseKind::Clustered;
-            sum.noise_edge += kinds[i] == NoiseKind::Edge;
-        }
+        if (k > 0) driftOdometry(o, gt[k - 1], gt[k], rng, gauss, odo, sum.distance_m);
+        simulateScan(world, sensor, gt[k], stamp, rng, gauss, noise, scan, core, kinds);
+        writeLabels(labels, k, t, kinds, sum);
         mrpt::obs::CObservationOdometry odom;
         odom.sensorLabel = "ODOMETRY";
         odom.timestamp = stamp;

@@ -154,6 +154,7 @@ class StreamFilter {
     };
     Sensor& sensorFor(const std::string& label);
     void record(StreamResult& r);
+    void count(const StreamResult& r);
     // The sensor's pending scan, when its pipeline finished it: marks its removals in the
     // observation, records it and queues it for takeFinished().
     void collectFinished(Sensor& s);
