@@ -25,21 +25,41 @@ DbscanFilter::Result DbscanFilter::filter(Scan& scan) {
     res.points_removed = pts_.nonfinite.size();
     tree_.build(pts_.x.data(), pts_.y.data(), m);
     const float eps = static_cast<float>(params_.eps_m);
-    const float eps2 = eps * eps;  // the tree's inclusive float test: dx*dx + dy*dy <= eps2
     stats_ = Stats{};
+    markCorePoints(eps);
+    binInCells();
+    joinWithinCells();
+    joinAcrossCells(eps * eps);  // the tree's inclusive float test: dx*dx + dy*dy <= eps2
+    res.clusters = numberClusters(eps);
+    label_.assign(n, -1);
+    for (std::size_t p = 0; p < m; ++p) {
+        if (point_label_[p] >= 0) {
+            label_[pts_.beam[p]] = point_label_[p];
+        } else {
+            scan.valid[pts_.beam[p]] = 0;
+            ++res.points_removed;
+        }
+    }
+    return res;
+}
 
-    // 1. Core points: min_pts points (itself included) within eps. Each query stops at min_pts.
+// 1. Core points: min_pts points (itself included) within eps. Each query stops at min_pts.
+void DbscanFilter::markCorePoints(float eps) {
+    const std::size_t m = pts_.size();
     core_.assign(m, 0);
     for (std::size_t p = 0; p < m; ++p) {
         tree_.radius(pts_.x[p], pts_.y[p], eps, neighbours_, params_.min_pts);
         stats_.neighbours_visited += neighbours_.size();
         core_[p] = neighbours_.size() >= params_.min_pts ? 1 : 0;
     }
+}
 
-    // 2. Clusters = connected components of the core points (edges: distance <= eps). Points
-    // are binned in square cells of side < eps / sqrt(2): two core points in one cell are
-    // always connected, and a point within eps of another lies at most 2 cells away. Cells are
-    // runs of `order_` sorted by cell key; pairs of cells are tested with an early exit.
+// 2. Clusters = connected components of the core points (edges: distance <= eps). Points are
+// binned in square cells of side < eps / sqrt(2): two core points in one cell are always
+// connected, and a point within eps of another lies at most 2 cells away. Cells are runs of
+// `order_` sorted by cell key; pairs of cells are tested with an early exit.
+void DbscanFilter::binInCells() {
+    const std::size_t m = pts_.size();
     const double side = params_.eps_m / std::sqrt(2.0) * (1.0 - 1e-4);
     cell_.resize(m);
     order_.resize(m);
@@ -63,10 +83,13 @@ DbscanFilter::Result DbscanFilter::filter(Scan& scan) {
             runs_.push_back(Run{static_cast<std::uint32_t>(k), 0});
     for (std::size_t c = 0; c < runs_.size(); ++c)
         runs_[c].end = c + 1 < runs_.size() ? runs_[c + 1].begin : static_cast<std::uint32_t>(m);
+}
 
+// One cell: its core points are one component.
+void DbscanFilter::joinWithinCells() {
     sets_.clear();
-    for (std::size_t p = 0; p < m; ++p) sets_.add();
-    for (const auto& run : runs_) {  // one cell: its core points are one component
+    for (std::size_t p = 0; p < pts_.size(); ++p) sets_.add();
+    for (const auto& run : runs_) {
         std::int64_t first = -1;
         for (std::uint32_t k = run.begin; k < run.end; ++k) {
             const std::uint32_t p = order_[k];
@@ -77,16 +100,22 @@ DbscanFilter::Result DbscanFilter::filter(Scan& scan) {
                 sets_.unite(static_cast<std::uint32_t>(first), p);
         }
     }
-    auto findRun = [&](std::int64_t cx, std::int64_t cy) -> const Run* {
-        auto it = std::lower_bound(runs_.begin(), runs_.end(), Cell{cx, cy},
-                                   [&](const Run& r, const Cell& c) {
-                                       const Cell& rc = cell_[order_[r.begin]];
-                                       return rc.x != c.x ? rc.x < c.x : rc.y < c.y;
-                                   });
-        if (it == runs_.end()) return nullptr;
-        const Cell& rc = cell_[order_[it->begin]];
-        return rc.x == cx && rc.y == cy ? &*it : nullptr;
-    };
+}
+
+// The run of cell (cx, cy), or nullptr when no point lies there.
+const DbscanFilter::Run* DbscanFilter::findRun(std::int64_t cx, std::int64_t cy) const {
+    auto it = std::lower_bound(runs_.begin(), runs_.end(), Cell{cx, cy},
+                               [&](const Run& r, const Cell& c) {
+                                   const Cell& rc = cell_[order_[r.begin]];
+                                   return rc.x != c.x ? rc.x < c.x : rc.y < c.y;
+                               });
+    if (it == runs_.end()) return nullptr;
+    const Cell& rc = cell_[order_[it->begin]];
+    return rc.x == cx && rc.y == cy ? &*it : nullptr;
+}
+
+// Cells up to 2 apart: joined by the first pair of their core points within eps.
+void DbscanFilter::joinAcrossCells(float eps2) {
     for (const auto& a : runs_) {
         const Cell ca = cell_[order_[a.begin]];
         for (std::int64_t dx = -2; dx <= 2; ++dx) {
@@ -117,11 +146,15 @@ DbscanFilter::Result DbscanFilter::filter(Scan& scan) {
             }
         }
     }
+}
 
-    // 3. Numbering as Ester's sequential algorithm does: by the smallest core point of each
-    // cluster. A border point (not core, a core point within eps) takes the smallest cluster
-    // number among its core neighbours, the one whose expansion would have reached it first.
+// 3. Numbering as Ester's sequential algorithm does: by the smallest core point of each
+// cluster. A border point (not core, a core point within eps) takes the smallest cluster
+// number among its core neighbours, the one whose expansion would have reached it first.
+// Returns the number of clusters.
+std::size_t DbscanFilter::numberClusters(float eps) {
     constexpr std::int32_t kNone = -1;
+    const std::size_t m = pts_.size();
     point_label_.assign(m, kNone);
     root_label_.assign(m, kNone);
     std::int32_t cluster = 0;
@@ -142,17 +175,7 @@ DbscanFilter::Result DbscanFilter::filter(Scan& scan) {
                 if (point_label_[p] == kNone || l < point_label_[p]) point_label_[p] = l;
             }
     }
-    res.clusters = static_cast<std::size_t>(cluster);
-    label_.assign(n, -1);
-    for (std::size_t p = 0; p < m; ++p) {
-        if (point_label_[p] >= 0) {
-            label_[pts_.beam[p]] = point_label_[p];
-        } else {
-            scan.valid[pts_.beam[p]] = 0;
-            ++res.points_removed;
-        }
-    }
-    return res;
+    return static_cast<std::size_t>(cluster);
 }
 
 }  // namespace kfd

@@ -79,6 +79,14 @@ class DbscanFilter {
     std::vector<std::int32_t> point_label_, root_label_;
     std::vector<std::uint32_t> neighbours_;
     std::vector<std::int32_t> label_;
+
+    // filter()'s steps, in order (dbscan.cpp says what each does).
+    void markCorePoints(float eps);
+    void binInCells();
+    void joinWithinCells();
+    const Run* findRun(std::int64_t cx, std::int64_t cy) const;
+    void joinAcrossCells(float eps2);
+    std::size_t numberClusters(float eps);
 };
 
 }  // namespace kfd
