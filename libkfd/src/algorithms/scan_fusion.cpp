@@ -163,113 +163,138 @@ ScanFusion::Result ScanFusion::fuse(Scan& kf) {
     const std::size_t kept = count_;
     count_ = 0;  // whatever happens below, the ring starts again after this keyframe
     if (kept == 0 || !kf.odometry || n < 2) return res;
-
-    ScanGeometry g = kf.geometry;
-    g.beams = n;
-    dirs_.update(g);
-    const float first = static_cast<float>(g.angle(0));
-    const float inv_step = static_cast<float>(1.0 / g.step());
-    const double res_rad = g.resolution();
-    const std::size_t S = params_.max_scans;
-    cand_.assign(n * S, kInf);
-    qx_.resize(n);
-    qy_.resize(n);
-    u_.resize(n);
-    const Pose2D kf_pose = compose(*kf.odometry, kf.sensor_pose);
-    const float gate = static_cast<float>(params_.gate_sigmas * std::sqrt(2.0) * sigma);
-    const float noise = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
-    const double dt = std::min(res_rad, 0.5 * kLambda);
-    const float factor = static_cast<float>(std::sin(dt) / std::sin(kLambda - dt));
-    const float span = static_cast<float>(params_.max_span_beams);
-    if (params_.refine_iterations > 0) {  // the keyframe's points and surfaces, for refine()
-        kx_.resize(n);
-        ky_.resize(n);
-        klink_.assign(n, 0);
-        for (std::size_t k = 0; k < n; ++k) {
-            kx_[k] = kf.range[k] * dirs_.cos[k];
-            ky_[k] = kf.range[k] * dirs_.sin[k];
-        }
-        for (std::size_t k = 0; k + 1 < n; ++k) {
-            if (!kf.valid[k] || !kf.valid[k + 1]) continue;
-            const float ex = kx_[k + 1] - kx_[k], ey = ky_[k + 1] - ky_[k];
-            const float dmax = std::min(kf.range[k], kf.range[k + 1]) * factor + noise;
-            klink_[k] = ex * ex + ey * ey <= dmax * dmax;
-        }
-    }
-
+    const Frame f = frameOf(kf, sigma);
+    if (params_.refine_iterations > 0) keyframeSurfaces(kf, f);  // for refine()
     // 2.-3. Each kept scan, oldest first, into column s of cand_.
     for (std::size_t s = 0; s < kept; ++s) {
-        const Slot& slot = slots_[(head_ + S - kept + s) % S];
         used_[s] = 0;
-        if (slot.geometry != g) continue;
-        Pose2D d = between(kf_pose, slot.pose);
+        const Slot& slot = slots_[(head_ + f.S - kept + s) % f.S];
+        if (slot.geometry != f.g) continue;
+        Pose2D d = between(f.kf_pose, slot.pose);
         if (std::hypot(d.x, d.y) > params_.max_step_m ||
             std::abs(wrapAngle(d.phi)) > params_.max_step_deg * kDeg)
             continue;
         if (params_.refine_iterations > 0 && refine(kf, slot, d)) ++res.scans_refined;
-        const float c = static_cast<float>(std::cos(d.phi)),
-                    sn = static_cast<float>(std::sin(d.phi));
-        const float tx = static_cast<float>(d.x), ty = static_cast<float>(d.y);
-        for (std::size_t j = 0; j < n; ++j) {
-            if (!slot.valid[j]) continue;
-            const float px = slot.range[j] * dirs_.cos[j], py = slot.range[j] * dirs_.sin[j];
-            qx_[j] = c * px - sn * py + tx;
-            qy_[j] = sn * px + c * py + ty;
-            u_[j] = (EvidenceFilter::approxAtan2(qy_[j], qx_[j]) - first) * inv_step;
-        }
-        for (std::size_t j = 0; j + 1 < n; ++j) {
-            if (!slot.valid[j] || !slot.valid[j + 1]) continue;
-            const float ex = qx_[j + 1] - qx_[j], ey = qy_[j + 1] - qy_[j];
-            const float dmax = std::min(slot.range[j], slot.range[j + 1]) * factor + noise;
-            if (ex * ex + ey * ey > dmax * dmax) continue;  // a depth edge, not one surface
-            const float ua = std::min(u_[j], u_[j + 1]), ub = std::max(u_[j], u_[j + 1]);
-            if (!(ub - ua <= span) || !(ub >= 0.0f) || !(ua <= static_cast<float>(n - 1))) continue;
-            const std::size_t k0 = static_cast<std::size_t>(std::ceil(std::max(0.0f, ua)));
-            const std::size_t k1 = std::min(n - 1, static_cast<std::size_t>(std::floor(ub)));
-            for (std::size_t k = k0; k <= k1; ++k) {
-                // The beam k ray t (cos, sin) meets q_j + v e: t = (q_j x e) / (dir x e).
-                const float den = dirs_.cos[k] * ey - dirs_.sin[k] * ex;
-                const float num = qx_[j] * ey - qy_[j] * ex;
-                float t = std::abs(den) > 1e-9f ? num / den : kInf;
-                if (!(t > 0.0f) || !std::isfinite(t)) {  // along the beam: the nearer end
-                    if (std::abs(den) > 1e-9f) continue;
-                    t = std::min(std::hypot(qx_[j], qy_[j]), std::hypot(qx_[j + 1], qy_[j + 1]));
-                }
-                float& slot_k = cand_[k * S + s];
-                slot_k = std::min(slot_k, t);
-            }
-        }
-        // The scan's median disagreement with the keyframe over its agreeing returns.
-        scratch_.clear();
-        for (std::size_t k = 0; k < n; ++k) {
-            if (!kf.valid[k]) continue;
-            const float diff = cand_[k * S + s] - kf.range[k];
-            if (std::abs(diff) <= gate) scratch_.push_back(diff);
-        }
-        if (scratch_.size() < kMinPairs) continue;
-        auto mid = scratch_.begin() + static_cast<std::ptrdiff_t>(scratch_.size() / 2);
-        std::nth_element(scratch_.begin(), mid, scratch_.end());
-        if (std::abs(*mid) > params_.max_bias_sigmas * sigma) {
-            ++res.scans_misaligned;
-            continue;
-        }
+        project(slot, d, s, f);
+        if (!agreesWithKeyframe(kf, s, f, res)) continue;
         used_[s] = 1;
         ++res.scans_used;
     }
-    if (res.scans_used == 0) return res;
+    if (res.scans_used > 0) combine(kf, kept, f, res);
+    return res;
+}
 
-    // 4. Per valid beam: its own range and the agreeing returns.
+ScanFusion::Frame ScanFusion::frameOf(const Scan& kf, double sigma) {
+    Frame f;
+    const std::size_t n = kf.range.size();
+    f.g = kf.geometry;
+    f.g.beams = n;
+    dirs_.update(f.g);
+    f.first = static_cast<float>(f.g.angle(0));
+    f.inv_step = static_cast<float>(1.0 / f.g.step());
+    f.S = params_.max_scans;
+    cand_.assign(n * f.S, kInf);
+    qx_.resize(n);
+    qy_.resize(n);
+    u_.resize(n);
+    f.kf_pose = compose(*kf.odometry, kf.sensor_pose);
+    f.sigma = sigma;
+    f.gate = static_cast<float>(params_.gate_sigmas * std::sqrt(2.0) * sigma);
+    f.noise = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
+    const double dt = std::min(f.g.resolution(), 0.5 * kLambda);
+    f.factor = static_cast<float>(std::sin(dt) / std::sin(kLambda - dt));
+    f.span = static_cast<float>(params_.max_span_beams);
+    return f;
+}
+
+// The keyframe's points and which consecutive returns are one surface (refine()'s targets).
+void ScanFusion::keyframeSurfaces(const Scan& kf, const Frame& f) {
+    const std::size_t n = kf.range.size();
+    kx_.resize(n);
+    ky_.resize(n);
+    klink_.assign(n, 0);
+    for (std::size_t k = 0; k < n; ++k) {
+        kx_[k] = kf.range[k] * dirs_.cos[k];
+        ky_[k] = kf.range[k] * dirs_.sin[k];
+    }
+    for (std::size_t k = 0; k + 1 < n; ++k) {
+        if (!kf.valid[k] || !kf.valid[k + 1]) continue;
+        const float ex = kx_[k + 1] - kx_[k], ey = ky_[k + 1] - ky_[k];
+        const float dmax = std::min(kf.range[k], kf.range[k + 1]) * f.factor + f.noise;
+        klink_[k] = ex * ex + ey * ey <= dmax * dmax;
+    }
+}
+
+// A kept scan moved into the keyframe's frame by d: each of its surface segments (consecutive
+// returns within the breakpoint distance) cut by the keyframe's beams it spans; the nearest
+// crossing per beam goes into column s of cand_.
+void ScanFusion::project(const Slot& slot, const Pose2D& d, std::size_t s, const Frame& f) {
+    const std::size_t n = f.g.beams;  // the keyframe's (the slot has its geometry)
+    const float c = static_cast<float>(std::cos(d.phi)), sn = static_cast<float>(std::sin(d.phi));
+    const float tx = static_cast<float>(d.x), ty = static_cast<float>(d.y);
+    for (std::size_t j = 0; j < n; ++j) {
+        if (!slot.valid[j]) continue;
+        const float px = slot.range[j] * dirs_.cos[j], py = slot.range[j] * dirs_.sin[j];
+        qx_[j] = c * px - sn * py + tx;
+        qy_[j] = sn * px + c * py + ty;
+        u_[j] = (EvidenceFilter::approxAtan2(qy_[j], qx_[j]) - f.first) * f.inv_step;
+    }
+    for (std::size_t j = 0; j + 1 < n; ++j) {
+        if (!slot.valid[j] || !slot.valid[j + 1]) continue;
+        const float ex = qx_[j + 1] - qx_[j], ey = qy_[j + 1] - qy_[j];
+        const float dmax = std::min(slot.range[j], slot.range[j + 1]) * f.factor + f.noise;
+        if (ex * ex + ey * ey > dmax * dmax) continue;  // a depth edge, not one surface
+        const float ua = std::min(u_[j], u_[j + 1]), ub = std::max(u_[j], u_[j + 1]);
+        if (!(ub - ua <= f.span) || !(ub >= 0.0f) || !(ua <= static_cast<float>(n - 1))) continue;
+        const std::size_t k0 = static_cast<std::size_t>(std::ceil(std::max(0.0f, ua)));
+        const std::size_t k1 = std::min(n - 1, static_cast<std::size_t>(std::floor(ub)));
+        for (std::size_t k = k0; k <= k1; ++k) {
+            // The beam k ray t (cos, sin) meets q_j + v e: t = (q_j x e) / (dir x e).
+            const float den = dirs_.cos[k] * ey - dirs_.sin[k] * ex;
+            const float num = qx_[j] * ey - qy_[j] * ex;
+            float t = std::abs(den) > 1e-9f ? num / den : kInf;
+            if (!(t > 0.0f) || !std::isfinite(t)) {  // along the beam: the nearer end
+                if (std::abs(den) > 1e-9f) continue;
+                t = std::min(std::hypot(qx_[j], qy_[j]), std::hypot(qx_[j + 1], qy_[j + 1]));
+            }
+            float& slot_k = cand_[k * f.S + s];
+            slot_k = std::min(slot_k, t);
+        }
+    }
+}
+
+// The scan's median disagreement with the keyframe over its agreeing returns: true when within
+// max_bias_sigmas (else counted misaligned); false too with fewer than kMinPairs returns.
+bool ScanFusion::agreesWithKeyframe(const Scan& kf, std::size_t s, const Frame& f, Result& res) {
+    scratch_.clear();
+    for (std::size_t k = 0; k < kf.range.size(); ++k) {
+        if (!kf.valid[k]) continue;
+        const float diff = cand_[k * f.S + s] - kf.range[k];
+        if (std::abs(diff) <= f.gate) scratch_.push_back(diff);
+    }
+    if (scratch_.size() < kMinPairs) return false;
+    auto mid = scratch_.begin() + static_cast<std::ptrdiff_t>(scratch_.size() / 2);
+    std::nth_element(scratch_.begin(), mid, scratch_.end());
+    if (std::abs(*mid) > params_.max_bias_sigmas * f.sigma) {
+        ++res.scans_misaligned;
+        return false;
+    }
+    return true;
+}
+
+// 4. Per valid beam: its own range and the agreeing returns, by the estimator.
+void ScanFusion::combine(Scan& kf, std::size_t kept, const Frame& f, Result& res) const {
     float vals[65];
     std::size_t agreeing_total = 0;
-    for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t k = 0; k < kf.range.size(); ++k) {
         if (!kf.valid[k]) continue;
         const float r = kf.range[k];
         std::size_t m = 0;
         vals[m++] = r;
         for (std::size_t s = 0; s < kept; ++s) {
             if (!used_[s]) continue;
-            const float v = cand_[k * S + s];
-            if (std::abs(v - r) <= gate) vals[m++] = v;
+            const float v = cand_[k * f.S + s];
+            if (std::abs(v - r) <= f.gate) vals[m++] = v;
         }
         if (m - 1 < params_.min_agreeing) continue;
         float est = 0.0f;
@@ -288,7 +313,6 @@ ScanFusion::Result ScanFusion::fuse(Scan& kf) {
     if (res.beams_fused > 0)
         res.mean_scans_per_fused =
             static_cast<double>(agreeing_total) / static_cast<double>(res.beams_fused);
-    return res;
 }
 
 }  // namespace kfd

@@ -104,6 +104,22 @@ class ScanFusion {
     // points kx_, ky_ and links; true when it changed.
     bool refine(const Scan& kf, const Slot& slot, Pose2D& d) const;
 
+    // One keyframe's frame: geometry, angle table origin, the noise gates and the breakpoint.
+    struct Frame {
+        ScanGeometry g;
+        float first = 0.0f, inv_step = 0.0f;  // beam index u = (angle - first) * inv_step
+        std::size_t S = 0;                    // cand_'s columns (max_scans)
+        Pose2D kf_pose;                       // the keyframe's sensor by odometry
+        double sigma = 0.0;                   // m
+        float gate = 0.0f, noise = 0.0f, factor = 0.0f, span = 0.0f;
+    };
+    // fuse()'s steps (scan_fusion.cpp says what each does).
+    Frame frameOf(const Scan& kf, double sigma);
+    void keyframeSurfaces(const Scan& kf, const Frame& f);
+    void project(const Slot& slot, const Pose2D& d, std::size_t s, const Frame& f);
+    bool agreesWithKeyframe(const Scan& kf, std::size_t s, const Frame& f, Result& res);
+    void combine(Scan& kf, std::size_t kept, const Frame& f, Result& res) const;
+
     Params params_;
     std::vector<Slot> slots_;
     std::size_t head_ = 0, count_ = 0;  // next slot to write, slots filled
