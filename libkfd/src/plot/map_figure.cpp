@@ -132,76 +132,101 @@ std::pair<int, int> MapFigureFrame::pixel(double x, double y) const {
     return {at((x - x_min) / metres_per_pixel), top + at((y_max - y) / metres_per_pixel)};
 }
 
-MapFigure renderMapFigure(const MapFigureInput& in) {
-    if (!in.grid) throw PlotError("map figure: no grid");
-    const auto& g = *in.grid;
-    const double res = g.getResolution();
+namespace {
 
-    Trajectory gt = in.ground_truth, odo = in.odometry;
-    if (gt.size() >= 2 && in.estimate.size() >= 2) {  // gt ~ T (+) est: bring gt to the map frame
+// The ground truth brought to the estimate's frame (gt ~ T (+) est) and the odometry started
+// where the estimate starts.
+void alignToEstimate(const MapFigureInput& in, Trajectory& gt, Trajectory& odo) {
+    gt = in.ground_truth;
+    odo = in.odometry;
+    if (gt.size() >= 2 && in.estimate.size() >= 2) {
         Trajectory sorted_gt = gt;
         sortByTime(sorted_gt);
         const auto ate = computeAte(in.estimate, sorted_gt, 0.05);
         const Pose2D inv = inverse(ate.alignment);
         for (auto& p : gt) p.pose = compose(inv, p.pose);
     }
-    if (!odo.empty() && !in.estimate.empty()) {  // start the odometry where the estimate starts
+    if (!odo.empty() && !in.estimate.empty()) {
         const Pose2D t = compose(in.estimate.front().pose, inverse(odo.front().pose));
         for (auto& p : odo) p.pose = compose(t, p.pose);
     }
+}
 
-    // The layers drawn and their bounds: nothing else sets the figure's extent.
-    const TColor grey(150, 150, 150), green(30, 160, 60), blue(30, 90, 220), navy(10, 20, 90),
-        black(0, 0, 0), orange(240, 130, 0);
-    std::vector<Layer> layers;
+const TColor kGrey(150, 150, 150), kGreen(30, 160, 60), kBlue(30, 90, 220), kNavy(10, 20, 90),
+    kBlack(0, 0, 0), kOrange(240, 130, 0);
+
+// The layers drawn (in legend order) and their bounds, with the margin: nothing else sets the
+// figure's extent.
+Bounds layersAndBounds(const MapFigureInput& in, const Trajectory& gt, const Trajectory& odo,
+                       const std::vector<std::size_t>& keyframes,
+                       const std::vector<std::size_t>& corridor, std::vector<Layer>& layers) {
+    const auto& g = *in.grid;
+    const double res = g.getResolution();
     Bounds b;
     if (const auto cells = knownCellBox(g)) {
-        layers.push_back({{"occupancy map", "white free, black occupied"}, black, false, false});
+        layers.push_back({{"occupancy map", "white free, black occupied"}, kBlack, false, false});
         b.add(g.getXMin() + cells->x0 * res, g.getYMin() + cells->y0 * res);
         b.add(g.getXMin() + (cells->x1 + 1) * res, g.getYMin() + (cells->y1 + 1) * res);
     }
     const bool draw_est = hasSegment(in.estimate), draw_gt = hasSegment(gt),
                draw_odo = hasSegment(odo);
-    const auto keyframes = drawable(in.keyframes, in.estimate);
-    const auto corridor = drawable(in.corridor, in.estimate);
-    if (draw_est) layers.push_back({{"estimate", "blue"}, blue});
-    if (!keyframes.empty()) layers.push_back({{"keyframes", "navy dots"}, navy, true});
-    if (draw_gt) layers.push_back({{"ground truth, aligned to the estimate", "green"}, green});
-    if (draw_odo) layers.push_back({{"odometry from the estimate's start", "grey"}, grey});
+    if (draw_est) layers.push_back({{"estimate", "blue"}, kBlue});
+    if (!keyframes.empty()) layers.push_back({{"keyframes", "navy dots"}, kNavy, true});
+    if (draw_gt) layers.push_back({{"ground truth, aligned to the estimate", "green"}, kGreen});
+    if (draw_odo) layers.push_back({{"odometry from the estimate's start", "grey"}, kGrey});
     if (!corridor.empty())
-        layers.push_back({{"scans the corridor switch found degenerate", "orange"}, orange, true});
+        layers.push_back({{"scans the corridor switch found degenerate", "orange"}, kOrange, true});
     if (draw_est || !keyframes.empty() || !corridor.empty()) addPath(b, in.estimate);
     if (draw_gt) addPath(b, gt);
     if (draw_odo) addPath(b, odo);
     if (b.empty()) b.add(0.5 * (g.getXMin() + g.getXMax()), 0.5 * (g.getYMin() + g.getYMax()));
     const double margin = std::max(in.margin_m, 0.0) + 0.5 * res;
     b.x0 -= margin, b.y0 -= margin, b.x1 += margin, b.y1 += margin;
+    return b;
+}
 
-    // The legend band above the map: title, one row per legend entry, the scale bar.
-    // A title wider than the budget is cut ("..."): it never widens the image beyond it.
-    std::string title = in.title;
+// The legend band above the map: its title (a title wider than the budget is cut with "...":
+// it never widens the image beyond it), height and width; PlotError when the budget cannot
+// hold it.
+struct Band {
+    std::string title;
+    int height = 0, width = 0;
+};
+Band legendBand(const MapFigureInput& in, const std::vector<Layer>& layers) {
+    Band band;
+    band.title = in.title;
     const std::size_t title_chars = static_cast<std::size_t>(
         std::max(4, (std::min(in.max_side_px, 1 << 20) - 2 * kPadPx) / kCharPx));
-    if (title.size() > title_chars) title = title.substr(0, title_chars - 3) + "...";
-    int band = kPadPx + kScaleRowPx + (title.empty() ? 0 : kTitleRowPx);
-    int legend_w = 200;  // the scale bar and its label
-    if (!title.empty())
-        legend_w = std::max(legend_w, 2 * kPadPx + kCharPx * static_cast<int>(title.size()));
+    if (band.title.size() > title_chars) band.title = band.title.substr(0, title_chars - 3) + "...";
+    band.height = kPadPx + kScaleRowPx + (band.title.empty() ? 0 : kTitleRowPx);
+    band.width = 200;  // the scale bar and its label
+    if (!band.title.empty())
+        band.width =
+            std::max(band.width, 2 * kPadPx + kCharPx * static_cast<int>(band.title.size()));
     for (const auto& l : layers) {
         if (!l.legend) continue;
-        band += kEntryRowPx;
-        legend_w = std::max(legend_w, 34 + kPadPx + kCharPx * static_cast<int>(l.text.name.size()));
+        band.height += kEntryRowPx;
+        band.width =
+            std::max(band.width, 34 + kPadPx + kCharPx * static_cast<int>(l.text.name.size()));
     }
     const double side = in.max_side_px;
-    if (legend_w > side || band + 1 > side || double(legend_w) * (band + 1) > in.max_pixels)
+    if (band.width > side || band.height + 1 > side ||
+        double(band.width) * (band.height + 1) > in.max_pixels)
         throw PlotError(
             format("map figure: a budget of %d px a side and %.0f pixels is too "
                    "small for the legend (%d x %d px)",
-                   in.max_side_px, in.max_pixels, legend_w, band + 1));
+                   in.max_side_px, in.max_pixels, band.width, band.height + 1));
+    return band;
+}
 
-    // The cell size drawn: the grid's, coarser until the whole image fits the budget.
+// The frame: the cell size drawn (the grid's, coarser until the whole image fits the
+// budget), the map's corner and size in pixels.
+MapFigureFrame frameFor(const MapFigureInput& in, const Bounds& b, const Band& band) {
+    const auto& g = *in.grid;
+    const double res = g.getResolution();
+    const double side = in.max_side_px;
     const double w_m = b.x1 - b.x0, h_m = b.y1 - b.y0;
-    double mpp = std::max({res, w_m / side, h_m / (side - band)});
+    double mpp = std::max({res, w_m / side, h_m / (side - band.height)});
     auto size = [&](double m) {
         const int w = std::max(1, static_cast<int>(std::ceil(w_m / m - 1e-9)));
         const int h = std::max(1, static_cast<int>(std::ceil(h_m / m - 1e-9)));
@@ -209,13 +234,12 @@ MapFigure renderMapFigure(const MapFigureInput& in) {
     };
     for (int k = 0; k < 10000; ++k) {  // the area shrinks with mpp^2 down to the legend's
         const auto [w, h] = size(mpp);
-        if (std::max(w, legend_w) <= side && h + band <= side &&
-            double(std::max(w, legend_w)) * (h + band) <= in.max_pixels)
+        if (std::max(w, band.width) <= side && h + band.height <= side &&
+            double(std::max(w, band.width)) * (h + band.height) <= in.max_pixels)
             break;
         mpp *= 1.01;
     }
-    MapFigure fig;
-    auto& f = fig.frame;
+    MapFigureFrame f;
     f.metres_per_pixel = mpp;
     f.x_min = b.x0, f.y_max = b.y1;
     if (mpp == res) {  // one cell a pixel: put the pixels on the cells
@@ -223,30 +247,18 @@ MapFigure renderMapFigure(const MapFigureInput& in) {
         f.y_max = g.getYMin() + std::ceil((b.y1 - g.getYMin()) / res) * res;
     }
     std::tie(f.width, f.height) = size(mpp);
-    f.top = band;
+    f.top = band.height;
+    return f;
+}
 
+// Title, legend and scale bar in the band (the scale bar: 1, 2 or 5 times a power of ten
+// metres, at least 20 pixels long).
+void drawBand(MapFigure& fig, const Band& band, const std::vector<Layer>& layers) {
     auto& img = fig.image;
-    const int img_w = std::max(f.width, legend_w);
-    img = mrpt::img::CImage(img_w, band + f.height, mrpt::img::CH_RGB);
-    img.filledRectangle(0, 0, img_w - 1, band + f.height - 1, TColor(255, 255, 255));
-    drawGrid(img, g, f);
-    path(img, f, odo, grey, 1);
-    path(img, f, gt, green, 5);  // wide: stays visible under an accurate estimate
-    path(img, f, in.estimate, blue, 2);
-    for (const auto k : corridor) {  // under the keyframe dots
-        const auto p = f.pixel(in.estimate[k].pose.x, in.estimate[k].pose.y);
-        img.filledRectangle(p.first - 2, p.second - 2, p.first + 2, p.second + 2, orange);
-    }
-    for (const auto k : keyframes) {
-        const auto p = f.pixel(in.estimate[k].pose.x, in.estimate[k].pose.y);
-        img.filledRectangle(p.first - 1, p.second - 1, p.first + 1, p.second + 1, navy);
-    }
-
-    // Title, legend and scale bar in the band.
     img.selectTextFont("9x15");
     int y = kPadPx;
-    if (!title.empty()) {
-        img.textOut(kPadPx, y, title, black);
+    if (!band.title.empty()) {
+        img.textOut(kPadPx, y, band.title, kBlack);
         y += kTitleRowPx;
     }
     for (const auto& l : layers) {
@@ -256,18 +268,51 @@ MapFigure renderMapFigure(const MapFigureInput& in) {
             img.filledRectangle(16, y + 4, 20, y + 8, l.colour);
         else
             img.filledRectangle(8, y + 4, 28, y + 8, l.colour);
-        img.textOut(34, y, l.text.name, black);
+        img.textOut(34, y, l.text.name, kBlack);
         y += kEntryRowPx;
     }
-    // Scale bar: 1, 2 or 5 times a power of ten metres, at least 20 pixels long.
+    const double mpp = fig.frame.metres_per_pixel;
     double metres = 1.0;
     for (int k = 0; metres / mpp < 19.5 && k < 1000; ++k)  // 0.05f is > 0.05
         metres *= (k % 3 == 1) ? 2.5 : 2.0;                // 1, 2, 5, 10, 20, 50, ...
     fig.scale_bar_m = metres;
     fig.scale_bar_px = static_cast<int>(std::lround(metres / mpp));
     fig.scale_bar_row = y + 8;
-    img.line(kPadPx, fig.scale_bar_row, kPadPx + fig.scale_bar_px, fig.scale_bar_row, black, 2);
-    img.textOut(12 + kPadPx + fig.scale_bar_px, y, format("%g m", metres), black);
+    img.line(kPadPx, fig.scale_bar_row, kPadPx + fig.scale_bar_px, fig.scale_bar_row, kBlack, 2);
+    img.textOut(12 + kPadPx + fig.scale_bar_px, y, format("%g m", metres), kBlack);
+}
+
+}  // namespace
+
+MapFigure renderMapFigure(const MapFigureInput& in) {
+    if (!in.grid) throw PlotError("map figure: no grid");
+    Trajectory gt, odo;
+    alignToEstimate(in, gt, odo);
+    const auto keyframes = drawable(in.keyframes, in.estimate);
+    const auto corridor = drawable(in.corridor, in.estimate);
+    std::vector<Layer> layers;
+    const Bounds b = layersAndBounds(in, gt, odo, keyframes, corridor, layers);
+    const Band band = legendBand(in, layers);
+    MapFigure fig;
+    fig.frame = frameFor(in, b, band);
+    const auto& f = fig.frame;
+    auto& img = fig.image;
+    const int img_w = std::max(f.width, band.width);
+    img = mrpt::img::CImage(img_w, band.height + f.height, mrpt::img::CH_RGB);
+    img.filledRectangle(0, 0, img_w - 1, band.height + f.height - 1, TColor(255, 255, 255));
+    drawGrid(img, *in.grid, f);
+    path(img, f, odo, kGrey, 1);
+    path(img, f, gt, kGreen, 5);  // wide: stays visible under an accurate estimate
+    path(img, f, in.estimate, kBlue, 2);
+    for (const auto k : corridor) {  // under the keyframe dots
+        const auto p = f.pixel(in.estimate[k].pose.x, in.estimate[k].pose.y);
+        img.filledRectangle(p.first - 2, p.second - 2, p.first + 2, p.second + 2, kOrange);
+    }
+    for (const auto k : keyframes) {
+        const auto p = f.pixel(in.estimate[k].pose.x, in.estimate[k].pose.y);
+        img.filledRectangle(p.first - 1, p.second - 1, p.first + 1, p.second + 1, kNavy);
+    }
+    drawBand(fig, band, layers);
     return fig;
 }
 
