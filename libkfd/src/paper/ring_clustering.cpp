@@ -48,25 +48,32 @@ bool RingClustering::tryMerge(const Scan& scan, const Block& a, const Block& b,
 RingClustering::Result RingClustering::cluster(const Scan& scan, Clusters& out) {
     Result res;
     const std::size_t n = scan.range.size();
-    const std::size_t t = params_.rings.rings;
     const ScanGeometry& g = scan.geometry;
     theta_ = params_.angle_gap_factor * g.resolution();
     wraps_ = n > 1 && g.seamGap() <= theta_ + 1e-12;
     res.theta_threshold = theta_;
-    res.r_max = partition_.compute(scan, ring_);
+    res.r_max = partition_.compute(scan, ring_);        // Sec. 3.2.1, Formulas 6-8
+    res.blocks = blocksInRings(scan);                   // Sec. 3.2.2
+    if (wraps_) res.merges += joinAcrossSeam(g);        // 360-degree scanners
+    res.merges += mergeAdjacentRings(scan, res.r_max);  // Sec. 3.2.3, Formulas 9-10
+    out.finalize(scan, provisional_, sets_);
+    return res;
+}
 
+// Sec. 3.2.2: angle-gap blocks inside each ring (scan order is angle order). Returns how many.
+std::size_t RingClustering::blocksInRings(const Scan& scan) {
+    const std::size_t n = scan.range.size();
+    const ScanGeometry& g = scan.geometry;
     sets_.clear();
     provisional_.assign(n, -1);
     for (auto& v : ring_blocks_) v.clear();
     std::fill(last_in_ring_.begin(), last_in_ring_.end(), -1);
-
-    // Sec. 3.2.2: angle-gap blocks inside each ring (scan order is angle order).
     for (std::size_t i = 0; i < n; ++i) {
         if (!scan.valid[i]) continue;
         const std::size_t k = ring_[i];
         const std::int64_t j = last_in_ring_[k];
         auto& blocks = ring_blocks_[k];
-        // Within one pass the gap is measured forward (no wrap); the seam is handled below.
+        // Within one pass the gap is measured forward (no wrap); the seam is handled apart.
         if (j >= 0 && static_cast<double>(i - static_cast<std::size_t>(j)) * g.resolution() <=
                           theta_ + 1e-12) {
             blocks.back().last = blocks.back().end1 = static_cast<std::uint32_t>(i);
@@ -78,24 +85,34 @@ RingClustering::Result RingClustering::cluster(const Scan& scan, Clusters& out) 
         provisional_[i] = static_cast<std::int32_t>(blocks.back().id);
         last_in_ring_[k] = static_cast<std::int64_t>(i);
     }
-    for (const auto& v : ring_blocks_) res.blocks += v.size();
+    std::size_t blocks = 0;
+    for (const auto& v : ring_blocks_) blocks += v.size();
+    return blocks;
+}
 
-    // 360-degree scanners: the last and first block of a ring may meet across the seam.
-    if (wraps_) {
-        for (auto& v : ring_blocks_) {
-            if (v.size() < 2) continue;
-            if (angularDistance(v.back().last, v.front().first, g) <= theta_ + 1e-12) {
-                res.merges += sets_.unite(v.back().id, v.front().id) ? 1 : 0;
-                // One block now: its endpoints are the outer ends of the two halves.
-                v.front().end0 = v.back().first;
-                v.back().end1 = v.front().last;
-                v.back().end0 = v.back().first;
-                v.front().end1 = v.front().last;
-            }
+// 360-degree scanners: the last and first block of a ring may meet across the seam. Returns
+// the unions made.
+std::size_t RingClustering::joinAcrossSeam(const ScanGeometry& g) {
+    std::size_t merges = 0;
+    for (auto& v : ring_blocks_) {
+        if (v.size() < 2) continue;
+        if (angularDistance(v.back().last, v.front().first, g) <= theta_ + 1e-12) {
+            merges += sets_.unite(v.back().id, v.front().id) ? 1 : 0;
+            // One block now: its endpoints are the outer ends of the two halves.
+            v.front().end0 = v.back().first;
+            v.back().end1 = v.front().last;
+            v.back().end0 = v.back().first;
+            v.front().end1 = v.front().last;
         }
     }
+    return merges;
+}
 
-    // Sec. 3.2.3: merge blocks of adjacent rings (Formulas 9-10).
+// Sec. 3.2.3: merge blocks of adjacent rings (Formulas 9-10). Returns the unions made.
+std::size_t RingClustering::mergeAdjacentRings(const Scan& scan, double r_max) {
+    const ScanGeometry& g = scan.geometry;
+    const std::size_t t = params_.rings.rings;
+    std::size_t merges = 0;
     // + 1e-6: theta / resolution is an integer in exact arithmetic (factor x resolution) but can
     // round to just below it, which would skip pairs exactly theta apart.
     const double gap_beams = g.resolution() > 0 ? theta_ / g.resolution() + 1e-6 : 0.0;
@@ -103,7 +120,7 @@ RingClustering::Result RingClustering::cluster(const Scan& scan, Clusters& out) 
         const auto& inner = ring_blocks_[k];
         const auto& outer = ring_blocks_[k + 1];
         if (inner.empty() || outer.empty()) continue;
-        const double r_k = partition_.outerRadius(k + 1, res.r_max);
+        const double r_k = partition_.outerRadius(k + 1, r_max);
         const double d_thr = params_.merge_distance_m > 0.0 ? params_.merge_distance_m
                                                             : 2.0 * r_k * std::sin(0.5 * theta_);
         std::size_t p = 0;
@@ -112,16 +129,14 @@ RingClustering::Result RingClustering::cluster(const Scan& scan, Clusters& out) 
                 ++p;
             for (std::size_t q = p;
                  q < outer.size() && static_cast<double>(outer[q].first) <= a.last + gap_beams; ++q)
-                res.merges += tryMerge(scan, a, outer[q], d_thr) ? 1 : 0;
+                merges += tryMerge(scan, a, outer[q], d_thr) ? 1 : 0;
         }
         if (wraps_) {  // pairs that meet across the seam
-            res.merges += tryMerge(scan, inner.front(), outer.back(), d_thr) ? 1 : 0;
-            res.merges += tryMerge(scan, inner.back(), outer.front(), d_thr) ? 1 : 0;
+            merges += tryMerge(scan, inner.front(), outer.back(), d_thr) ? 1 : 0;
+            merges += tryMerge(scan, inner.back(), outer.front(), d_thr) ? 1 : 0;
         }
     }
-
-    out.finalize(scan, provisional_, sets_);
-    return res;
+    return merges;
 }
 
 }  // namespace kfd

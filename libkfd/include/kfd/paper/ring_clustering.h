@@ -65,6 +65,10 @@ class RingClustering {
     };
     double angularDistance(std::size_t a, std::size_t b, const ScanGeometry& g) const;
     bool tryMerge(const Scan& scan, const Block& a, const Block& b, double d_threshold);
+    // cluster()'s steps: Sec. 3.2.2, the seam of a 360-degree scan, Sec. 3.2.3.
+    std::size_t blocksInRings(const Scan& scan);
+    std::size_t joinAcrossSeam(const ScanGeometry& g);
+    std::size_t mergeAdjacentRings(const Scan& scan, double r_max);
 
     Params params_;
     RingPartition partition_;
