@@ -29,10 +29,8 @@ namespace {
 // The denoising stage the configuration's pipeline runs (selected by `variant`), kfd's
 // evidence_denoise when it lists none.
 std::string denoisingStage(const kfd::Pipeline::Params& p) {
-    const kfd::StageChoice* role = kfd::defaultStageRegistry().choice("variant");
-    for (const auto& st : p.stages)
-        if (role && role->ofStage(st)) return st;
-    return "evidence_denoise";
+    const auto* listed = kfd::defaultStageRegistry().choice("variant")->listedIn(p.stages);
+    return listed ? listed->stage : "evidence_denoise";
 }
 
 struct Options {

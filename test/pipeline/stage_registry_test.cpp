@@ -126,6 +126,8 @@ TEST(StageRegistry, ChoiceKeysNameTheStagesOfARole) {
     EXPECT_EQ(selector->find("paper")->stage, "keyframe");
     EXPECT_EQ(selector->find("view")->stage, "view_keyframe");
     EXPECT_EQ(selector->find("histogram"), nullptr);
+    EXPECT_EQ(selector->listedIn({"distance", "view_keyframe", "keyframe"})->value, "view");
+    EXPECT_EQ(selector->listedIn({"distance", "evidence_denoise"}), nullptr);
     const StageChoice* variant = r.choice("variant");
     ASSERT_NE(variant, nullptr);
     EXPECT_EQ(variant->values(), "reference, range_aware, evidence");

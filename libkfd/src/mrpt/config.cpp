@@ -190,9 +190,8 @@ std::string stageList(const Pipeline::Params& p, const char* sep) {
 // The value of choice `c` in `p`: the option of the stage of its role that `p` lists ("" when
 // none is listed).
 std::string choiceValue(const Pipeline::Params& p, const StageChoice& c) {
-    for (const auto& st : p.stages)
-        if (const auto* o = c.ofStage(st)) return o->value;
-    return "";
+    const auto* o = c.listedIn(p.stages);
+    return o ? o->value : "";
 }
 
 // The value of key `name` in `p`: from the first stage declaring it that `p` lists, else the

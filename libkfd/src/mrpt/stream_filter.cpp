@@ -153,7 +153,6 @@ void StreamFilter::collectFinished(Sensor& s) {
 StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& scan,
                                    const std::optional<Pose2D>& odometry, OnFinished done) {
     StreamResult r = process(scan, odometry);
-    drain();  // what this scan finished
     InOrder w;
     w.scan = &scan;
     w.held = r.pending;

@@ -41,6 +41,12 @@ const StageChoice::Option* StageChoice::ofStage(std::string_view stage) const {
     return nullptr;
 }
 
+const StageChoice::Option* StageChoice::listedIn(const std::vector<std::string>& stages) const {
+    for (const auto& st : stages)
+        if (const Option* o = ofStage(st)) return o;
+    return nullptr;
+}
+
 std::string StageChoice::values() const {
     std::string s;
     for (const auto& o : options) s += (s.empty() ? "" : ", ") + o.value;

@@ -16,6 +16,7 @@
 #include "kfd/baselines/motion_stage.h"
 #include "kfd/io/gz_output.h"
 #include "kfd/io/png_output.h"
+#include "kfd/mrpt/default_stages.h"
 #include "kfd/os/cancel.h"
 #include "kfd/os/output_paths.h"
 #include "kfd/pipeline/format.h"
@@ -341,9 +342,7 @@ namespace {
 // stage): configured -> used. Empty when none was lowered.
 std::string gateText(const IcpSlamSummary& s) {
     const auto& stages = s.pipeline.stages;
-    if (std::find(stages.begin(), stages.end(), "keyframe") == stages.end() &&
-        std::find(stages.begin(), stages.end(), "view_keyframe") == stages.end())
-        return {};
+    if (!defaultStageRegistry().choice("selector")->listedIn(stages)) return {};
     std::string lowered;
     if (s.guard_translation_m != s.guard_translation_m_configured)
         lowered += format("%g -> %g m", s.guard_translation_m_configured, s.guard_translation_m);

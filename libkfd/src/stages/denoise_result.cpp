@@ -1,5 +1,7 @@
 #include "kfd/stages/denoise_result.h"
 
+#include "kfd/pipeline/stage_registry.h"
+
 namespace kfd {
 
 const char* toString(DenoiseVariant v) {
@@ -14,16 +16,9 @@ const char* toString(DenoiseVariant v) {
     return "unknown";
 }
 
-const char* stageName(DenoiseVariant v) {
-    switch (v) {
-        case DenoiseVariant::Reference:
-            return "denoise";
-        case DenoiseVariant::RangeAware:
-            return "range_aware_denoise";
-        case DenoiseVariant::Evidence:
-            return "evidence_denoise";
-    }
-    return "unknown";
+const char* stageName(DenoiseVariant v) {  // the core registry's `variant` choice
+    const auto* o = coreStageRegistry().choice("variant")->find(toString(v));
+    return o ? o->stage.c_str() : "unknown";
 }
 
 DenoiseResult startDenoising(Scan& scan, DenoiseVariant variant) {

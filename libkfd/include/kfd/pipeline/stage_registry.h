@@ -47,6 +47,8 @@ struct StageChoice {
     const Option* find(std::string_view value) const;
     /// The option that runs stage `stage`, or nullptr.
     const Option* ofStage(std::string_view stage) const;
+    /// The option of the first stage of this role that `stages` lists, or nullptr.
+    const Option* listedIn(const std::vector<std::string>& stages) const;
     /// "paper, view".
     std::string values() const;
 };
