@@ -10,6 +10,7 @@
 #include "common/source_cli.h"
 #include "kfd/io/rawlog_filter.h"
 #include "kfd/mrpt/config.h"
+#include "kfd/mrpt/default_stages.h"
 #include "kfd/paper/window_helper.h"
 #include "kfd/pipeline/format.h"
 
@@ -57,38 +58,20 @@ void printInputAndSensor(const kfd::RawlogFilterOptions& o, const kfd::RawlogFil
     }
 }
 
-// The lines on the scans and points: kept, dropped, removed, the odometry check, the denoiser.
+// The lines on the scans and points (kept, dropped, removed), then each listed stage's own
+// counters, as the stage declares them.
 void printScansAndPoints(const kfd::RawlogFilterSummary& s) {
     const double removed = static_cast<double>(s.points_removed_noise);
     std::printf("  scans    in %zu, kept %zu, dropped %zu (%.1f %%)\n", s.scans_in, s.scans_kept,
                 s.scans_dropped, s.droppedPercent());
-    if (s.scans_corridor)
-        std::printf("  corridor %s degenerate (%.1f %%): %s by odometry or time\n",
-                    kfd::plural(s.scans_corridor, "scan").c_str(),
-                    100.0 * static_cast<double>(s.scans_corridor) /
-                        static_cast<double>(std::max<std::size_t>(1, s.scans_in)),
-                    kfd::plural(s.keyframes_corridor, "keyframe").c_str());
     std::printf("  points   in %zu; in kept scans removed: %zu out of range, %zu noise (%.2f %%)\n",
-                s.points_in, s.points_removed_range, s.points_removed_noise,
+                s.points_in, s.points_removed - s.points_removed_noise, s.points_removed_noise,
                 s.points_in ? 100.0 * removed / static_cast<double>(s.points_in) : 0.0);
-    if (s.scans_odometry_frozen || s.scans_odometry_jump)
-        std::printf(
-            "  odometry withheld from %s (%zu frozen while the scans changed, %s the scans do "
-            "not show): decided laser only\n",
-            kfd::plural(s.scans_odometry_frozen + s.scans_odometry_jump, "scan").c_str(),
-            s.scans_odometry_frozen, kfd::plural(s.scans_odometry_jump, "jump").c_str());
     if (s.points_removed_noise)
-        std::printf("  denoise  at most %.2f %% of a kept scan's returns removed",
+        std::printf("  denoise  at most %.2f %% of a kept scan's returns removed\n",
                     100.0 * s.max_removed_noise_share);
-    if (s.scans_denoise_stale || s.scans_denoise_capped)
-        std::printf("; the bound on removal acted on %s (%s, %zu capped)",
-                    kfd::plural(s.scans_denoise_stale + s.scans_denoise_capped, "scan").c_str(),
-                    kfd::plural(s.scans_denoise_stale, "stale reference").c_str(),
-                    s.scans_denoise_capped);
-    if (s.scans_denoise_confirmed)
-        std::printf("; above the bound but confirmed by the scan just before on %s",
-                    kfd::plural(s.scans_denoise_confirmed, "scan").c_str());
-    if (s.points_removed_noise) std::printf("\n");
+    for (const std::string& line : kfd::stageCounterLines(s.stage_totals))
+        std::printf("  %s\n", line.c_str());
 }
 
 // The line on the output's objects (CARMEN lines, bag messages or MRPT objects).
@@ -164,6 +147,23 @@ void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
                 s.filter_seconds, s.scans_in ? 1e6 * s.filter_seconds / s.scans_in : 0.0);
 }
 
+// --list-columns: the per-scan CSV's columns and the counters, each stage's as it declares them.
+void printColumns() {
+    std::printf(
+        "The door's columns: index, timestamp, sensor, kept, reason, points_in, removed_noise,\n"
+        "points_out, microseconds; then each listed stage's own, in pipeline order; then\n"
+        "icp_goodness, odom_x, odom_y, odom_phi, x, y, phi (kfd/io/scan_csv.h).\n");
+    for (const kfd::StageInfo& st : kfd::defaultStageRegistry().stages()) {
+        if (st.columns.empty() && st.counters.empty()) continue;
+        std::printf("\n%s\n", st.name.c_str());
+        for (const kfd::StageColumn& c : st.columns)
+            std::printf("  column   %-20s %s\n", c.name.c_str(), c.help.c_str());
+        for (const kfd::StageCounter& c : st.counters)
+            std::printf("  counter  %-24s %s%s\n", c.name.c_str(), c.help.c_str(),
+                        c.kept_only ? "" : " (every scan it ran on)");
+    }
+}
+
 // --list-keys: one key a line, with its two defaults, its range and its meaning (unit).
 void printKeys() {
     const auto& keys = kfd::configKeys();
@@ -210,7 +210,7 @@ void printWindowSuggestion(const std::vector<double>& a) {
 // kfd-filter's flags beyond RawlogFilterOptions.
 struct Flags {
     std::string config;
-    bool print_config = false, list_keys = false, list = false;
+    bool print_config = false, list_keys = false, list_columns = false, list = false;
     std::vector<double> window;
     std::string compression = "input", removed_as = "nan";
 };
@@ -258,6 +258,9 @@ void addConfigOptions(kfd::app::Cli& cli, kfd::RawlogFilterOptions& opts, Flags&
     cli.flag("--list-keys", f.list_keys,
              "list every configuration key with its defaults, range and\n"
              "meaning, then exit");
+    cli.flag("--list-columns", f.list_columns,
+             "list the per-scan CSV's columns and the counters each stage\n"
+             "declares, with their meaning, then exit");
     cli.option("--suggest-window", f.window,
                "Formulas 4-5: suggest the window m for speed V (m/s) and\n"
                "scan rate F (Hz), then exit",
@@ -268,6 +271,7 @@ void addConfigOptions(kfd::app::Cli& cli, kfd::RawlogFilterOptions& opts, Flags&
 // The run: one of the listing and printing flags, or the log filtered and its summary.
 void run(kfd::app::Cli& cli, kfd::RawlogFilterOptions& opts, const Flags& f) {
     if (f.list_keys) return printKeys();
+    if (f.list_columns) return printColumns();
     if (!f.window.empty()) return printWindowSuggestion(f.window);
     if (f.list) {
         if (opts.input.empty()) throw kfd::app::UsageError("--list: no input log (-i)");

@@ -26,24 +26,23 @@ void asScanCsvError(Fn&& fn) {
 
 }  // namespace
 
-void ScanCsvWriter::open(const std::string& path, const std::string& name) {
+void ScanCsvWriter::open(const std::string& path, const std::string& name,
+                         const std::vector<std::string>& stage_columns) {
     asScanCsvError([&] {
         out_.emplace(path, name);
-        *out_ << "index,timestamp,sensor,kept,reason,p_common,p_threshold,references,points_in,"
-                 "removed_range,clusters,noise_clusters,removed_noise,points_out,microseconds,"
-                 "view_change,changed_fraction,degeneracy,corridor,denoise_bound,odometry_check,"
-                 "icp_goodness,odom_x,odom_y,odom_phi,"
-                 "x,y,phi\n";
+        std::string header =
+            "index,timestamp,sensor,kept,reason,points_in,removed_noise,points_out,"
+            "microseconds";
+        for (const std::string& c : stage_columns) header += "," + c;
+        *out_ << header << ",icp_goodness,odom_x,odom_y,odom_phi,x,y,phi\n";
     });
 }
 
 void ScanCsvWriter::write(const ScanRecord& r, const std::optional<Pose2D>& pose) {
-    std::string line = format(
-        "%zu,%.6f,%s,%d,%s,%.6f,%.6f,%zu,%zu,%zu,%zu,%zu,%zu,%zu,%.2f,%.4f,%.4f,%.4f,%d,%s,%s",
-        r.index, stampForOutput(r.stamp), r.sensor.c_str(), r.kept ? 1 : 0, r.reason, r.p_common,
-        r.p_threshold, r.references, r.points_in, r.removed_range, r.clusters, r.noise_clusters,
-        r.removed_noise, r.points_out, r.microseconds, r.view_change, r.changed_fraction,
-        r.degeneracy, r.corridor ? 1 : 0, toString(r.denoise_bound), toString(r.odometry_check));
+    std::string line = format("%zu,%.6f,%s,%d,%s,%zu,%zu,%zu,%.2f", r.index,
+                              stampForOutput(r.stamp), r.sensor.c_str(), r.kept ? 1 : 0, r.reason,
+                              r.points_in, r.removed_noise, r.points_out, r.microseconds);
+    line += r.stage_cells;
     line += std::isnan(r.icp_goodness)
                 ? std::string(",")
                 : format(",%.4f%s", r.icp_goodness, r.icp_rejected ? "r" : "");

@@ -10,7 +10,6 @@
 #include "kfd/io/source.h"
 #include "kfd/mrpt/default_stages.h"
 #include "kfd/mrpt/scan_check.h"
-#include "kfd/paper/distance_filter.h"
 #include "kfd/pipeline/format.h"
 #include "kfd/stages/denoise_result.h"
 
@@ -52,6 +51,8 @@ StreamFilter::StreamFilter(const Pipeline::Params& params, StageFactory extra,
     : params_(params), extra_(std::move(extra)) {
     // Validated now, not at the first scan; the first sensor takes this pipeline.
     spare_ = std::make_unique<Pipeline>(params_, defaultStageRegistry());
+    outputs_ = StageOutputs(params_.stages, defaultStageRegistry());
+    counters_.stage_totals = outputs_.zeroTotals();
     if (!one_scan_latency)
         for (const auto& stage : spare_->stages())
             if (stage->defers())
@@ -93,6 +94,7 @@ StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
         rec.stamp = stampOf(obs);
         rec.reason = skippedReason(check.reject);
         rec.points_in = obs.getScanSize();
+        rec.stage_cells = outputs_.cells(nullptr);
         ++counters_.scans_skipped;
         ++counters_.skipped_by_reason[static_cast<std::size_t>(check.reject)];
         return res;
@@ -208,70 +210,44 @@ std::size_t StreamFilter::pendingCount() const {
 void StreamFilter::record(StreamResult& res) {
     const ScanReport& rep = res.report;
     ScanRecord& rec = res.record;
-    const auto* kf = rep.find<KeyframeDecision>();
-    const auto d = rep.findOrDefault<DistanceFilter::Result>();
-    const auto n = rep.findOrDefault<DenoiseResult>();
-    if (kf) {
+    if (const auto* kf = rep.find<KeyframeDecision>()) {
         rec.reason = toString(kf->reason);
-        rec.p_common = kf->p_common;
-        rec.p_threshold = kf->p_threshold;
-        rec.references = kf->references;
-        rec.view_change = kf->view_change;
-        rec.changed_fraction = kf->changed_fraction;
-        rec.degeneracy = kf->degeneracy;
-        rec.corridor = kf->corridor;
-        rec.corridor_keyframe = kf->reason == KeyframeReason::Corridor;
     } else {  // no keyframe stage: "kept", or the stage that dropped the scan
         rec.reason = "kept";
         for (const StageReport& sr : rep)
             if (sr.dropped) rec.reason = sr.name;
     }
     rec.points_in = rep.points_in;
-    rec.removed_range = d.removed_non_finite + d.removed_out_of_range;
-    rec.clusters = n.clusters;
-    rec.noise_clusters = n.noise_clusters;
     rec.removed_noise = rep.noiseRemoved();
-    if (const auto* o = rep.find<OdometryCheck::Result>()) {
-        rec.odometry_check = o->verdict;
-        counters_.scans_odometry_frozen += o->verdict == OdometryVerdict::Frozen;
-        counters_.scans_odometry_jump += o->verdict == OdometryVerdict::Jump;
-    }
-    rec.denoise_bound = n.capped             ? DenoiseBound::Capped
-                        : n.stale_references ? DenoiseBound::StaleReferences
-                        : n.confirmed        ? DenoiseBound::Confirmed
-                                             : DenoiseBound::None;
     rec.points_out = rep.points_out;
     rec.microseconds = rep.microseconds;
+    rec.stage_cells = outputs_.cells(&rep);
     count(res);
 }
 
-// The counters of a recorded scan.
+// The counters of a recorded scan: the door's own, then the listed stages' declared ones.
 void StreamFilter::count(const StreamResult& res) {
     const ScanReport& rep = res.report;
     const ScanRecord& rec = res.record;
     ScanCounters& c = counters_;
     c.stamps_backwards += res.stamp_backwards ? 1 : 0;
     c.geometry_resets += res.geometry_reset ? 1 : 0;
-    c.scans_corridor += rec.corridor ? 1 : 0;
-    c.keyframes_corridor += rec.corridor_keyframe ? 1 : 0;
     c.points_in += rep.points_in;
     c.filter_seconds += rep.microseconds * 1e-6;
-    if (res.keep) {
-        ++c.scans_kept;
-        c.points_removed_range += rec.removed_range;
-        c.points_removed_noise += rec.removed_noise;
-        c.scans_denoise_stale += rec.denoise_bound == DenoiseBound::StaleReferences;
-        c.scans_denoise_capped += rec.denoise_bound == DenoiseBound::Capped;
-        c.scans_denoise_confirmed += rec.denoise_bound == DenoiseBound::Confirmed;
-        const std::size_t usable = rep.points_in - rec.removed_range;
-        if (usable > 0)
-            c.max_removed_noise_share =
-                std::max(c.max_removed_noise_share,
-                         static_cast<double>(rec.removed_noise) / static_cast<double>(usable));
-        c.points_removed += rep.points_in - rep.points_out;
-    } else {
+    outputs_.count(rep, c.stage_totals);
+    if (!res.keep) {
         ++c.scans_dropped;
+        return;
     }
+    ++c.scans_kept;
+    c.points_removed_noise += rec.removed_noise;
+    // The share of the returns the denoisers saw (what the other stages left valid).
+    const std::size_t usable = rep.points_out + rec.removed_noise;
+    if (usable > 0)
+        c.max_removed_noise_share =
+            std::max(c.max_removed_noise_share,
+                     static_cast<double>(rec.removed_noise) / static_cast<double>(usable));
+    c.points_removed += rep.points_in - rep.points_out;
 }
 
 std::string noUsableScan(const ScanCounters& c, const SourceCounters& source,

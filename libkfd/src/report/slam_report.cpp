@@ -84,9 +84,7 @@ std::string reportMarkdown(const IcpSlamSummary& sum,
             r += format("%s %.3f", i ? "," : "", sum.lost_track_stamps[i]);
         r += sum.lost_track_stamps.size() > 10 ? ", ... s\n" : " s\n";
     }
-    if (sum.scans_corridor)
-        r += "- corridor switch: " + plural(sum.scans_corridor, "scan") +
-             " degenerate (orange in the figure)\n";
+    for (const std::string& line : stageCounterLines(sum.stage_totals)) r += "- " + line + "\n";
     if (sum.ate_rmse) r += format("- ATE RMSE after SE(2) alignment: %.4f m\n", *sum.ate_rmse);
     if (sum.relations) {
         const auto& a = *sum.relations;
@@ -230,7 +228,6 @@ void scansJson(Json& j, const IcpSlamSummary& s) {
     j["scans_in"] = s.scans_in;
     j["scans_kept"] = s.scans_kept;
     j["dropped_pct"] = s.dropped_pct;
-    j["scans_corridor"] = s.scans_corridor;
     j["scans_skipped"] = s.scans_skipped;  // kfd::checkScan: bad geometry, never reached ICP
     {
         nlohmann::ordered_json by_reason = nlohmann::ordered_json::object();
@@ -266,11 +263,12 @@ void icpJson(Json& j, const IcpSlamSummary& s) {
 
 // The pre-filter's own counters and times, the matched drop rates, the scans before the run.
 void prefilterJson(Json& j, const IcpSlamSummary& s) {
-    j["scans_odometry_frozen"] = s.scans_odometry_frozen;
-    j["scans_odometry_jump"] = s.scans_odometry_jump;
-    j["scans_denoise_stale"] = s.scans_denoise_stale;
-    j["scans_denoise_capped"] = s.scans_denoise_capped;
-    j["scans_denoise_confirmed"] = s.scans_denoise_confirmed;
+    for (const StageTotal& t : s.stage_totals) {  // the listed stages' declared counters
+        if (t.value == std::floor(t.value) && std::fabs(t.value) < 9e15)
+            j[t.name] = static_cast<long long>(t.value);
+        else
+            j[t.name] = t.value;
+    }
     j["prefilter_us_per_scan"] = s.prefilter_us_per_scan;
     j["icp_ms_per_scan"] = s.icp_ms_per_scan;
     j["icp_ms_per_kept_scan"] = s.icp_ms_per_kept_scan;

@@ -43,4 +43,12 @@ bool endDenoising(const Clusters& c, DenoiseResult& r, StageReport& report) {
     return true;
 }
 
+std::vector<StageColumn> denoiseColumns() {
+    using R = DenoiseResult;
+    return {diagnosticColumn<R>("clusters", "the clusters the denoising stage found", "%zu",
+                                [](const R& r) { return r.clusters; }),
+            diagnosticColumn<R>("noise_clusters", "the clusters it removed as noise", "%zu",
+                                [](const R& r) { return r.noise_clusters; })};
+}
+
 }  // namespace kfd

@@ -44,4 +44,6 @@ bool DenoiseStage::process(Scan& scan, StageReport& report, const ScanReport&) {
     return endDenoising(clusters_, res, report);
 }
 
+std::vector<StageColumn> DenoiseStage::columns() { return denoiseColumns(); }
+
 }  // namespace kfd

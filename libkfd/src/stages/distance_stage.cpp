@@ -39,4 +39,20 @@ bool DistanceStage::process(Scan& scan, StageReport& report, const ScanReport&) 
     return true;
 }
 
+std::vector<StageColumn> DistanceStage::columns() {
+    using R = DistanceFilter::Result;
+    return {diagnosticColumn<R>(
+        "removed_range",
+        "beams removed by Algorithm 1 (non-finite or outside the range "
+        "limits)",
+        "%zu", [](const R& r) { return r.removed_non_finite + r.removed_out_of_range; })};
+}
+
+std::vector<StageCounter> DistanceStage::counters() {
+    using R = DistanceFilter::Result;
+    return {diagnosticCounter<R>(
+        "points_removed_range", "points out of range removed from kept scans", true,
+        [](const R& r) { return r.removed_non_finite + r.removed_out_of_range; })};
+}
+
 }  // namespace kfd

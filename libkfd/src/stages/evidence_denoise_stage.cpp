@@ -69,4 +69,39 @@ bool EvidenceDenoiseStage::finish(Scan& scan, StageReport& report, const ScanRep
     return endDenoising(clusters_, res, report);
 }
 
+namespace {
+// How the bound on removal acted (EvidenceFilter step 5): "none", "stale_references" (temporal
+// evidence ignored), "capped" (cut to the bound) or "confirmed" (above it, confirmed by the scan
+// just before and removed whole).
+const char* boundOf(const DenoiseResult& r) {
+    return r.capped             ? "capped"
+           : r.stale_references ? "stale_references"
+           : r.confirmed        ? "confirmed"
+                                : "none";
+}
+}  // namespace
+
+std::vector<StageColumn> EvidenceDenoiseStage::columns() {
+    std::vector<StageColumn> c = denoiseColumns();
+    c.push_back(diagnosticColumn<DenoiseResult>(
+        "denoise_bound",
+        "how the bound on removal acted: none, stale_references, capped or confirmed", "%s",
+        boundOf));
+    return c;
+}
+
+std::vector<StageCounter> EvidenceDenoiseStage::counters() {
+    using R = DenoiseResult;
+    return {diagnosticCounter<R>(
+                "scans_denoise_stale", "kept scans whose references were stale (spatial only)",
+                true, [](const R& r) { return std::string(boundOf(r)) == "stale_references"; }),
+            diagnosticCounter<R>("scans_denoise_capped",
+                                 "kept scans whose removal was cut to the bound", true,
+                                 [](const R& r) { return r.capped; }),
+            diagnosticCounter<R>(
+                "scans_denoise_confirmed",
+                "kept scans above the bound, confirmed by the scan just before (all removed)", true,
+                [](const R& r) { return std::string(boundOf(r)) == "confirmed"; })};
+}
+
 }  // namespace kfd

@@ -25,4 +25,15 @@ bool KeyframeStage::process(Scan& scan, StageReport& report, const ScanReport&) 
     return d.keyframe;
 }
 
+std::vector<StageColumn> KeyframeStage::columns() {
+    using D = KeyframeDecision;
+    return {diagnosticColumn<D>("p_common",
+                                "P_common, the product of the clamped correlations (Formula 3)",
+                                "%.6f", [](const D& d) { return d.p_common; }),
+            diagnosticColumn<D>("p_threshold", "P_pair^k, the threshold P_common is held to",
+                                "%.6f", [](const D& d) { return d.p_threshold; }),
+            diagnosticColumn<D>("references", "k, the keyframes compared against (<= window)",
+                                "%zu", [](const D& d) { return d.references; })};
+}
+
 }  // namespace kfd

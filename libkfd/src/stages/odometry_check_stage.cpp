@@ -21,4 +21,22 @@ bool OdometryCheckStage::process(Scan& scan, StageReport& report, const ScanRepo
     return true;
 }
 
+std::vector<StageColumn> OdometryCheckStage::columns() {
+    using R = OdometryCheck::Result;
+    return {diagnosticColumn<R>("odometry_check",
+                                "the verdict: none (no odometry), ok, frozen or jump (withheld "
+                                "from the stages)",
+                                "%s", [](const R& r) { return toString(r.verdict); })};
+}
+
+std::vector<StageCounter> OdometryCheckStage::counters() {
+    using R = OdometryCheck::Result;
+    return {diagnosticCounter<R>("scans_odometry_frozen",
+                                 "scans whose odometry stood still as they changed", false,
+                                 [](const R& r) { return r.verdict == OdometryVerdict::Frozen; }),
+            diagnosticCounter<R>("scans_odometry_jump",
+                                 "scans whose odometry jumped where they did not", false,
+                                 [](const R& r) { return r.verdict == OdometryVerdict::Jump; })};
+}
+
 }  // namespace kfd

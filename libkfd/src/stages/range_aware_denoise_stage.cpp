@@ -47,4 +47,6 @@ bool RangeAwareDenoiseStage::process(Scan& scan, StageReport& report, const Scan
     return endDenoising(clusters_, res, report);
 }
 
+std::vector<StageColumn> RangeAwareDenoiseStage::columns() { return denoiseColumns(); }
+
 }  // namespace kfd

@@ -58,4 +58,30 @@ bool ViewKeyframeStage::process(Scan& scan, StageReport& report, const ScanRepor
     return d.keyframe;
 }
 
+std::vector<StageColumn> ViewKeyframeStage::columns() {
+    using D = KeyframeDecision;
+    return {diagnosticColumn<D>("references", "keyframes compared against (1 once there is one)",
+                                "%zu", [](const D& d) { return d.references; }),
+            diagnosticColumn<D>("view_change",
+                                "RMS displacement of the view since the keyframe, in tolerances",
+                                "%.4f", [](const D& d) { return d.view_change; }),
+            diagnosticColumn<D>("changed_fraction",
+                                "laser only: the share of common returns that changed", "%.4f",
+                                [](const D& d) { return d.changed_fraction; }),
+            diagnosticColumn<D>("degeneracy",
+                                "lambda_min / lambda_max of the normals' information (1: none)",
+                                "%.4f", [](const D& d) { return d.degeneracy; }),
+            diagnosticColumn<D>("corridor", "1: the corridor switch found the scan degenerate",
+                                "%d", [](const D& d) { return d.corridor ? 1 : 0; })};
+}
+
+std::vector<StageCounter> ViewKeyframeStage::counters() {
+    using D = KeyframeDecision;
+    return {diagnosticCounter<D>("scans_corridor", "scans the corridor switch found degenerate",
+                                 false, [](const D& d) { return d.corridor; }),
+            diagnosticCounter<D>("keyframes_corridor",
+                                 "keyframes the corridor switch made (odometry or time)", false,
+                                 [](const D& d) { return d.reason == KeyframeReason::Corridor; })};
+}
+
 }  // namespace kfd

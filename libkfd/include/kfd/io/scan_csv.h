@@ -3,6 +3,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "kfd/mrpt/scan_record.h"
 #include "kfd/os/output_paths.h"
@@ -17,33 +18,32 @@ class ScanCsvError : public Error {
     using Error::Error;
 };
 
-/// Writes ScanRecords as CSV rows, one per scan, under this header (the one column set):
+/// Writes ScanRecords as CSV rows, one per scan, under this header:
 ///
-///     index,timestamp,sensor,kept,reason,p_common,p_threshold,references,points_in,
-///     removed_range,clusters,noise_clusters,removed_noise,points_out,microseconds,
-///     view_change,changed_fraction,degeneracy,corridor,denoise_bound,odometry_check,icp_goodness,odom_x,odom_y,odom_phi,
-///     x,y,phi
+///     index,timestamp,sensor,kept,reason,points_in,removed_noise,points_out,microseconds,
+///     <the listed stages' columns>,icp_goodness,odom_x,odom_y,odom_phi,x,y,phi
 ///
-/// index, timestamp (s, 0 when unknown), sensor, kept (1/0) and reason as in ScanRecord;
-/// p_common, p_threshold, references: the keyframe stage's Formula 3 values (0 without it);
-/// points_in, removed_range, clusters, noise_clusters, removed_noise, points_out: beams and
-/// clusters; microseconds: the pipeline's time; view_change, changed_fraction, degeneracy,
-/// corridor (1/0): the view selector and corridor switch; denoise_bound: "none", or how the
-/// evidence denoiser's bound on removal acted ("stale_references": temporal evidence ignored,
-/// "capped": cut to the bound, "confirmed": above it, confirmed by the scan just before and
-/// removed whole); odometry_check: "none" (no odometry or no check), "ok",
-/// "frozen" or "jump" (kfd/algorithms/odometry_check.h: withheld from the stages); icp_goodness:
-/// kfd-icp-slam, ICP's goodness when it corrected this scan's pose (0-1; "r" appended when the
-/// map builder rejected the correction), else empty; odom_x, odom_y, odom_phi: the odometry
-/// the scan came with (m, m, rad; empty when unknown or --laser-only); x, y, phi: the SLAM's pose
-/// of the scan (kfd-icp-slam; empty in kfd-filter). A skipped scan's reason is
-/// "skipped:<why>", its points_in its beam count, its other numbers 0 and degeneracy 1.
+/// The door's columns: index, timestamp (s, 0 when unknown), sensor, kept (1/0) and reason as
+/// in ScanRecord; points_in, removed_noise (by the denoising stages), points_out: valid beams;
+/// microseconds: the pipeline's time. Then each listed stage's own columns, in pipeline
+/// order, as the stage declares them (`kfd-filter --list-columns` prints them with their
+/// meaning; kfd/pipeline/stage_outputs.h): e.g. removed_range (distance), p_common,
+/// p_threshold, references (keyframe), view_change, changed_fraction, degeneracy, corridor
+/// (view_keyframe), clusters, noise_clusters (the denoising stages), denoise_bound
+/// (evidence_denoise), odometry_check (odometry_check). Then icp_goodness: kfd-icp-slam, ICP's
+/// goodness when it corrected this scan's pose (0-1; "r" appended when the map builder
+/// rejected the correction), else empty; odom_x, odom_y, odom_phi: the odometry the scan came
+/// with (m, m, rad; empty when unknown or --laser-only); x, y, phi: the SLAM's pose of the
+/// scan (kfd-icp-slam; empty in kfd-filter). A skipped scan's reason is "skipped:<why>", its
+/// points_in its beam count, its stage cells those of a stage that did not run.
 class ScanCsvWriter {
   public:
     /// Opens `path` for writing (kfd's checked OutputFile) and writes the header; `name` is the
     /// file users know (e.g. the final name of a temporary file). ScanCsvError when it cannot
     /// be written.
-    void open(const std::string& path, const std::string& name);
+    /// `stage_columns`: the door's StageOutputs::columns().
+    void open(const std::string& path, const std::string& name,
+              const std::vector<std::string>& stage_columns);
     bool isOpen() const { return out_ && out_->isOpen(); }
     /// One row; `pose` fills x, y, phi. ScanCsvError when the write fails.
     void write(const ScanRecord& r, const std::optional<Pose2D>& pose = std::nullopt);

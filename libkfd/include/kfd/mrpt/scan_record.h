@@ -7,26 +7,14 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "kfd/algorithms/odometry_check.h"
 #include "kfd/pipeline/scan.h"
+#include "kfd/pipeline/stage_outputs.h"
 
 namespace kfd {
-
-/// How the evidence denoiser's bound on removal acted on a scan (EvidenceFilter step 5).
-enum class DenoiseBound {
-    None,             // removed what the evidence said (within the bound)
-    StaleReferences,  // the references disagreed with too much of the scan: spatial only
-    Capped,           // even so above the bound: the smallest segments only
-    Confirmed,        // above the bound, but the raw scan just before confirmed it: all removed
-};
-/// "none", "stale_references", "capped", "confirmed".
-inline const char* toString(DenoiseBound b) {
-    return b == DenoiseBound::Capped            ? "capped"
-           : b == DenoiseBound::StaleReferences ? "stale_references"
-           : b == DenoiseBound::Confirmed       ? "confirmed"
-                                                : "none";
-}
 
 /// One scan as the door saw it: the row of the per-scan CSV (kfd/io/scan_csv.h documents
 /// the columns). A skipped scan (bad geometry) has `skipped` set, points_in = its beam count
@@ -37,25 +25,15 @@ struct ScanRecord {
     std::string sensor;     // the scan's sensor label
     bool kept = false;      // a keyframe: the scan goes on (to the output, to ICP)
     ScanSkipReason skipped = ScanSkipReason::None;  // not None: bad geometry, never ran
-    const char* reason = "";  // keyframe reason ("view_change", "similar", ...), else "kept"
-                              // or the stage that dropped it, or "skipped:<why>" (static text)
-    double p_common = 0.0;    // the keyframe stage's P_common (Formula 3); 0 without it
-    double p_threshold = 0.0;
-    std::size_t references = 0;
-    std::size_t points_in = 0;      // valid beams entering the pipeline
-    std::size_t removed_range = 0;  // by Algorithm 1 (non-finite or outside the range limits)
-    std::size_t clusters = 0;       // the denoiser's clusters (0 when it did not run)
-    std::size_t noise_clusters = 0;
-    std::size_t removed_noise = 0;  // by the denoising stages
+    const char* reason = "";    // keyframe reason ("view_change", "similar", ...), else "kept"
+                                // or the stage that dropped it, or "skipped:<why>" (static text)
+    std::size_t points_in = 0;  // valid beams entering the pipeline
+    std::size_t removed_noise = 0;  // by the denoising stages (StageReport::noise)
     std::size_t points_out = 0;     // valid beams leaving the pipeline
     double microseconds = 0.0;      // time in the pipeline's stages
-    double view_change = 0.0;       // the view selector's measures (kfd/algorithms/view_selector.h)
-    double changed_fraction = 0.0;
-    double degeneracy = 1.0;
-    bool corridor = false;           // the corridor switch found the scan degenerate
-    bool corridor_keyframe = false;  // ... and made it a keyframe by odometry or time
-    DenoiseBound denoise_bound = DenoiseBound::None;         // the evidence denoiser's bound acted
-    OdometryVerdict odometry_check = OdometryVerdict::None;  // the odometry check's verdict
+    /// The listed stages' own columns, ",cell,cell,...": what each stage declares
+    /// (kfd/pipeline/stage_outputs.h; StreamFilter::outputs() reads a cell by name).
+    std::string stage_cells;
     std::optional<Pose2D> odometry;  // the odometry the door was given, after its check
     /// kfd-icp-slam: ICP's goodness when the map builder corrected this (kept) scan's pose,
     /// else NaN; icp_rejected when the builder rejected that correction (below its minimum).
@@ -73,24 +51,20 @@ struct ScanCounters {
     /// outputs like a non-keyframe, not counted in scans_dropped.
     std::size_t scans_skipped = 0;
     std::size_t skipped_by_reason[kScanSkipReasons] = {};  // indexed by ScanSkipReason
-    std::size_t beams_bad_range = 0;     // beams marked invalid: NaN, +-inf, negative, huge range
-    std::size_t odometry_bad = 0;        // scans whose odometry was not finite (used as unknown)
-    std::size_t stamps_backwards = 0;    // scans stamped before their sensor's previous scan
-    std::size_t geometry_resets = 0;     // a sensor's geometry changed: its state was reset
-    std::size_t scans_corridor = 0;      // scans the corridor switch found degenerate
-    std::size_t keyframes_corridor = 0;  // keyframes the switch made (odometry or time)
-    std::size_t scans_odometry_frozen = 0;  // scans whose odometry stood still as they changed
-    std::size_t scans_odometry_jump = 0;    // scans whose odometry jumped where they did not
-    std::size_t scans_denoise_stale = 0;    // kept scans whose denoiser found its references stale
-    std::size_t scans_denoise_capped = 0;   // kept scans whose removal was cut to the bound
-    std::size_t scans_denoise_confirmed = 0;  // kept scans above the bound, confirmed (all removed)
+    std::size_t beams_bad_range = 0;   // beams marked invalid: NaN, +-inf, negative, huge range
+    std::size_t odometry_bad = 0;      // scans whose odometry was not finite (used as unknown)
+    std::size_t stamps_backwards = 0;  // scans stamped before their sensor's previous scan
+    std::size_t geometry_resets = 0;   // a sensor's geometry changed: its state was reset
     /// The largest share of a kept scan's valid returns the denoising stages removed (0-1).
     double max_removed_noise_share = 0.0;
     std::size_t points_in = 0;             // valid beams of the scans that ran
-    std::size_t points_removed_range = 0;  // by Algorithm 1, in kept scans
     std::size_t points_removed_noise = 0;  // by the denoising stages, in kept scans
     std::size_t points_removed = 0;        // points_in - points_out over the kept scans
     double filter_seconds = 0.0;           // time inside the pipeline's stages
+    /// The listed stages' own counters (kfd/pipeline/stage_outputs.h), in pipeline order.
+    std::vector<StageTotal> stage_totals;
+    /// The stage counter called `name`, 0 when no listed stage declares it.
+    double stageTotal(std::string_view name) const { return totalOf(stage_totals, name); }
 
     /// Dropped and skipped scans, in % of scans_in.
     double notKeptPercent() const {

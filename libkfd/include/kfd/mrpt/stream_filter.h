@@ -119,6 +119,9 @@ class StreamFilter {
     /// What every call so far added up to (the figures of kfd-filter's and kfd-icp-slam's
     /// summaries).
     const ScanCounters& counters() const { return counters_; }
+    /// The listed stages' declared outputs: the per-scan CSV's stage columns (ScanCsvWriter),
+    /// a record's cell by name (`outputs().cell(record.stage_cells, "corridor")`).
+    const StageOutputs& outputs() const { return outputs_; }
 
     /// Laser only: the odometry given to process() is ignored (kfd decides from the scans
     /// alone; what --laser-only sets in every tool that reads logs).
@@ -178,6 +181,7 @@ class StreamFilter {
     Scan spare_scan_;                    // the next scan's buffer (swapped with its sensor's)
     std::deque<StreamResult> finished_;  // finished pending scans, oldest first
     ScanCounters counters_;
+    StageOutputs outputs_;  // of params_.stages
     bool laser_only_ = false;
 };
 

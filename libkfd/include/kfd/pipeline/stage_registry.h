@@ -7,19 +7,34 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <typeinfo>
 #include <vector>
 
 #include "kfd/pipeline/error.h"
 #include "kfd/pipeline/stage.h"
+#include "kfd/pipeline/stage_outputs.h"
 
 namespace kfd {
 
+namespace detail {
+template <class S, class = void>
+struct DeclaresColumns : std::false_type {};
+template <class S>
+struct DeclaresColumns<S, std::void_t<decltype(S::columns())>> : std::true_type {};
+template <class S, class = void>
+struct DeclaresCounters : std::false_type {};
+template <class S>
+struct DeclaresCounters<S, std::void_t<decltype(S::counters())>> : std::true_type {};
+}  // namespace detail
+
 /// Everything the registry knows about one stage.
 struct StageInfo {
-    std::string name;            // e.g. "keyframe", as listed in Pipeline::Params::stages
-    std::string help;            // one line
-    std::vector<StageKey> keys;  // its configuration keys, in documentation order
+    std::string name;                    // e.g. "keyframe", as listed in Pipeline::Params::stages
+    std::string help;                    // one line
+    std::vector<StageKey> keys;          // its configuration keys, in documentation order
+    std::vector<StageColumn> columns;    // its per-scan CSV columns (kfd/pipeline/stage_outputs.h)
+    std::vector<StageCounter> counters;  // its counters of a run
     std::function<std::unique_ptr<StageParams>()> defaults;  // its Params, default values
     /// Validates parameters of this stage (kfd::ParameterError naming the Params field).
     std::function<void(const StageParams&)> validate;
@@ -60,7 +75,9 @@ class StageRegistry {
   public:
     /// Registers stage class S, which provides: static constexpr const char* kName, kHelp;
     /// a copyable `Params` struct; static std::vector<StageKey> keys(); and a constructor
-    /// S(const Params&) that throws kfd::ParameterError on invalid parameters.
+    /// S(const Params&) that throws kfd::ParameterError on invalid parameters; optionally its
+    /// outputs: static std::vector<StageColumn> columns() and std::vector<StageCounter>
+    /// counters().
     template <class S>
     void add() {
         using P = typename S::Params;
@@ -68,6 +85,8 @@ class StageRegistry {
         info.name = S::kName;
         info.help = S::kHelp;
         info.keys = S::keys();
+        if constexpr (detail::DeclaresColumns<S>::value) info.columns = S::columns();
+        if constexpr (detail::DeclaresCounters<S>::value) info.counters = S::counters();
         info.defaults = [] { return std::make_unique<StageParamsOf<P>>(); };
         info.validate = [](const StageParams& p) { S check(paramsOf<P>(p, S::kName)); };
         info.create = [](const StageParams& p) -> std::unique_ptr<Stage> {

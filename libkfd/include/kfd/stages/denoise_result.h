@@ -4,10 +4,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "kfd/paper/clusters.h"
 #include "kfd/pipeline/scan.h"
 #include "kfd/pipeline/stage.h"
+#include "kfd/pipeline/stage_outputs.h"
 
 namespace kfd {
 
@@ -49,5 +51,8 @@ DenoiseResult startDenoising(Scan& scan, DenoiseVariant variant);
 /// Its end: the clusters counted, the removals reported as noise, `r` kept as the stage's
 /// diagnostics. Returns true (a denoising stage never drops a scan).
 bool endDenoising(const Clusters& c, DenoiseResult& r, StageReport& report);
+
+/// The per-scan columns every denoising stage declares: clusters, noise_clusters.
+std::vector<StageColumn> denoiseColumns();
 
 }  // namespace kfd

@@ -8,6 +8,7 @@
 #include "kfd/paper/clusters.h"
 #include "kfd/paper/ring_clustering.h"
 #include "kfd/pipeline/stage.h"
+#include "kfd/pipeline/stage_outputs.h"
 #include "kfd/stages/denoise_result.h"
 
 namespace kfd {
@@ -27,6 +28,8 @@ class DenoiseStage : public Stage {
     };
     /// Keys: rings, ring_r_max, angle_gap_factor, merge_distance_m, m_threshold.
     static std::vector<StageKey> keys();
+    /// Its per-scan CSV columns (kfd/pipeline/stage_outputs.h).
+    static std::vector<StageColumn> columns();
 
     DenoiseStage();  // Params{}
     explicit DenoiseStage(const Params& p);

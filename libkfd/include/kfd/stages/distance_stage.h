@@ -5,6 +5,7 @@
 
 #include "kfd/paper/distance_filter.h"
 #include "kfd/pipeline/stage.h"
+#include "kfd/pipeline/stage_outputs.h"
 
 namespace kfd {
 
@@ -17,6 +18,10 @@ class DistanceStage : public Stage {
     using Params = DistanceFilter::Params;
     /// Keys: min_range, max_range.
     static std::vector<StageKey> keys();
+    /// Its per-scan CSV columns (kfd/pipeline/stage_outputs.h).
+    static std::vector<StageColumn> columns();
+    /// Its counters of a run (summaries, summary.json).
+    static std::vector<StageCounter> counters();
 
     explicit DistanceStage(const Params& p = {}) : algo_(p) {}
     const char* name() const override { return kName; }

@@ -7,6 +7,7 @@
 #include "kfd/algorithms/evidence_filter.h"
 #include "kfd/paper/clusters.h"
 #include "kfd/pipeline/stage.h"
+#include "kfd/pipeline/stage_outputs.h"
 #include "kfd/stages/denoise_result.h"
 
 namespace kfd {
@@ -26,6 +27,10 @@ class EvidenceDenoiseStage : public Stage {
     /// temporal, pose_trans_error_m, pose_rot_error_deg, motion_error_fraction,
     /// max_removed_fraction, max_confirmed_fraction, confirm_support, temporal_scans, next_scan.
     static std::vector<StageKey> keys();
+    /// Its per-scan CSV columns (kfd/pipeline/stage_outputs.h).
+    static std::vector<StageColumn> columns();
+    /// Its counters of a run (summaries, summary.json).
+    static std::vector<StageCounter> counters();
 
     explicit EvidenceDenoiseStage(const Params& p = {}) : filter_(p) {}
     const char* name() const override { return kName; }

@@ -5,6 +5,7 @@
 
 #include "kfd/algorithms/keyframe_selector.h"
 #include "kfd/pipeline/stage.h"
+#include "kfd/pipeline/stage_outputs.h"
 
 namespace kfd {
 
@@ -21,6 +22,8 @@ class KeyframeStage : public Stage {
     /// Keys: bins, window, p_pair, and the guards max_consecutive_drops, max_interval_s,
     /// max_translation_m, max_rotation_deg.
     static std::vector<StageKey> keys();
+    /// Its per-scan CSV columns (kfd/pipeline/stage_outputs.h).
+    static std::vector<StageColumn> columns();
 
     explicit KeyframeStage(const Params& p = {}) : algo_(p) {}
     const char* name() const override { return kName; }

@@ -6,6 +6,7 @@
 
 #include "kfd/algorithms/odometry_check.h"
 #include "kfd/pipeline/stage.h"
+#include "kfd/pipeline/stage_outputs.h"
 
 namespace kfd {
 
@@ -20,6 +21,10 @@ class OdometryCheckStage : public Stage {
     using Params = OdometryCheck::Params;
     /// Keys: frozen_changed_fraction, jump_margin.
     static std::vector<StageKey> keys();
+    /// Its per-scan CSV columns (kfd/pipeline/stage_outputs.h).
+    static std::vector<StageColumn> columns();
+    /// Its counters of a run (summaries, summary.json).
+    static std::vector<StageCounter> counters();
 
     explicit OdometryCheckStage(const Params& p = {}) : algo_(p) {}
     const char* name() const override { return kName; }

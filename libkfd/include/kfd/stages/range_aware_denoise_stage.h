@@ -7,6 +7,7 @@
 #include "kfd/algorithms/range_aware_clustering.h"
 #include "kfd/paper/clusters.h"
 #include "kfd/pipeline/stage.h"
+#include "kfd/pipeline/stage_outputs.h"
 #include "kfd/stages/denoise_result.h"
 
 namespace kfd {
@@ -26,6 +27,8 @@ class RangeAwareDenoiseStage : public Stage {
     /// Keys: angle_gap_factor, jump_lambda_deg, jump_sigma_m, m_threshold, min_object_size_m,
     /// min_points_floor.
     static std::vector<StageKey> keys();
+    /// Its per-scan CSV columns (kfd/pipeline/stage_outputs.h).
+    static std::vector<StageColumn> columns();
 
     RangeAwareDenoiseStage();  // Params{}
     explicit RangeAwareDenoiseStage(const Params& p);

@@ -5,6 +5,7 @@
 
 #include "kfd/algorithms/view_keyframe_selector.h"
 #include "kfd/pipeline/stage.h"
+#include "kfd/pipeline/stage_outputs.h"
 
 namespace kfd {
 
@@ -21,6 +22,10 @@ class ViewKeyframeStage : public Stage {
     /// change_tolerance_m, change_tolerance_ratio, max_changed_fraction, degeneracy_ratio,
     /// corridor_translation_m, corridor_rotation_deg, corridor_interval_s, and the guards.
     static std::vector<StageKey> keys();
+    /// Its per-scan CSV columns (kfd/pipeline/stage_outputs.h).
+    static std::vector<StageColumn> columns();
+    /// Its counters of a run (summaries, summary.json).
+    static std::vector<StageCounter> counters();
 
     explicit ViewKeyframeStage(const Params& p = {}) : algo_(p) {}
     const char* name() const override { return kName; }
