@@ -181,21 +181,25 @@ TEST(IcpSlamRunner, ScansCsvIsTheDoorsRecordWithThePose) {
     ASSERT_FALSE(slam.empty());
     ASSERT_FALSE(filter.empty());
     EXPECT_EQ(slam[0], filter[0]);  // one column set
-    // The door's 9 columns, the default pipeline's stages' 10 declared ones, ICP's and the
-    // poses' 7.
-    ASSERT_EQ(slam[0].size(), 26u);
-    EXPECT_EQ(slam[0][3], "kept");
-    EXPECT_EQ(slam[0][9], "odometry_check");  // the first stage's first column
-    EXPECT_EQ(slam[0][19], "icp_goodness");
-    EXPECT_EQ(slam[0][23], "x");
+    // Columns by name: the door's, the listed stages' declared ones, ICP's and the poses'.
+    const auto col = [&](const std::string& name) {
+        const auto it = std::find(slam[0].begin(), slam[0].end(), name);
+        EXPECT_NE(it, slam[0].end()) << name;
+        return static_cast<std::size_t>(it - slam[0].begin());
+    };
+    const std::size_t n = slam[0].size(), kept_col = col("kept"), goodness = col("icp_goodness"),
+                      x = col("x");
+    EXPECT_EQ(kept_col, 3u);
+    EXPECT_EQ(col("odometry_check"), 9u);  // the first stage's first column
+    EXPECT_EQ(x, n - 3);
     std::size_t kept = 0, corrected = 0, rejected = 0;
     for (std::size_t i = 1; i < slam.size(); ++i) {
-        ASSERT_EQ(slam[i].size(), 26u) << i;
-        kept += slam[i][3] == "1";
-        EXPECT_FALSE(slam[i][23].empty()) << i;  // the SLAM pose
-        const std::string& g = slam[i][19];
+        ASSERT_EQ(slam[i].size(), n) << i;
+        kept += slam[i][kept_col] == "1";
+        EXPECT_FALSE(slam[i][x].empty()) << i;  // the SLAM pose
+        const std::string& g = slam[i][goodness];
         if (g.empty()) continue;
-        EXPECT_EQ(slam[i][3], "1") << i;  // only kept scans reach ICP
+        EXPECT_EQ(slam[i][kept_col], "1") << i;  // only kept scans reach ICP
         ++corrected;
         rejected += g.back() == 'r';
         const double v = std::stod(g);
@@ -214,9 +218,9 @@ TEST(IcpSlamRunner, ScansCsvIsTheDoorsRecordWithThePose) {
     EXPECT_GT(s.icp_goodness_median, 0.4);
     EXPECT_LE(s.icp_goodness_median, 1.05);
     for (std::size_t i = 1; i < filter.size(); ++i) {
-        ASSERT_EQ(filter[i].size(), 26u) << i;
-        EXPECT_TRUE(filter[i][23].empty()) << i;  // kfd-filter has no SLAM pose
-        EXPECT_TRUE(filter[i][19].empty()) << i;  // nor ICP
+        ASSERT_EQ(filter[i].size(), n) << i;
+        EXPECT_TRUE(filter[i][x].empty()) << i;         // kfd-filter has no SLAM pose
+        EXPECT_TRUE(filter[i][goodness].empty()) << i;  // nor ICP
     }
     EXPECT_EQ(filter.size(), f.scans_in + 1);
     // The same counters: the scans both drivers gave the door add up alike.
