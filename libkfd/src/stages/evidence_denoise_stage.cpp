@@ -87,6 +87,9 @@ std::vector<StageColumn> EvidenceDenoiseStage::columns() {
         "denoise_bound",
         "how the bound on removal acted: none, stale_references, capped or confirmed", "%s",
         boundOf));
+    c.push_back(diagnosticColumn<DenoiseResult>(
+        "sigma_mm", "the range noise the evidence used (mm; measured, then floored)", "%.2f",
+        [](const DenoiseResult& r) { return 1e3 * r.sigma; }));
     return c;
 }
 
