@@ -4,6 +4,7 @@
 #include <string>
 
 #include "common/cli.h"
+#include "common/config_cli.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/sim/denoise_quality.h"
 
@@ -32,8 +33,8 @@ int main(int argc, char** argv) {
     cli.flag("--laser-only", laser_only,
              "withhold the log's odometry from the pipeline (as from a LaserScan-only source)");
     return cli.run(argc, argv, [&] {
-        const auto q =
-            kfd::evaluateDenoising(rawlog, labels, kfd::loadConfigFile(config), laser_only);
+        const auto q = kfd::evaluateDenoising(
+            rawlog, labels, kfd::app::loadConfig(config, "kfd-denoise-eval"), laser_only);
         std::printf(
             "scans %zu (scored %zu kept of %zu), points %zu, noise %zu (isolated %zu, "
             "clustered %zu, edge %zu)\n",

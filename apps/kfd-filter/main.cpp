@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/cli.h"
+#include "common/config_cli.h"
 #include "common/source_cli.h"
 #include "kfd/io/rawlog_filter.h"
 #include "kfd/mrpt/config.h"
@@ -279,7 +280,7 @@ void run(kfd::app::Cli& cli, kfd::RawlogFilterOptions& opts, const Flags& f) {
     }
     opts.bag.removed = kfd::parseRemovedMark(f.removed_as);
     opts.bag.compression = kfd::parseBagCompression(f.compression);
-    opts.pipeline = f.config.empty() ? kfd::kfdDefaults() : kfd::loadConfigFile(f.config);
+    opts.pipeline = kfd::app::loadConfig(f.config, "kfd-filter");
     if (f.print_config) {
         std::fputs(kfd::toIni(opts.pipeline).c_str(), stdout);
         return;

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "common/cli.h"
+#include "common/config_cli.h"
 #include "common/source_cli.h"
 #include "kfd/io/open_source.h"
 #include "kfd/io/png_output.h"
@@ -192,8 +193,7 @@ int main(int argc, char** argv) {
             throw kfd::app::UsageError("give exactly one of --index and --time");
         kfd::app::checkOutputPaths({{"input log", o.in}, {"configuration", o.cfg}},
                                    {{"output image", o.out}});
-        const kfd::Pipeline::Params p =
-            o.cfg.empty() ? kfd::kfdDefaults() : kfd::loadConfigFile(o.cfg);
+        const kfd::Pipeline::Params p = kfd::app::loadConfig(o.cfg, "kfd-render");
         const Chosen c = chooseScans(o);
         kfd::Pipeline::Params drawn = p;
         drawn.stages = {"distance", denoisingStage(p)};

@@ -505,8 +505,11 @@ def compare_configs(out, mode, config_a, config_b):
 
 
 def kfd_key(config_path, key):
-    """The value of KEY in the [KFD] section of a kfd-icp-slam .ini (the last one given; a
-    trailing '# comment' cut), None when the file or the key is missing."""
+    """The value of KEY in a kfd-icp-slam .ini's kfd configuration: in a stage's section
+    [KFD.<stage>] (KEY "max_view_change", or "view_keyframe.max_view_change" for that stage's
+    only), or as a flat key of before in [KFD]; the last one given, a trailing '# comment' cut.
+    None when the file or the key is missing."""
+    stage, _, name = key.rpartition(".")
     value, section = None, None
     try:
         lines = open(config_path).read().splitlines()
@@ -516,9 +519,9 @@ def kfd_key(config_path, key):
         line = line.split("#", 1)[0].strip()
         if line.startswith("[") and line.endswith("]"):
             section = line[1:-1].strip()
-        elif section == "KFD" and "=" in line:
+        elif section and (section == "KFD" or section.startswith("KFD.")) and "=" in line:
             k, v = line.split("=", 1)
-            if k.strip() == key:
+            if k.strip() == name and (not stage or section == "KFD." + stage):
                 value = v.strip()
     return value
 
@@ -664,7 +667,8 @@ def build_parser():
     v.add_argument("--reference", required=True, metavar="MODE@CONFIG",
                    help="the runs every row is paired with (e.g. none@default: a mode that "
                    "ignores [KFD], run under one config)")
-    v.add_argument("--key", help="a [KFD] key whose value (from each config's .ini) is shown")
+    v.add_argument("--key", help="a kfd key whose value (from each config's .ini, [KFD.<stage>] or "
+                   "[KFD]) is shown; STAGE.KEY for one stage's")
     v.add_argument("--failure-factor", type=float, default=kfd_report.FAILURE_FACTOR,
                    metavar="F", help="a run fails when an error is above F x the reference's "
                    "median on its log")

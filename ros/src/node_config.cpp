@@ -95,8 +95,9 @@ NodeConfig nodeConfig(const std::map<std::string, XmlRpc::XmlRpcValue>& params) 
     NodeConfig c;
     if (const auto it = params.find("config"); it != params.end())
         c.config_path = stringParam("config", it->second);
-    c.pipeline = c.config_path.empty() ? kfdDefaults() : loadConfigFile(c.config_path);
-    std::vector<std::pair<std::string, std::string>> kfd_keys;  // in kfd's order, below
+    c.pipeline =
+        c.config_path.empty() ? kfdDefaults() : loadConfigFile(c.config_path, "KFD", &c.notes);
+    ConfigValues kfd_keys;  // in kfd's order, below
     for (const auto& [key, value] : params) {
         if (key == "odom") {
             const std::string s = stringParam(key, value);
@@ -132,11 +133,16 @@ NodeConfig nodeConfig(const std::map<std::string, XmlRpc::XmlRpcValue>& params) 
             } catch (const Error& e) {
                 throw ConfigError(key, e.what());
             }
+        } else if (key != "config" && value.getType() == XmlRpc::XmlRpcValue::TypeStruct) {
+            ConfigValues::Section stage{key, {}};  // ~<stage>/<key>: that stage's keys
+            for (auto& [name, v] : value) stage.keys.emplace_back(name, keyText(name, v));
+            kfd_keys.sections.push_back(std::move(stage));
         } else if (key != "config") {
-            kfd_keys.emplace_back(key, keyText(key, value));
+            kfd_keys.keys.emplace_back(key, keyText(key, value));
         }
     }
-    applyConfigKeys(c.pipeline, kfd_keys, defaultStageRegistry());
+    applyConfig(c.pipeline, kfd_keys, defaultStageRegistry(),
+                ConfigSyntax{ConfigSyntax::RosParams, "KFD"}, &c.notes);
     validateConfig(c.pipeline, defaultStageRegistry());
     return c;
 }

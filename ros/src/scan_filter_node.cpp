@@ -59,6 +59,7 @@ ScanFilterNode::ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh, const No
       nh_(nh),
       pnh_(pnh),
       filter_(LiveFilter::Params{config.pipeline, config.removed, config.reset_jump}) {
+    for (const std::string& note : config_.notes) ROS_WARN("kfd: %s", note.c_str());
     tf_ = std::make_unique<tf2_ros::Buffer>();
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_, nh_, true);
     const auto q = static_cast<std::uint32_t>(config_.queue_size);

@@ -42,7 +42,7 @@ same_json() { python3 "$root/scripts/bench/same_outputs.py" json "$@"; }
 # own ("  view_keyframe: ...") in place of the corridor, odometry and bound lines; their values
 # are compared in kfd-icp-slam's summary.json.
 summary_of() {
-  sed -E -e '/^  (corridor|odometry withheld) /d' -e '/^  [a-z_]+(#[0-9]+)?: /d' \
+  sed -E -e '/^  (corridor|odometry withheld) /d' -e '/^  [a-z_0-9]+: /d' \
     -e 's/; the bound on removal acted on .*$//' -e 's/; above the bound but confirmed .*$//' "$1" |
     grep -Ev '^  (output|time) '
 }

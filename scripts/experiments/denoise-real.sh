@@ -11,13 +11,15 @@ out="$root/out/denoise-real"
 mkdir -p "$out"
 cd "$out"
 echo "scan,timestamp,beam,kind" > empty.csv
-base="$root/share/kfd/default.ini"
+# Over kfd's defaults (what a file leaves out keeps share/kfd/default.ini's value), each
+# method's own stage listed alone and its keys in its section (issue 34).
 for v in reference range_aware evidence; do
-  sed -e "s/^pipeline = .*/pipeline = denoise/" -e "s/^variant = .*/variant = $v/" "$base" > "$v.ini"
+  st=$([ $v = reference ] && echo denoise || { [ $v = evidence ] && echo evidence_denoise || echo range_aware_denoise; })
+  printf "[KFD]\npipeline = %s\n[KFD.%s]\n" "$st" "$st" > "$v.ini"
 done
 # The evidence variant with the pose margins it was first given (narrower than the default).
 { cat evidence.ini; printf "pose_trans_error_m = 0.02\npose_rot_error_deg = 0.5\nmotion_error_fraction = 0.1\n"; } > evidence_narrow.ini
-for st in dbscan radius sor shadow; do sed -e "s/^pipeline = .*/pipeline = $st/" "$base" > "$st.ini"; done
+for st in dbscan radius sor shadow; do printf "[KFD]\npipeline = %s\n[KFD.%s]\n" "$st" "$st" > "$st.ini"; done
 { cat shadow.ini; echo "shadow_neighbors = 1"; } > shadow1.ini
 logs=("$@")
 [ ${#logs[@]} -gt 0 ] || logs=("${all_logs[@]}")

@@ -94,9 +94,20 @@ TEST(Pipeline, UnknownStageThrows) {
     EXPECT_THROW(Pipeline(withStages({""})), kfd::ParameterError);
 }
 
-TEST(Pipeline, RepeatedStageThrows) {
-    EXPECT_THROW(Pipeline(withStages({"distance", "keyframe", "distance"})), kfd::ParameterError);
-    EXPECT_THROW(Pipeline(withStages({"denoise", "denoise"})), kfd::ParameterError);
+TEST(Pipeline, AStageListedTwiceRunsTwiceWithTheParametersOfEachInstance) {
+    EXPECT_EQ(instanceNames({"denoise", "distance", "denoise", "denoise"}),
+              (std::vector<std::string>{"denoise", "distance", "denoise_2", "denoise_3"}));
+    Pipeline::Params params = withStages({"distance", "keyframe", "distance"});
+    const StageInfo& distance = *coreStageRegistry().find("distance");
+    static_cast<DistanceFilter::Params*>(params.at(distance, "distance_2").data())->max_range =
+        2.0;  // the second instance narrows the range; the first keeps the scan's own
+    Pipeline p(params);
+    EXPECT_EQ(stageNames(p), (std::vector<std::string>{"distance", "keyframe", "distance"}));
+    Scan s = test::flatWall(181, kPi, 3.0);  // every return beyond 2 m but within the scan's own
+    const ScanReport r = p.process(s);
+    ASSERT_EQ(r.stage_count, 3u);
+    EXPECT_EQ(r.stage_reports[0].points_removed, 0u);
+    EXPECT_EQ(r.stage_reports[2].points_removed, 181u);
 }
 
 TEST(Pipeline, InvalidStageParamsThrow) {

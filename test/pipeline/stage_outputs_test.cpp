@@ -67,10 +67,10 @@ TEST(StageOutputs, ColumnsAreTheListedStagesDeclarationsInPipelineOrder) {
 TEST(StageOutputs, AStageListedTwiceGetsItsColumnsAndCountersAgainUnderItsSecondName) {
     const StageRegistry r = registryWithTally();
     const StageOutputs twice({"tally", "tally"}, r);
-    EXPECT_EQ(twice.columns(), (std::vector<std::string>{"seen", "tally#2.seen"}));
+    EXPECT_EQ(twice.columns(), (std::vector<std::string>{"seen", "tally_2.seen"}));
     ASSERT_EQ(twice.zeroTotals().size(), 4u);
-    EXPECT_EQ(twice.zeroTotals()[2].name, "tally#2.tally_all");
-    EXPECT_EQ(twice.zeroTotals()[2].stage, "tally#2");
+    EXPECT_EQ(twice.zeroTotals()[2].name, "tally_2.tally_all");
+    EXPECT_EQ(twice.zeroTotals()[2].stage, "tally_2");
 }
 
 TEST(StageOutputs, AColumnNameTwoStagesDeclareIsPrefixedInTheSecond) {
@@ -107,6 +107,28 @@ TEST(StageOutputs, CellsComeFromEachStagesOwnReportAndAbsentWhenItDidNotRun) {
         stageCounterLines(totals),
         (std::vector<std::string>{"tally: 4 scans it ran on; 2 kept scans it ran on",
                                   "distance: 4 points out of range removed from kept scans"}));
+}
+
+TEST(StageOutputs, EachInstanceOfAStageListedTwiceHasItsOwnCells) {
+    const StageRegistry r = registryWithTally();
+    Pipeline::Params p;
+    p.stages = {"tally", "tally"};  // the second runs only on the scans the first keeps
+    Pipeline pipeline(p, r);
+    const StageOutputs out(p.stages, r);
+    std::vector<StageTotal> totals = out.zeroTotals();
+    std::vector<std::string> rows;
+    for (int i = 0; i < 4; ++i) {
+        Scan s = test::noisyWall();
+        const ScanReport rep = pipeline.process(s);
+        rows.push_back(out.cells(&rep));
+        out.count(rep, totals);
+    }
+    // The first sees 1, 2, 3, 4 and keeps 1 and 3; the second sees those two, keeps the first.
+    EXPECT_EQ(rows, (std::vector<std::string>{",1,1", ",2,0", ",3,2", ",4,0"}));
+    EXPECT_EQ(out.cell(rows[2], "tally_2.seen"), "2");
+    EXPECT_EQ(totalOf(totals, "tally_all"), 4.0);
+    EXPECT_EQ(totalOf(totals, "tally_2.tally_all"), 2.0);
+    EXPECT_EQ(totalOf(totals, "tally_2.tally_kept"), 1.0);
 }
 
 TEST(StageOutputs, AnUnknownStageIsAnErrorNamingIt) {

@@ -128,13 +128,22 @@ TEST_F(ScanFilterNodeTest, RefusesAnUnknownPrivateParameterNamingIt) {
 }
 
 TEST_F(ScanFilterNodeTest, ReadsItsPrivateParameters) {
-    ros::param::set("/good/window", 3);
+    ros::param::set("/good/view_keyframe/max_view_change", 0.5);  // a stage's own: ~stage/key
+    ros::param::set("/good/max_range", 30);  // a flat key of before: read, with a note
     ros::param::set("/good/odom", std::string("topic"));
     ros::param::set("/good/removed_as", std::string("inf"));
     const auto n = node("good");
     EXPECT_EQ(n->config().odometry, kfd::ros1::NodeConfig::Odometry::Topic);
     EXPECT_EQ(n->config().removed, kfd::RemovedMark::PlusInf);
-    EXPECT_NE(kfd::toIni(n->config().pipeline).find("window = 3"), std::string::npos);
+    const std::string ini = kfd::toIni(n->config().pipeline);
+    EXPECT_NE(ini.find("[KFD.view_keyframe]\n"), std::string::npos) << ini;
+    EXPECT_NE(ini.find("max_view_change = 0.5\n"), std::string::npos) << ini;
+    EXPECT_NE(ini.find("max_range = 30\n"), std::string::npos) << ini;
+    ASSERT_EQ(n->config().notes.size(), 1u);
+    EXPECT_NE(n->config().notes[0].find("~distance/{max_range}"), std::string::npos)
+        << n->config().notes[0];
+    ros::param::set("/other/keyframe/window", 3);  // a stage the pipeline does not list
+    EXPECT_EQ(refusedKey("other"), "keyframe");
 }
 
 TEST_F(ScanFilterNodeTest, MissingTfFallsBackToLaserOnlyForThatScan) {

@@ -66,9 +66,13 @@ class KfdCompare(unittest.TestCase):
         ini = {}
         for name, vc in (("ref", "0.75"), ("lo", "0.40"), ("hi", "1.20")):
             ini[name] = os.path.join(self.tmp, name + ".ini")
-            with open(ini[name], "w") as f:  # a later key wins; comments are cut
-                f.write("[ICP]\nmax_view_change = 9\n[KFD]\nmax_view_change = 0.5\n"
-                        "max_view_change = %s   # the knob\n" % vc)
+            # A later key wins; comments are cut; the stage's section, or a flat key of before
+            # ("hi"); another section's key of the same name is not it.
+            section = "[KFD]" if name == "hi" else "[KFD]\n[KFD.view_keyframe]"
+            with open(ini[name], "w") as f:
+                f.write("[ICP]\nmax_view_change = 9\n%s\nmax_view_change = 0.5\n"
+                        "max_view_change = %s   # the knob\n[KFD.other]\nmax_view_change_x = 3\n"
+                        % (section, vc))
 
         def runs(config, mode, local, drop, cpu, finished=True):
             for k, v in enumerate(local):

@@ -482,8 +482,10 @@ std::pair<kfd::IcpSlamSummary, kfd::IcpSlamSummary> runOffOn(const std::string& 
 // finished. On the observations layout (the bundled log) and the actions-and-frames one.
 TEST(IcpSlamRunner, NextScanKeepsTheSameScansWithOnePoseAndRowPerScan) {
     TempDir dir;
-    const std::string off = configWith(dir / "off.ini", "KFD", {{"next_scan", "false"}});
-    const std::string on = configWith(dir / "on.ini", "KFD", {{"next_scan", "true"}});
+    const std::string off =
+        configWith(dir / "off.ini", "KFD.evidence_denoise", {{"next_scan", "false"}});
+    const std::string on =
+        configWith(dir / "on.ini", "KFD.evidence_denoise", {{"next_scan", "true"}});
     std::vector<std::string> logs = {kOffice};
     if (fs::exists(kSena)) logs.push_back(kSena);
     for (const std::string& log : logs) {
@@ -520,17 +522,28 @@ TEST(IcpSlamRunner, NextScanKeepsTheSameScansWithOnePoseAndRowPerScan) {
     }
 }
 
-// With only the denoise stage every scan is kept and pending until the next one: the last one
-// of the log waits for the end (finish()). It must reach ICP, get its pose and row, and count,
-// in the run and in the pre-pass that matches a drop rate.
+// kfd-icp-slam's configuration with its [KFD] part replaced by `kfd` (a pipeline of other
+// stages: the shipped sections of the stages it leaves out would be errors).
+std::string configWithKfd(const std::string& path, const std::string& kfd) {
+    std::string ini = text(kConfig);
+    ini = ini.substr(0, ini.find("\n[KFD]") + 1) + kfd;
+    std::ofstream(path) << ini;
+    return path;
+}
+
+// With only the evidence denoiser every scan is kept and pending until the next one: the last
+// one of the log waits for the end (finish()). It must reach ICP, get its pose and row, and
+// count, in the run and in the pre-pass that matches a drop rate.
 TEST(IcpSlamRunner, NextScanRunsTheLastPendingScanOfTheLog) {
     TempDir dir;
-    const std::string off =
-        configWith(dir / "off.ini", "KFD", {{"next_scan", "false"}, {"pipeline", "denoise"}});
-    const std::string on =
-        configWith(dir / "on.ini", "KFD", {{"next_scan", "true"}, {"pipeline", "denoise"}});
+    const std::string off = configWithKfd(
+        dir / "off.ini",
+        "[KFD]\npipeline = evidence_denoise\n[KFD.evidence_denoise]\nnext_scan = false\n");
+    const std::string on = configWithKfd(
+        dir / "on.ini",
+        "[KFD]\npipeline = evidence_denoise\n[KFD.evidence_denoise]\nnext_scan = true\n");
     const auto [a, b] = runOffOn(kOffice, dir, off, on);
-    EXPECT_EQ(b.pipeline.stages, std::vector<std::string>{"denoise"});
+    EXPECT_EQ(b.pipeline.stages, std::vector<std::string>{"evidence_denoise"});
     EXPECT_EQ(b.scans_in, a.scans_in);
     EXPECT_EQ(b.scans_kept, a.scans_kept);
     EXPECT_EQ(b.scans_kept, b.scans_in);

@@ -71,8 +71,6 @@ std::vector<std::string> parseStageList(const std::string& text, const StageRegi
         if (!registry.find(item))
             throw ConfigError("pipeline",
                               "unknown stage '" + item + "' (known: " + registry.names() + ")");
-        for (const auto& s : stages)
-            if (s == item) throw ConfigError("pipeline", "stage '" + item + "' repeated");
         stages.push_back(item);
     }
     if (stages.empty())
@@ -139,7 +137,7 @@ void checkIniText(const std::string& text, const std::string& section) {
 void checkYamlText(const std::string& text) { detail::checkYaml(text); }
 
 Pipeline::Params loadYamlText(const std::string& text, const std::string& origin,
-                              const Pipeline::Params* base) {
+                              const Pipeline::Params* base, std::vector<std::string>* notes) {
     checkYamlText(text);
     mrpt::containers::yaml doc;
     try {
@@ -147,7 +145,7 @@ Pipeline::Params loadYamlText(const std::string& text, const std::string& origin
     } catch (const std::exception& e) {
         throw ConfigError("", "cannot parse YAML " + origin + ": " + e.what());
     }
-    return loadYaml(doc, base);
+    return loadYaml(doc, base, notes);
 }
 
 namespace {
@@ -271,9 +269,122 @@ void applyConfigKeys(Pipeline::Params& p,
             if (rank(key) == r) applyConfigKey(p, key, value, registry);
 }
 
+namespace {
+
+// The registered stage of instance `name` ("denoise", "denoise_2"), or nullptr.
+const StageInfo* stageOfInstance(const StageRegistry& registry, const std::string& name) {
+    if (const StageInfo* info = registry.find(name)) return info;
+    const auto cut = name.find_last_of('_');
+    if (cut == std::string::npos || cut + 1 == name.size() ||
+        name.find_first_not_of("0123456789", cut + 1) != std::string::npos)
+        return nullptr;
+    return registry.find(name.substr(0, cut));
+}
+
+// The flat stage keys of `keys` (not pipeline, not a choice key), in their order.
+std::vector<std::string> flatStageKeys(const ConfigValues& values, const StageRegistry& registry) {
+    std::vector<std::string> flat;
+    for (const auto& kv : values.keys)
+        if (kv.first != "pipeline" && !registry.choice(kv.first)) flat.push_back(kv.first);
+    return flat;
+}
+
+// The note on flat keys: read for this release, each with its new spelling (the listed stages
+// that declare it), or the remark that no listed stage does.
+std::string flatKeysNote(const std::vector<std::string>& flat, const Pipeline::Params& p,
+                         const StageRegistry& registry, const ConfigSyntax& syntax) {
+    std::map<std::string, std::string> by_stage;  // instance -> its keys
+    std::vector<std::string> order;
+    std::string unused;
+    for (const std::string& key : flat) {
+        bool listed = false;
+        for (const auto& [stage, k] : findKey(registry, key))
+            if (std::find(p.stages.begin(), p.stages.end(), stage->name) != p.stages.end()) {
+                if (!by_stage.count(stage->name)) order.push_back(stage->name);
+                std::string& keys = by_stage[stage->name];
+                keys += (keys.empty() ? "" : ", ") + key;
+                listed = true;
+            }
+        if (!listed) unused += (unused.empty() ? "" : ", ") + key;
+    }
+    std::string note = plural(flat.size(), "flat key") + " in " + syntax.flatPlace() +
+                       ", read for this release: write them per stage, ";
+    for (std::size_t i = 0; i < order.size(); ++i)
+        note += (i ? "; " : "") + syntax.spell(order[i], by_stage[order[i]]);
+    if (!unused.empty())
+        note += std::string(order.empty() ? "" : "; ") + unused +
+                ": no stage of the pipeline has them (they set stages it does not run)";
+    return note;
+}
+
+// One stage instance's keys: ConfigError naming both when the instance is not in the
+// pipeline, naming the key when the stage has no such key.
+void applySection(Pipeline::Params& p, const ConfigValues::Section& section,
+                  const StageRegistry& registry, const ConfigSyntax& syntax) {
+    const std::vector<std::string> instances = instanceNames(p.stages);
+    const auto it = std::find(instances.begin(), instances.end(), section.stage);
+    const std::string where = syntax.sectionName(section.stage);
+    if (it == instances.end()) {
+        const StageInfo* info = stageOfInstance(registry, section.stage);
+        throw ConfigError(section.stage,
+                          where + ": " +
+                              (info ? "stage '" + section.stage + "' is not in the pipeline ("
+                                    : "no stage '" + section.stage +
+                                          "' (known: " + registry.names() + "; the pipeline: ") +
+                              stageList(p, ", ") + ")");
+    }
+    const StageInfo& info =
+        *registry.find(p.stages[static_cast<std::size_t>(it - instances.begin())]);
+    for (const auto& [key, value] : section.keys) {
+        const StageKey* k = nullptr;
+        for (const auto& candidate : info.keys)
+            if (candidate.name == key) k = &candidate;
+        if (!k) {
+            std::string known;
+            for (const auto& candidate : info.keys)
+                known += (known.empty() ? "" : ", ") + candidate.name;
+            throw ConfigError(
+                key, where + ": not a key of stage " + info.name + " (its keys: " + known + ")");
+        }
+        try {
+            k->set(p.at(info, section.stage).data(), trim(value));
+        } catch (const ParameterError& e) {
+            throw ConfigError(key, where + ": " + e.detail());
+        }
+    }
+}
+
+}  // namespace
+
+std::string ConfigSyntax::sectionName(const std::string& stage) const {
+    if (kind == Yaml) return "kfd: " + stage + ":";
+    if (kind == RosParams) return "~" + stage + "/";
+    return "[" + section + "." + stage + "]";
+}
+
+std::string ConfigSyntax::flatPlace() const {
+    if (kind == Yaml) return "the kfd: map";
+    if (kind == RosParams) return "the node's private parameters";
+    return "[" + section + "]";
+}
+
+std::string ConfigSyntax::spell(const std::string& stage, const std::string& keys) const {
+    if (kind == Yaml) return "kfd: " + stage + ": {" + keys + "}";
+    if (kind == RosParams) return "~" + stage + "/{" + keys + "}";
+    return sectionName(stage) + " " + keys;
+}
+
+void applyConfig(Pipeline::Params& p, const ConfigValues& values, const StageRegistry& registry,
+                 const ConfigSyntax& syntax, std::vector<std::string>* notes) {
+    applyConfigKeys(p, values.keys, registry);
+    for (const auto& section : values.sections) applySection(p, section, registry, syntax);
+    const std::vector<std::string> flat = flatStageKeys(values, registry);
+    if (notes && !flat.empty()) notes->push_back(flatKeysNote(flat, p, registry, syntax));
+}
+
 void validateConfig(const Pipeline::Params& p, const StageRegistry& registry) {
     for (const auto& e : p.entries()) {
-        const StageInfo* stage = registry.find(e.stage);
+        const StageInfo* stage = stageOfInstance(registry, e.stage);
         if (!stage) continue;
         try {
             stage->validate(*e.params);
@@ -284,11 +395,11 @@ void validateConfig(const Pipeline::Params& p, const StageRegistry& registry) {
     }
 }
 
-Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
-                         const Pipeline::Params* base) {
-    if (!cfg.sectionExists(section))
-        throw ConfigError("", "no [" + section + "] section in the configuration");
-    if (const auto text = iniTextOf(cfg)) checkIniText(*text, section);
+namespace {
+
+// The keys of one .ini section, as (key, value).
+std::vector<std::pair<std::string, std::string>> iniKeys(const mrpt::config::CConfigFileBase& cfg,
+                                                         const std::string& section) {
     std::vector<std::pair<std::string, std::string>> values;
     try {
         std::vector<std::string> names;
@@ -298,30 +409,69 @@ Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg, const std::st
     } catch (const std::exception& e) {
         throw ConfigError("", "cannot read [" + section + "]: " + mrptMessage(e.what()));
     }
+    return values;
+}
+
+// [section] and its stages' sections [section.<stage>], as read.
+ConfigValues iniValues(const mrpt::config::CConfigFileBase& cfg, const std::string& section) {
+    ConfigValues v;
+    v.keys = iniKeys(cfg, section);
+    std::vector<std::string> sections;
+    cfg.getAllSections(sections);
+    const std::string prefix = lower(section) + ".";
+    for (const std::string& name : sections)
+        if (lower(name).rfind(prefix, 0) == 0)
+            v.sections.push_back({lower(name.substr(prefix.size())), iniKeys(cfg, name)});
+    return v;
+}
+
+}  // namespace
+
+Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+                         const Pipeline::Params* base, std::vector<std::string>* notes) {
+    if (!cfg.sectionExists(section))
+        throw ConfigError("", "no [" + section + "] section in the configuration");
+    const ConfigValues values = iniValues(cfg, section);
+    if (const auto text = iniTextOf(cfg)) {
+        checkIniText(*text, section);
+        for (const auto& s : values.sections) checkIniText(*text, section + "." + s.stage);
+    }
     const StageRegistry& registry = defaultStageRegistry();
     Pipeline::Params p = base ? *base : kfdDefaults();
-    applyConfigKeys(p, values, registry);
+    applyConfig(p, values, registry, ConfigSyntax{ConfigSyntax::Ini, section}, notes);
     validateConfig(p, registry);
     return p;
 }
 
-Pipeline::Params loadYaml(const mrpt::containers::yaml& doc, const Pipeline::Params* base) {
+Pipeline::Params loadYaml(const mrpt::containers::yaml& doc, const Pipeline::Params* base,
+                          std::vector<std::string>* notes) {
     if (!doc.isMap()) throw ConfigError("", "the YAML document must be a map of kfd keys");
     const mrpt::containers::yaml root = doc.has("kfd") ? doc["kfd"] : doc;
     if (!root.isMap()) throw ConfigError("kfd", "must be a map of kfd keys");
     const StageRegistry& registry = defaultStageRegistry();
     Pipeline::Params p = base ? *base : kfdDefaults();
-    std::vector<std::pair<std::string, std::string>> values;
+    ConfigValues values;
     for (const auto& kv : root.asMap()) {
         const std::string name = std::string(kv.first.internalAsStr());
-        values.emplace_back(name, scalarText(mrpt::containers::yaml(kv.second), name));
+        const mrpt::containers::yaml node(kv.second);
+        if (!node.isMap()) {
+            values.keys.emplace_back(name, scalarText(node, name));
+            continue;
+        }
+        ConfigValues::Section section{name, {}};  // a stage's map: its keys
+        for (const auto& skv : node.asMap()) {
+            const std::string key = std::string(skv.first.internalAsStr());
+            section.keys.emplace_back(key, scalarText(mrpt::containers::yaml(skv.second), key));
+        }
+        values.sections.push_back(std::move(section));
     }
-    applyConfigKeys(p, values, registry);
+    applyConfig(p, values, registry, ConfigSyntax{ConfigSyntax::Yaml, "kfd"}, notes);
     validateConfig(p, registry);
     return p;
 }
 
-Pipeline::Params loadConfigFile(const std::string& path, const std::string& section) {
+Pipeline::Params loadConfigFile(const std::string& path, const std::string& section,
+                                std::vector<std::string>* notes) {
     namespace fs = std::filesystem;
     std::error_code ec;
     if (!fs::is_regular_file(path, ec))
@@ -341,7 +491,7 @@ Pipeline::Params loadConfigFile(const std::string& path, const std::string& sect
             if (!e.key().empty()) throw;
             throw ConfigError("", path + ": " + e.what());
         }
-        return loadYamlText(text, "file " + path);
+        return loadYamlText(text, "file " + path, nullptr, notes);
     }
     if (ext != ".ini" && ext != ".cfg")
         throw ConfigError("", "unknown configuration format '" + ext + "' (use .ini or .yaml)");
@@ -353,16 +503,22 @@ Pipeline::Params loadConfigFile(const std::string& path, const std::string& sect
     } catch (const std::exception& e) {
         throw ConfigError("", "cannot read .ini file " + path + ": " + mrptMessage(e.what()));
     }
-    return loadIni(*cfg, section);
+    return loadIni(*cfg, section, nullptr, notes);
 }
 
 std::string toIni(const Pipeline::Params& p, const std::string& section) {
     const StageRegistry& registry = defaultStageRegistry();
-    std::string s = "[" + section + "]\n";
-    s += "pipeline = " + stageList(p, ", ") + "\n";
-    for (const auto& name : keyNames(registry))
-        if (!findKey(registry, name).empty())
-            s += name + " = " + keyValue(p, registry, name) + "\n";
+    std::string s = "[" + section + "]\npipeline = " + stageList(p, ", ") + "\n";
+    const std::vector<std::string> instances = instanceNames(p.stages);
+    for (std::size_t i = 0; i < instances.size(); ++i) {
+        const StageInfo* info = registry.find(p.stages[i]);
+        if (!info) continue;
+        s += "\n[" + section + "." + instances[i] + "]\n";
+        const StageParams* set = p.find(instances[i]);
+        const auto defaults = info->defaults();
+        for (const StageKey& k : info->keys)
+            s += k.name + " = " + k.get(set ? set->data() : defaults->data()) + "\n";
+    }
     return s;
 }
 

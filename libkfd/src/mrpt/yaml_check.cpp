@@ -132,11 +132,11 @@ void checkYaml(const std::string& text) {
     //    values plain or quoted scalars, flow lists [a, b] or block lists (- a). Outside
     //    comments none of { } & * ! % ? | > @ ` (flow maps, anchors, aliases, tags,
     //    directives, complex keys, block scalars, reserved), no document markers (--- ...),
-    //    no nested lists, no tab in indentation, at most two levels; no key twice in a map.
+    //    no nested lists, no tab in indentation, at most three levels (kfd: / a stage / its
+    //    keys); no key twice in a map.
     const auto lines = splitLines(text.substr(body));
-    std::map<std::string, std::size_t> seen;  // "parent/key" -> line
-    std::string parent;                       // the last top-level key
-    std::size_t child_indent = 0;             // indentation of its keys (0: none yet)
+    std::map<std::string, std::size_t> seen;              // "a/b/key" -> line
+    std::vector<std::pair<std::size_t, std::string>> up;  // the maps above: (indent, key)
     for (std::size_t ln = 0; ln < lines.size(); ++ln) {
         const std::string& raw = lines[ln];
         const std::string at = " at line " + std::to_string(ln + 1);
@@ -151,8 +151,7 @@ void checkYaml(const std::string& text) {
         if (content.empty()) continue;
         checkContent(content, at);
         if (content[0] == '-') {  // block list item of the key above
-            if (indent == 0 && parent.empty())
-                throw ConfigError("", "YAML: a list is not a map" + at);
+            if (indent == 0 && up.empty()) throw ConfigError("", "YAML: a list is not a map" + at);
             continue;
         }
         const auto colon = content.find(':');
@@ -160,20 +159,19 @@ void checkYaml(const std::string& text) {
         std::string key = trim(content.substr(0, colon));
         if (key.size() >= 2 && (key[0] == '\'' || key[0] == '"') && key.back() == key[0])
             key = key.substr(1, key.size() - 2);
-        if (indent > 0 && parent.empty())
+        while (!up.empty() && up.back().first >= indent) up.pop_back();
+        if (indent > 0 && up.empty())
             throw ConfigError(key, "YAML: indented key without a map above it" + at);
-        if (indent > 0 && child_indent == 0) child_indent = indent;
-        if (indent > child_indent && child_indent > 0)
-            throw ConfigError(key, "YAML: more than two levels of maps" + at);
-        const std::string path = indent == 0 ? key : parent + "/" + key;
-        const auto [it, inserted] = seen.emplace(path, ln + 1);
+        if (up.size() >= kMaxYamlLevels)
+            throw ConfigError(
+                key, "YAML: more than " + std::to_string(kMaxYamlLevels) + " levels of maps" + at);
+        std::string path;
+        for (const auto& u : up) path += u.second + "/";
+        const auto [it, inserted] = seen.emplace(path + key, ln + 1);
         if (!inserted)
             throw ConfigError(key, "set twice (lines " + std::to_string(it->second) + " and " +
                                        std::to_string(ln + 1) + ")");
-        if (indent == 0) {
-            parent = key;
-            child_indent = 0;
-        }
+        up.emplace_back(indent, key);
     }
 }
 

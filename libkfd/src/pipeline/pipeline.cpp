@@ -17,10 +17,22 @@ PipelineParams& PipelineParams::operator=(const PipelineParams& o) {
     return *this;
 }
 
-StageParams& PipelineParams::at(const StageInfo& stage) {
-    if (StageParams* p = find(stage.name)) return *p;
-    entries_.push_back(Entry{stage.name, stage.defaults()});
+StageParams& PipelineParams::at(const StageInfo& stage) { return at(stage, stage.name); }
+
+StageParams& PipelineParams::at(const StageInfo& stage, std::string_view instance) {
+    if (StageParams* p = find(instance)) return *p;
+    entries_.push_back(Entry{std::string(instance), stage.defaults()});
     return *entries_.back().params;
+}
+
+std::vector<std::string> instanceNames(const std::vector<std::string>& stages) {
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < stages.size(); ++i) {
+        std::size_t n = 1;
+        for (std::size_t j = 0; j < i; ++j) n += stages[j] == stages[i];
+        names.push_back(n == 1 ? stages[i] : stages[i] + "_" + std::to_string(n));
+    }
+    return names;
 }
 
 StageParams* PipelineParams::find(std::string_view name) {
@@ -45,10 +57,7 @@ void Pipeline::initialize(const Params& p, const StageRegistry& registry) {
         if (!info)
             throw ParameterError("stages", "pipeline: unknown stage '" + name +
                                                "' (known: " + registry.names() + ")");
-        for (const auto* s : infos)
-            if (s == info)
-                throw ParameterError("stages", "pipeline: stage '" + name + "' listed twice");
-        infos.push_back(info);
+        infos.push_back(info);  // a stage may be listed twice: its second instance is name_2
     }
     // Set but not listed: validated here (listed stages validate when they are built).
     for (const auto& e : p.entries()) {
@@ -58,9 +67,10 @@ void Pipeline::initialize(const Params& p, const StageRegistry& registry) {
         if (info && !listed) info->validate(*e.params);
     }
     std::vector<std::unique_ptr<Stage>> stages;
-    for (const auto* info : infos) {
-        const StageParams* set = p.find(info->name);
-        stages.push_back(set ? info->create(*set) : info->create(*info->defaults()));
+    const std::vector<std::string> instances = instanceNames(p.stages);
+    for (std::size_t i = 0; i < infos.size(); ++i) {
+        const StageParams* set = p.find(instances[i]);
+        stages.push_back(set ? infos[i]->create(*set) : infos[i]->create(*infos[i]->defaults()));
     }
     finished_ = false;
     if (held_) finishHeld(nullptr);  // by the stages that held it; finished() returns it

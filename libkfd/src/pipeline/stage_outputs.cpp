@@ -17,7 +17,7 @@ StageOutputs::StageOutputs(const std::vector<std::string>& stages, const StageRe
         b.occurrence = static_cast<std::size_t>(std::count(listed.begin(), listed.end(), stage));
         listed.push_back(stage);
         const std::string prefix =
-            b.occurrence ? stage + "#" + std::to_string(b.occurrence + 1) + "." : std::string();
+            b.occurrence ? stage + "_" + std::to_string(b.occurrence + 1) + "." : std::string();
         for (const StageColumn& c : info->columns) {
             std::string name = prefix + c.name;
             if (std::find(names_.begin(), names_.end(), name) != names_.end())

@@ -12,7 +12,9 @@ void Run::prepare() {
     cfg_.emplace(checkConfigFile(opts_.config_file));
     resolvePaths(opts_, *cfg_, sum_);
     log_params_ = IcpSlamLogParams::fromConfig(*cfg_, kSect, sum_.notices);
-    kfd_params_ = cfg_->sectionExists("KFD") ? loadIni(*cfg_, "KFD") : kfdDefaults();
+    // Flat [KFD] keys (read for this release) are named with their new spelling in notices.
+    kfd_params_ =
+        cfg_->sectionExists("KFD") ? loadIni(*cfg_, "KFD", nullptr, &sum_.notices) : kfdDefaults();
     applySlamGate(*cfg_, kfd_params_, sum_);
     sum_.pipeline = pipelineForMode(opts_.mode, kfd_params_);
     sum_.laser_only = opts_.laser_only;

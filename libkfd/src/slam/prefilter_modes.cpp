@@ -68,11 +68,11 @@ Pipeline::Params pipelineForMode(PrefilterMode mode, const Pipeline::Params& kfd
     for (const auto& info : prefilterModes()) {
         if (info.mode != mode || info.uses_kfd_stages) continue;
         p.stages = info.stages;
-        // A stage with a role (selector, variant): the one the [KFD] pipeline chose, if any.
+        // A stage with a role (selector, variant): the one the [KFD] pipeline chose, if any
+        // (the first it lists, as everywhere: StageChoice::listedIn).
         for (auto& st : p.stages)
             if (const StageChoice* c = reg.choiceOfStage(st))
-                for (const auto& listed : kfd.stages)
-                    if (c->ofStage(listed)) st = listed;
+                if (const StageChoice::Option* o = c->listedIn(kfd.stages)) st = o->stage;
     }
     return p;
 }

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <vector>
 
+#include "kfd/mrpt/default_stages.h"
 #include "kfd/os/output_paths.h"
 #include "kfd/stages/keyframe_stage.h"
 #include "kfd/stages/view_keyframe_stage.h"
@@ -81,10 +82,11 @@ void resolvePaths(const IcpSlamOptions& opts, const mrpt::config::CConfigFile& c
 
 void applySlamGate(const mrpt::config::CConfigFile& cfg, Pipeline::Params& kfd,
                    IcpSlamSummary& sum) {
-    // Both keyframe stages' guards are lowered; the summary reports the listed stage's
-    // (kfd's view_keyframe when the pipeline lists neither).
-    const bool paper =
-        std::find(kfd.stages.begin(), kfd.stages.end(), KeyframeStage::kName) != kfd.stages.end();
+    // Both keyframe stages' guards are lowered (and those of a second instance); the summary
+    // reports the first listed keyframe stage's (kfd's view_keyframe when it lists neither).
+    const StageRegistry& reg = defaultStageRegistry();
+    const StageChoice::Option* listed = reg.choice("selector")->listedIn(kfd.stages);
+    const bool paper = listed && listed->stage == KeyframeStage::kName;
     const KeyframeGuards::Params& kf =
         paper ? static_cast<const KeyframeGuards::Params&>(kfd.get<KeyframeStage>())
               : kfd.get<ViewKeyframeStage>();
@@ -92,9 +94,19 @@ void applySlamGate(const mrpt::config::CConfigFile& cfg, Pipeline::Params& kfd,
     sum.guard_rotation_deg_configured = kf.max_rotation_deg;
     const double gate_m = cfg.read_double(kSect, "localizationLinDistance", 0.2);
     const double gate_deg = cfg.read_double(kSect, "localizationAngDistance", 5.0);
-    for (KeyframeGuards::Params* g :
-         {static_cast<KeyframeGuards::Params*>(&kfd.get<KeyframeStage>()),
-          static_cast<KeyframeGuards::Params*>(&kfd.get<ViewKeyframeStage>())}) {
+    std::vector<KeyframeGuards::Params*> guards{&kfd.get<KeyframeStage>(),
+                                                &kfd.get<ViewKeyframeStage>()};
+    const std::vector<std::string> instances = instanceNames(kfd.stages);
+    for (std::size_t i = 0; i < instances.size(); ++i)  // keyframe_2, view_keyframe_2, ...
+        if (instances[i] != kfd.stages[i] && reg.choice("selector")->ofStage(kfd.stages[i])) {
+            void* d = kfd.at(*reg.find(kfd.stages[i]), instances[i]).data();
+            guards.push_back(
+                kfd.stages[i] == KeyframeStage::kName
+                    ? static_cast<KeyframeGuards::Params*>(static_cast<KeyframeStage::Params*>(d))
+                    : static_cast<KeyframeGuards::Params*>(
+                          static_cast<ViewKeyframeStage::Params*>(d)));
+        }
+    for (KeyframeGuards::Params* g : guards) {
         if (gate_m > 0.0 && g->max_translation_m > gate_m) g->max_translation_m = gate_m;
         if (gate_deg > 0.0 && g->max_rotation_deg > gate_deg) g->max_rotation_deg = gate_deg;
     }

@@ -61,6 +61,39 @@ void applyConfigKey(Pipeline::Params& p, const std::string& key, const std::stri
 void applyConfigKeys(Pipeline::Params& p,
                      const std::vector<std::pair<std::string, std::string>>& values,
                      const StageRegistry& registry);
+/// A configuration as read, before it is applied: the top section's keys ([KFD] or the kfd:
+/// map: `pipeline`, the choice keys, and flat stage keys, read for this release), then each
+/// stage's own keys ([KFD.<stage>], `kfd: <stage>: {...}`, the ROS node's `~<stage>/<key>`).
+/// A stage listed twice is configured as `<stage>_2` (kfd::instanceNames).
+struct ConfigValues {
+    std::vector<std::pair<std::string, std::string>> keys;
+    struct Section {
+        std::string stage;  // the instance: "distance", "denoise_2"
+        std::vector<std::pair<std::string, std::string>> keys;
+    };
+    std::vector<Section> sections;
+};
+
+/// How the user wrote the configuration, for messages: the sections' and keys' spelling.
+struct ConfigSyntax {
+    enum Kind { Ini, Yaml, RosParams } kind = Ini;
+    std::string section = "KFD";  // the .ini section (Ini)
+    /// "[KFD.distance]", "kfd: distance:", "~distance/".
+    std::string sectionName(const std::string& stage) const;
+    /// "[KFD]", "the kfd: map", "the node's private parameters".
+    std::string flatPlace() const;
+    /// "[KFD.distance] min_range, max_range" and the like.
+    std::string spell(const std::string& stage, const std::string& keys) const;
+};
+
+/// Applies `values` to `p`: the top keys (applyConfigKeys), then each stage's section. A
+/// section of a stage the pipeline does not list is a ConfigError naming the stage and the
+/// pipeline; a key the stage does not declare one naming the key and the stage's keys. Flat
+/// stage keys (the spelling before issue 34) still set every stage declaring them; when
+/// `notes` is given, one note there names each with its new spelling.
+void applyConfig(Pipeline::Params& p, const ConfigValues& values, const StageRegistry& registry,
+                 const ConfigSyntax& syntax, std::vector<std::string>* notes = nullptr);
+
 /// Validates every stage's parameters set in `p` once (each stage's own checks); ConfigError
 /// naming the user's key for the stage's kfd::ParameterError.
 void validateConfig(const Pipeline::Params& p, const StageRegistry& registry);
@@ -72,13 +105,19 @@ void validateConfig(const Pipeline::Params& p, const StageRegistry& registry);
 /// CConfigFileMemory has already merged duplicate keys: check its text with checkIniText).
 /// Unknown keys and out-of-range values throw ConfigError naming the key. Other sections are
 /// ignored, so the [KFD] section can live inside an icp-slam .ini.
+///
+/// Each stage's keys live in a section of its own, [KFD.<stage>] (applyConfig); [KFD] holds
+/// `pipeline`, the choice keys (`selector`, `variant`) and, for this release, the flat keys of
+/// before (a note in `notes` gives their new spelling).
 Pipeline::Params loadIni(const mrpt::config::CConfigFileBase& cfg,
-                         const std::string& section = "KFD",
-                         const Pipeline::Params* base = nullptr);
+                         const std::string& section = "KFD", const Pipeline::Params* base = nullptr,
+                         std::vector<std::string>* notes = nullptr);
 
 /// Largest configuration text the YAML loader reads (1 MiB); kfd's keys need a few hundred
 /// bytes.
 constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;
+/// Deepest YAML nesting the loader reads: `kfd:`, a stage, its keys.
+constexpr std::size_t kMaxYamlLevels = 3;
 
 /// Checks the text of an .ini file before MRPT reads it (MRPT keeps the last of two equal
 /// keys silently): ConfigError naming the key when a key of `section` appears twice (keys and
@@ -92,10 +131,10 @@ void checkIniText(const std::string& text, const std::string& section = "KFD");
 ///  - encoding: valid UTF-8 (no overlong forms, surrogates or code points above U+10FFFF);
 ///    a byte-order mark only as the very first character;
 ///  - characters: no control character other than tab, CR and LF (C0, DEL, C1);
-///  - the subset kfd's keys need: a map of scalars, or the same map under one top-level
-///    key (`kfd:`), at most two levels; values plain or quoted scalars, flow lists [a, b]
-///    (not nested) or block lists (- a). Outside comments none of { } & * ! % ? | > @ `
-///    (flow maps, anchors, aliases, tags, directives, complex keys, block scalars), no
+///  - the subset kfd's keys need: a map of scalars and stages' maps, or the same map under
+///    one top-level key (`kfd:`), at most kMaxYamlLevels levels; values plain or quoted scalars,
+///    flow lists [a, b] (not nested) or block lists (- a). Outside comments none of { } & * ! % ? |
+///    > @ ` (flow maps, anchors, aliases, tags, directives, complex keys, block scalars), no
 ///    document markers (--- or ...), no tab in indentation, no unterminated quote or list;
 ///  - no key twice in the same map (ConfigError naming the key).
 void checkYamlText(const std::string& text);
@@ -103,26 +142,30 @@ void checkYamlText(const std::string& text);
 /// checkYamlText(text), then MRPT's YAML parser, then loadYaml. `origin` names the text in
 /// messages (e.g. "file x.yaml").
 Pipeline::Params loadYamlText(const std::string& text, const std::string& origin = "",
-                              const Pipeline::Params* base = nullptr);
+                              const Pipeline::Params* base = nullptr,
+                              std::vector<std::string>* notes = nullptr);
 
-/// Reads a YAML map of the same keys. If the document has a top-level `kfd:` map, that map is
-/// used; otherwise the top level itself.
-Pipeline::Params loadYaml(const mrpt::containers::yaml& doc,
-                          const Pipeline::Params* base = nullptr);
+/// Reads a YAML map of the same keys: `pipeline`, the choice keys, and a map per stage
+/// (`distance: {max_range: 30}`; flat keys as in loadIni). If the document has a top-level
+/// `kfd:` map, that map is used; otherwise the top level itself.
+Pipeline::Params loadYaml(const mrpt::containers::yaml& doc, const Pipeline::Params* base = nullptr,
+                          std::vector<std::string>* notes = nullptr);
 
 /// Loads a .ini/.cfg (section [KFD]) or .yaml/.yml file by extension (YAML through
 /// loadYamlText; .ini keys set twice are a ConfigError, see checkIniText; so is
 /// `pipeline =` with no stage). Throws ConfigError when the
 /// file is missing, unreadable, or has no [KFD] section / kfd keys.
-Pipeline::Params loadConfigFile(const std::string& path, const std::string& section = "KFD");
+/// `notes`: what the user should know (flat keys read for this release), for the app to print.
+Pipeline::Params loadConfigFile(const std::string& path, const std::string& section = "KFD",
+                                std::vector<std::string>* notes = nullptr);
 
 /// kfd's defaults for small indoor robots: share/kfd/default.ini, compiled in (kfd-filter
 /// without -c, kfd-icp-slam without [KFD]). kfdDefaultIni() is that file's text.
 Pipeline::Params kfdDefaults();
 const char* kfdDefaultIni();
 
-/// The effective configuration as an .ini [KFD] section (every key of the default registry,
-/// current values).
+/// The effective configuration as .ini text: [KFD] with the pipeline, then a section per
+/// listed stage, [KFD.<stage>], with every key of that stage at its current value.
 std::string toIni(const Pipeline::Params& p, const std::string& section = "KFD");
 
 }  // namespace kfd

@@ -25,7 +25,9 @@ namespace kfd {
 /// Stages whose parameters were never set run with their Params defaults.
 class PipelineParams {
   public:
-    /// Stage names in order, each at most once (see StageRegistry::names()). By default the
+    /// Stage names in order (see StageRegistry::names()); a stage listed twice runs twice, its
+    /// second instance called `<stage>_2` (instanceNames()), with parameters of its own. By
+    /// default the
     /// distance filter and kfd's keyframe and denoising stages (kfdDefaults() adds the
     /// odometry check).
     std::vector<std::string> stages{"distance", "view_keyframe", "evidence_denoise"};
@@ -60,6 +62,8 @@ class PipelineParams {
 
     /// The parameters of a registered stage by name (created with its defaults when missing).
     StageParams& at(const StageInfo& stage);
+    /// The parameters of one instance of `stage` ("denoise_2": its second listing).
+    StageParams& at(const StageInfo& stage, std::string_view instance);
     /// The parameters set for stage `name`, or nullptr.
     StageParams* find(std::string_view name);
     const StageParams* find(std::string_view name) const;
@@ -74,6 +78,10 @@ class PipelineParams {
   private:
     std::vector<Entry> entries_;
 };
+
+/// The instance name of each listed stage: the stage's name, `<stage>_<n>` for its n-th
+/// listing: {"denoise", "distance", "denoise"} -> {"denoise", "distance", "denoise_2"}.
+std::vector<std::string> instanceNames(const std::vector<std::string>& stages);
 
 class Pipeline {
   public:

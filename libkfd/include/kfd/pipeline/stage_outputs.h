@@ -67,8 +67,8 @@ StageCounter diagnosticCounter(std::string name, std::string help, bool kept_onl
 
 /// One counter's total over a run.
 struct StageTotal {
-    std::string stage;  // the stage as listed ("view_keyframe"; "denoise#2" for a second one)
-    std::string name;   // the counter's key ("scans_corridor"; "denoise#2.<key>")
+    std::string stage;  // the stage as listed ("view_keyframe"; "denoise_2" for a second one)
+    std::string name;   // the counter's key ("scans_corridor"; "denoise_2.<key>")
     std::string help;
     double value = 0.0;
 };
@@ -82,7 +82,7 @@ std::vector<std::string> stageCounterLines(const std::vector<StageTotal>& totals
 
 /// The declared outputs of one pipeline (its listed stages, in order): the CSV header's stage
 /// part, each scan's cells and the run's counters. A stage listed twice gets its columns and
-/// counters a second time, named "<stage>#2.<name>"; a column name two stages declare is kept
+/// counters a second time, named "<stage>_2.<name>"; a column name two stages declare is kept
 /// by the first and prefixed "<stage>." in the second.
 class StageOutputs {
   public:

@@ -6,6 +6,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include "kfd/io/bag_writer.h"
 #include "kfd/pipeline/pipeline.h"
@@ -27,6 +28,9 @@ struct NodeConfig {
     RemovedMark removed = RemovedMark::NaN;  // ~removed_as: nan | inf
     double reset_jump = 1.0;                 // ~reset_jump, s (LiveFilter::Params::reset_jump)
     int queue_size = 10;  // ~queue_size: the scan subscriber's and publisher's queues
+    /// What the user should know (flat kfd keys read for this release, with their new
+    /// spelling ~<stage>/<key>): the node logs them at start.
+    std::vector<std::string> notes;
 };
 
 /// The node's own parameter names (without '~').
@@ -34,11 +38,12 @@ bool isNodeParameter(const std::string& name);
 
 /// The node's configuration from its private parameters (names without '~', values as the
 /// parameter server holds them). kfd's configuration: ~config's file (kfd::loadConfigFile) or
-/// kfd's defaults, then every other parameter as a kfd key (kfd::applyConfigKey: ints,
-/// doubles, bools and strings as their text, a list as its comma-separated items), then
-/// kfd::validateConfig. kfd::ConfigError naming the parameter (e.g. "config key 'window': ...",
-/// "config key 'odom': ...") on an unknown key, a bad value or a value of the wrong type: the
-/// node refuses to start.
+/// kfd's defaults, then every other parameter as a kfd key: a stage's map `~<stage>/<key>`
+/// (e.g. ~distance/max_range; kfd::applyConfig), or `~pipeline`, `~selector`, `~variant`, or
+/// a flat key of before (read for this release, with a note): ints, doubles, bools and
+/// strings as their text, a list as its comma-separated items; then kfd::validateConfig.
+/// kfd::ConfigError naming the parameter (e.g. "config key 'window': ...", "config key 'odom':
+/// ...") on an unknown key, a bad value or a value of the wrong type: the node refuses to start.
 NodeConfig nodeConfig(const std::map<std::string, XmlRpc::XmlRpcValue>& params);
 
 }  // namespace kfd::ros1
