@@ -952,7 +952,7 @@ Decided decide(kfd::Source& src) {
             d.odometry.push_back(e.odometry);
             auto copy = *s;
             const auto r = checked.process(copy, e.odometry);
-            d.jumps += checked.outputs().cell(r.record.stage_cells, "odometry_check") == "jump";
+            d.jumps += checked.outputs().cell(r.report, "odometry_check") == "jump";
             d.keep.push_back(f.process(*s, e.odometry).keep);
         });
     return d;

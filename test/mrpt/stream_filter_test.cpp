@@ -182,7 +182,7 @@ TEST(StreamFilter, FrozenOdometryIsDecidedAsLaserOnly) {
             ++scans;
             same += a.keep == b.keep;
             const auto cell = [&](const char* column) {
-                return frozen.outputs().cell(a.record.stage_cells, column);
+                return frozen.outputs().cell(a.report, column);
             };
             withheld += cell("odometry_check") == "frozen";
             const std::size_t usable = a.record.points_in - std::stoul(cell("removed_range"));

@@ -88,17 +88,18 @@ TEST(StageOutputs, CellsComeFromEachStagesOwnReportAndAbsentWhenItDidNotRun) {
     const StageOutputs out(p.stages, r);
     std::vector<StageTotal> totals = out.zeroTotals();
     std::vector<std::string> rows;
+    std::vector<ScanReport> reports;
     for (int i = 0; i < 4; ++i) {
         Scan s = test::noisyWall();  // beam 60 out of range, beam 61 NaN
-        const ScanReport rep = pipeline.process(s);
-        rows.push_back(out.cells(&rep));
-        out.count(rep, totals);
+        reports.push_back(pipeline.process(s));
+        rows.push_back(out.cells(reports.back()));
+        out.count(reports.back(), totals);
     }
     EXPECT_EQ(rows, (std::vector<std::string>{",1,2", ",2,0", ",3,2", ",4,0"}));
-    EXPECT_EQ(out.cell(rows[2], "removed_range"), "2");
-    EXPECT_EQ(out.cell(rows[2], "seen"), "3");
-    EXPECT_EQ(out.cell(rows[2], "no_such_column"), "");
-    EXPECT_EQ(out.cells(nullptr), ",0,0");  // a skipped scan: no stage ran
+    EXPECT_EQ(out.cell(reports[2], "removed_range"), "2");
+    EXPECT_EQ(out.cell(reports[2], "seen"), "3");
+    EXPECT_EQ(out.cell(reports[2], "no_such_column"), "");
+    EXPECT_EQ(out.cells(ScanReport{}), ",0,0");  // a skipped scan: no stage ran
     EXPECT_EQ(totalOf(totals, "tally_all"), 4.0);
     EXPECT_EQ(totalOf(totals, "tally_kept"), 2.0);  // kept scans only
     EXPECT_EQ(totalOf(totals, "points_removed_range"), 4.0);
@@ -117,15 +118,16 @@ TEST(StageOutputs, EachInstanceOfAStageListedTwiceHasItsOwnCells) {
     const StageOutputs out(p.stages, r);
     std::vector<StageTotal> totals = out.zeroTotals();
     std::vector<std::string> rows;
+    std::vector<ScanReport> reports;
     for (int i = 0; i < 4; ++i) {
         Scan s = test::noisyWall();
-        const ScanReport rep = pipeline.process(s);
-        rows.push_back(out.cells(&rep));
-        out.count(rep, totals);
+        reports.push_back(pipeline.process(s));
+        rows.push_back(out.cells(reports.back()));
+        out.count(reports.back(), totals);
     }
     // The first sees 1, 2, 3, 4 and keeps 1 and 3; the second sees those two, keeps the first.
     EXPECT_EQ(rows, (std::vector<std::string>{",1,1", ",2,0", ",3,2", ",4,0"}));
-    EXPECT_EQ(out.cell(rows[2], "tally_2.seen"), "2");
+    EXPECT_EQ(out.cell(reports[2], "tally_2.seen"), "2");
     EXPECT_EQ(totalOf(totals, "tally_all"), 4.0);
     EXPECT_EQ(totalOf(totals, "tally_2.tally_all"), 2.0);
     EXPECT_EQ(totalOf(totals, "tally_2.tally_kept"), 1.0);

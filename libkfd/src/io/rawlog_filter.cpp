@@ -322,7 +322,7 @@ void Run::openOutputs() {
     if (!opts_.stats_csv.empty()) {
         asRawlogError([&] {
             tmp_csv_.emplace(opts_.stats_csv);
-            csv_.open(tmp_csv_->path().string(), opts_.stats_csv, filter_.outputs().columns());
+            csv_.open(tmp_csv_->path().string(), opts_.stats_csv, filter_.outputs());
         });
     }
 }

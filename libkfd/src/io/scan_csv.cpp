@@ -27,13 +27,14 @@ void asScanCsvError(Fn&& fn) {
 }  // namespace
 
 void ScanCsvWriter::open(const std::string& path, const std::string& name,
-                         const std::vector<std::string>& stage_columns) {
+                         const StageOutputs& stages) {
+    stages_ = stages;
     asScanCsvError([&] {
         out_.emplace(path, name);
         std::string header =
             "index,timestamp,sensor,kept,reason,points_in,removed_noise,points_out,"
             "microseconds";
-        for (const std::string& c : stage_columns) header += "," + c;
+        for (const std::string& c : stages_.columns()) header += "," + c;
         *out_ << header << ",icp_goodness,odom_x,odom_y,odom_phi,x,y,phi\n";
     });
 }
@@ -42,7 +43,7 @@ void ScanCsvWriter::write(const ScanRecord& r, const std::optional<Pose2D>& pose
     std::string line = format("%zu,%.6f,%s,%d,%s,%zu,%zu,%zu,%.2f", r.index,
                               stampForOutput(r.stamp), r.sensor.c_str(), r.kept ? 1 : 0, r.reason,
                               r.points_in, r.removed_noise, r.points_out, r.microseconds);
-    line += r.stage_cells;
+    line += stages_.cells(r.report);
     line += std::isnan(r.icp_goodness)
                 ? std::string(",")
                 : format(",%.4f%s", r.icp_goodness, r.icp_rejected ? "r" : "");

@@ -94,7 +94,6 @@ StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
         rec.stamp = stampOf(obs);
         rec.reason = skippedReason(check.reject);
         rec.points_in = obs.getScanSize();
-        rec.stage_cells = outputs_.cells(nullptr);
         ++counters_.scans_skipped;
         ++counters_.skipped_by_reason[static_cast<std::size_t>(check.reject)];
         return res;
@@ -221,7 +220,7 @@ void StreamFilter::record(StreamResult& res) {
     rec.removed_noise = rep.noiseRemoved();
     rec.points_out = rep.points_out;
     rec.microseconds = rep.microseconds;
-    rec.stage_cells = outputs_.cells(&rep);
+    rec.report = rep;
     count(res);
 }
 

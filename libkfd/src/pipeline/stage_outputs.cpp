@@ -3,21 +3,22 @@
 #include <algorithm>
 
 #include "kfd/pipeline/error.h"
+#include "kfd/pipeline/pipeline.h"
 #include "kfd/pipeline/stage_registry.h"
 
 namespace kfd {
 
 StageOutputs::StageOutputs(const std::vector<std::string>& stages, const StageRegistry& registry) {
-    std::vector<std::string> listed;
-    for (const std::string& stage : stages) {
+    const std::vector<std::string> instances = instanceNames(stages);  // "denoise", "denoise_2"
+    for (std::size_t i = 0; i < stages.size(); ++i) {
+        const std::string& stage = stages[i];
         const StageInfo* info = registry.find(stage);
         if (!info) throw Error("unknown stage '" + stage + "'", "stages");
         Bound b;  // the how-manieth listing of this stage
         b.stage = stage;
-        b.occurrence = static_cast<std::size_t>(std::count(listed.begin(), listed.end(), stage));
-        listed.push_back(stage);
-        const std::string prefix =
-            b.occurrence ? stage + "_" + std::to_string(b.occurrence + 1) + "." : std::string();
+        b.occurrence = static_cast<std::size_t>(
+            std::count(stages.begin(), stages.begin() + static_cast<std::ptrdiff_t>(i), stage));
+        const std::string prefix = b.occurrence ? instances[i] + "." : std::string();
         for (const StageColumn& c : info->columns) {
             std::string name = prefix + c.name;
             if (std::find(names_.begin(), names_.end(), name) != names_.end())
@@ -29,8 +30,7 @@ StageOutputs::StageOutputs(const std::vector<std::string>& stages, const StageRe
         for (const StageCounter& c : info->counters) {
             counter_stage_.push_back(b);
             counters_.push_back(c);
-            zero_totals_.push_back({prefix.empty() ? stage : prefix.substr(0, prefix.size() - 1),
-                                    prefix + c.name, c.help, 0.0});
+            zero_totals_.push_back({instances[i], prefix + c.name, c.help, 0.0});
         }
     }
 }
@@ -42,26 +42,21 @@ const StageReport* StageOutputs::reportOf(const ScanReport& r, const Bound& b) {
     return nullptr;
 }
 
-std::string StageOutputs::cells(const ScanReport* report) const {
+std::string StageOutputs::cellAt(const ScanReport& report, std::size_t i) const {
+    const StageReport* s = reportOf(report, column_stage_[i]);
+    return s ? columns_[i].cell(*s) : columns_[i].absent;
+}
+
+std::string StageOutputs::cells(const ScanReport& report) const {
     std::string line;
-    for (std::size_t i = 0; i < columns_.size(); ++i) {
-        const StageReport* s = report ? reportOf(*report, column_stage_[i]) : nullptr;
-        line += ',';
-        line += s ? columns_[i].cell(*s) : columns_[i].absent;
-    }
+    for (std::size_t i = 0; i < columns_.size(); ++i) line += ',' + cellAt(report, i);
     return line;
 }
 
-std::string StageOutputs::cell(const std::string& cells, std::string_view name) const {
+std::string StageOutputs::cell(const ScanReport& report, std::string_view name) const {
     const auto it = std::find(names_.begin(), names_.end(), name);
-    if (it == names_.end()) return {};
-    std::size_t at = 0;  // cells starts with ','
-    for (auto n = it - names_.begin(); n >= 0; --n) {
-        at = cells.find(',', at);
-        if (at == std::string::npos) return {};
-        ++at;
-    }
-    return cells.substr(at, cells.find(',', at) - at);
+    return it == names_.end() ? std::string()
+                              : cellAt(report, static_cast<std::size_t>(it - names_.begin()));
 }
 
 void StageOutputs::count(const ScanReport& report, std::vector<StageTotal>& totals) const {

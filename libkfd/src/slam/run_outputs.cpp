@@ -13,7 +13,7 @@ void Run::openOutputs() {
     const StagedOutputFolder& out = *res_.output;
     logs_.emplace(out, log_params_);
     csv_.open((out.path() / "scans.csv").string(), out.finalName("scans.csv"),
-              prefilter_->outputs().columns());
+              prefilter_->outputs());
     source_ = openLog(sum_.rawlog, opts_.source);
 }
 
@@ -28,7 +28,7 @@ void Run::writeStep(double builder_ms) {
     Trajectory& traj = res_.trajectory;
     for (const ScanRecord& s : step_scans_) {
         if (s.kept) res_.keyframes.push_back(traj.size());
-        if (prefilter_->outputs().cell(s.stage_cells, "corridor") == "1")
+        if (prefilter_->outputs().cell(s.report, "corridor") == "1")
             res_.corridor.push_back(traj.size());
         const double t = stampForOutput(s.stamp);
         if (s.odometry) res_.odometry.push_back(StampedPose{t, *s.odometry});

@@ -8,6 +8,7 @@
 #include "kfd/mrpt/scan_record.h"
 #include "kfd/os/output_paths.h"
 #include "kfd/pipeline/error.h"
+#include "kfd/pipeline/stage_outputs.h"
 
 namespace kfd {
 
@@ -41,9 +42,9 @@ class ScanCsvWriter {
     /// Opens `path` for writing (kfd's checked OutputFile) and writes the header; `name` is the
     /// file users know (e.g. the final name of a temporary file). ScanCsvError when it cannot
     /// be written.
-    /// `stage_columns`: the door's StageOutputs::columns().
-    void open(const std::string& path, const std::string& name,
-              const std::vector<std::string>& stage_columns);
+    /// `stages`: the door's outputs (StreamFilter::outputs()), which give the listed stages'
+    /// columns and format each row's cells from its record's report.
+    void open(const std::string& path, const std::string& name, const StageOutputs& stages);
     bool isOpen() const { return out_ && out_->isOpen(); }
     /// One row; `pose` fills x, y, phi. ScanCsvError when the write fails.
     void write(const ScanRecord& r, const std::optional<Pose2D>& pose = std::nullopt);
@@ -53,6 +54,7 @@ class ScanCsvWriter {
 
   private:
     std::optional<OutputFile> out_;
+    StageOutputs stages_;
 };
 
 }  // namespace kfd

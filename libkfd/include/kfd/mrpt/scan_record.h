@@ -12,6 +12,7 @@
 
 #include "kfd/algorithms/odometry_check.h"
 #include "kfd/pipeline/scan.h"
+#include "kfd/pipeline/stage.h"
 #include "kfd/pipeline/stage_outputs.h"
 
 namespace kfd {
@@ -31,9 +32,10 @@ struct ScanRecord {
     std::size_t removed_noise = 0;  // by the denoising stages (StageReport::noise)
     std::size_t points_out = 0;     // valid beams leaving the pipeline
     double microseconds = 0.0;      // time in the pipeline's stages
-    /// The listed stages' own columns, ",cell,cell,...": what each stage declares
-    /// (kfd/pipeline/stage_outputs.h; StreamFilter::outputs() reads a cell by name).
-    std::string stage_cells;
+    /// The stages' reports (empty for a skipped scan): the listed stages' own columns are
+    /// formatted from it when the row is written (kfd/pipeline/stage_outputs.h;
+    /// StreamFilter::outputs().cell(record.report, "corridor") reads one by name).
+    ScanReport report;
     std::optional<Pose2D> odometry;  // the odometry the door was given, after its check
     /// kfd-icp-slam: ICP's goodness when the map builder corrected this (kept) scan's pose,
     /// else NaN; icp_rejected when the builder rejected that correction (below its minimum).

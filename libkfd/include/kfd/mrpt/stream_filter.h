@@ -120,7 +120,7 @@ class StreamFilter {
     /// summaries).
     const ScanCounters& counters() const { return counters_; }
     /// The listed stages' declared outputs: the per-scan CSV's stage columns (ScanCsvWriter),
-    /// a record's cell by name (`outputs().cell(record.stage_cells, "corridor")`).
+    /// a record's cell by name (`outputs().cell(record.report, "corridor")`).
     const StageOutputs& outputs() const { return outputs_; }
 
     /// Laser only: the odometry given to process() is ignored (kfd decides from the scans

@@ -93,10 +93,10 @@ class StageOutputs {
     /// The stage columns' names, in order.
     const std::vector<std::string>& columns() const { return names_; }
     /// ",cell,cell,..." for one scan (every stage column; `absent` for a stage that did not
-    /// run). `report` may be nullptr (a skipped scan).
-    std::string cells(const ScanReport* report) const;
-    /// The cell of column `name` in a row of cells() ("" when there is no such column).
-    std::string cell(const std::string& cells, std::string_view name) const;
+    /// run, e.g. every one of a skipped scan, whose report is empty).
+    std::string cells(const ScanReport& report) const;
+    /// The cell of column `name` for one scan ("" when there is no such column).
+    std::string cell(const ScanReport& report, std::string_view name) const;
 
     /// Every counter of the listed stages, in order, at 0.
     const std::vector<StageTotal>& zeroTotals() const { return zero_totals_; }
@@ -110,6 +110,7 @@ class StageOutputs {
         std::size_t occurrence = 0;
     };
     static const StageReport* reportOf(const ScanReport& r, const Bound& b);
+    std::string cellAt(const ScanReport& report, std::size_t column) const;
 
     std::vector<std::string> names_;
     std::vector<Bound> column_stage_;
