@@ -15,7 +15,7 @@ namespace {
 TEST(BaselineStages, RegisteredAfterTheCoreStages) {
     EXPECT_EQ(test::allStages().names(),
               "distance, keyframe, denoise, view_keyframe, range_aware_denoise, "
-              "evidence_denoise, odometry_check, fuse, motion, dbscan, radius, sor, shadow, "
+              "evidence_denoise, odometry_check, fuse, track, motion, dbscan, radius, sor, shadow, "
               "decimate");
     StageRegistry only;
     registerBaselineStages(only);  // works without the core stages too

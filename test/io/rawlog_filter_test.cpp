@@ -552,8 +552,9 @@ TEST(KfdFilterCli, WithoutAConfigUsesKfdsDefaultsAndPrintsTheSensor) {
     EXPECT_NE(text.find("range noise"), std::string::npos) << text;
     ASSERT_EQ(run(quoted(KFD_FILTER_EXE) + " --print-config", &printed), 0);
     EXPECT_EQ(printed, kfd::toIni(kfd::kfdDefaults()));
-    EXPECT_NE(printed.find("pipeline = odometry_check, distance, view_keyframe, evidence_denoise"),
-              std::string::npos)
+    EXPECT_NE(
+        printed.find("pipeline = odometry_check, distance, track, view_keyframe, evidence_denoise"),
+        std::string::npos)
         << printed;
 }
 

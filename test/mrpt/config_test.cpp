@@ -135,7 +135,7 @@ TEST(Config, KfdDefaultsAreDefaultIniCompiledIn) {
     const auto ini = kfd::loadConfigFile(std::string(KFD_SHARE_DIR) + "/default.ini");
     EXPECT_EQ(kfd::toIni(kfd::kfdDefaults()), kfd::toIni(ini));
     EXPECT_EQ(kfd::kfdDefaults().stages,
-              (std::vector<std::string>{"odometry_check", "distance", "view_keyframe",
+              (std::vector<std::string>{"odometry_check", "distance", "track", "view_keyframe",
                                         "evidence_denoise"}));
 }
 
@@ -427,7 +427,7 @@ TEST(Config, EveryKeyCarriesItsParamsDefaultAndKfdsDefault) {
 TEST(Config, ChoiceKeysReplaceTheStageOfTheirRole) {
     using V = std::vector<std::string>;
     EXPECT_EQ(fromIniText("[KFD]\nselector = paper\nvariant = reference\n").stages,
-              (V{"odometry_check", "distance", "keyframe", "denoise"}));
+              (V{"odometry_check", "distance", "track", "keyframe", "denoise"}));
     EXPECT_EQ(
         fromIniText("[KFD]\nvariant = range_aware\npipeline = distance, evidence_denoise\n").stages,
         (V{"distance", "range_aware_denoise"}));

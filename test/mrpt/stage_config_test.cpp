@@ -59,7 +59,7 @@ TEST(StageConfig, FlatKeysOfBeforeStillSetTheirStagesWithANoteGivingTheNewSpelli
 TEST(StageConfig, ASectionOfAStageThePipelineDoesNotListIsAnErrorNamingBoth) {
     const std::string m = errorOf("[KFD]\n[KFD.keyframe]\nwindow = 3\n");
     EXPECT_NE(m.find("[KFD.keyframe]: stage 'keyframe' is not in the pipeline (odometry_check, "
-                     "distance, view_keyframe, evidence_denoise)"),
+                     "distance, track, view_keyframe, evidence_denoise)"),
               std::string::npos)
         << m;
     const std::string u = errorOf("[KFD]\n[KFD.median]\nwindow = 3\n");

@@ -27,8 +27,8 @@ TEST(StageRegistry, CoreRegistryHoldsThePapersStagesThenKfds) {
     const auto& r = coreStageRegistry();
     EXPECT_EQ(r.names(),
               "distance, keyframe, denoise, view_keyframe, range_aware_denoise, "
-              "evidence_denoise, odometry_check, fuse");
-    ASSERT_EQ(r.stages().size(), 8u);
+              "evidence_denoise, odometry_check, fuse, track");
+    ASSERT_EQ(r.stages().size(), 9u);
     for (const auto& s : r.stages()) {
         EXPECT_FALSE(s.help.empty()) << s.name;
         EXPECT_FALSE(s.keys.empty()) << s.name;
@@ -56,7 +56,7 @@ TEST(StageRegistry, EachStageOwnsItsKeys) {
               with({"view_samples", "view_tolerance_m", "view_tolerance_deg", "max_view_change",
                     "change_tolerance_m", "change_tolerance_ratio", "max_changed_fraction",
                     "degeneracy_ratio", "corridor_translation_m", "corridor_rotation_deg",
-                    "corridor_interval_s"},
+                    "corridor_interval_s", "max_track_disagreement"},
                    guards));
     EXPECT_EQ(keyNames(*r.find("range_aware_denoise")),
               (std::vector<std::string>{"angle_gap_factor", "m_threshold", "jump_lambda_deg",
@@ -146,7 +146,7 @@ TEST(StageRegistry, RejectsRepeatedAndEmptyNames) {
     EXPECT_THROW(r.add<KeyframeStage>(), Error);
     StageInfo nameless;
     EXPECT_THROW(r.add(nameless), Error);
-    EXPECT_EQ(r.stages().size(), 8u);
+    EXPECT_EQ(r.stages().size(), 9u);
 }
 
 TEST(PipelineParams, TypedAccessCopiesAndDefaults) {

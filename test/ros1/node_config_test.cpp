@@ -50,7 +50,7 @@ TEST(NodeConfig, KeyParametersOverrideTheConfigFile) {
     EXPECT_NE(ini.find("bins = 30"), std::string::npos) << ini;
     EXPECT_NE(ini.find("p_pair = 0.9"), std::string::npos) << ini;
     // selector = paper: the paper's keyframe stage where the default's view_keyframe was.
-    EXPECT_NE(ini.find("pipeline = odometry_check, distance, keyframe, evidence_denoise"),
+    EXPECT_NE(ini.find("pipeline = odometry_check, distance, track, keyframe, evidence_denoise"),
               std::string::npos)
         << ini;
     std::remove(path.c_str());

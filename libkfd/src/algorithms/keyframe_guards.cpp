@@ -29,6 +29,10 @@ const char* toString(KeyframeReason r) {
             return "corridor";
         case KeyframeReason::Covered:
             return "covered";
+        case KeyframeReason::TrackPoor:
+            return "track_poor";
+        case KeyframeReason::TrackOdometry:
+            return "track_odometry";
     }
     return "unknown";
 }

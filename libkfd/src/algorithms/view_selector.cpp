@@ -31,6 +31,8 @@ void ViewSelector::initialize(const Params& p) {
         bad("corridor_rotation_deg", "corridor_rotation_deg must be in (0, 360] (deg)");
     if (!(p.corridor_interval_s > 0.0) || !std::isfinite(p.corridor_interval_s))
         bad("corridor_interval_s", "corridor_interval_s must be > 0 (s)");
+    if (!nonneg(p.max_track_disagreement))
+        bad("max_track_disagreement", "max_track_disagreement must be >= 0 (0 = off)");
     params_ = p;
     tan_b_ = std::tan(p.tolerance_deg * kPi / 180.0);
     reset();
@@ -47,14 +49,14 @@ std::size_t ViewSelector::stride(std::size_t beams) const {
     return std::max<std::size_t>(1, (beams + params_.max_samples - 1) / params_.max_samples);
 }
 
-ViewMeasure ViewSelector::measure(const Scan& scan) {
+ViewMeasure ViewSelector::measure(const Scan& scan, const std::optional<Pose2D>& motion) {
     const Params& p = params_;
     const std::size_t beams = scan.range.size();
     const std::size_t k = stride(beams);
     const std::size_t n = (beams + k - 1) / k;
     dirs_.update(scan.geometry);
 
-    const bool odometry = scan.odometry && kf_odometry_ && have_keyframe_;
+    const bool odometry = (motion || (scan.odometry && kf_odometry_)) && have_keyframe_;
     const bool compare =
         !odometry && have_keyframe_ && kf_geometry_ == scan.geometry && kf_samples_.size() == n;
     const float a = static_cast<float>(p.tolerance_m), b = static_cast<float>(tan_b_);
@@ -123,23 +125,17 @@ ViewMeasure ViewSelector::measure(const Scan& scan) {
     m.corridor = p.degeneracy_ratio > 0.0 && m.degeneracy < p.degeneracy_ratio;
     if (!have_keyframe_) return m;  // keyframe = true
 
+    w_sum_ = w_sum;
+    wx_ = wx;
+    wy_ = wy;
+    wq_ = wq;
+    points_ = points;
     if (odometry) {
         m.used_odometry = true;
-        const Pose2D rel = between(*kf_odometry_, *scan.odometry);
-        // translation: every point moves |t|, against the range-free unit a
-        double e2 = (rel.x * rel.x + rel.y * rel.y) / (p.tolerance_m * p.tolerance_m);
-        if (points > 0) {
-            // rotation: a point at range r moves 2 sin(phi / 2) r, against a + r tan b;
-            // sum w |p'|^2 in the robot frame, p' = Rs p + ts
-            const Pose2D& s = scan.sensor_pose;
-            const double cs = std::cos(s.phi), ss = std::sin(s.phi);
-            const double q = wq + 2.0 * (s.x * (cs * wx - ss * wy) + s.y * (ss * wx + cs * wy)) +
-                             w_sum * (s.x * s.x + s.y * s.y);
-            e2 += 2.0 * (1.0 - std::cos(rel.phi)) * q / static_cast<double>(points);
-        }
-        m.view_change = std::sqrt(std::max(0.0, e2));
+        const Pose2D rel = motion ? *motion : between(*kf_odometry_, *scan.odometry);
+        m.view_change = viewChange(rel, scan.sensor_pose);
         if (m.corridor) {
-            const Travel t = travel(*kf_odometry_, *scan.odometry);
+            const Travel t = travel(Pose2D{}, rel);
             m.keyframe =
                 t.metres >= p.corridor_translation_m || t.degrees >= p.corridor_rotation_deg;
         } else
@@ -155,6 +151,26 @@ ViewMeasure ViewSelector::measure(const Scan& scan) {
     else
         m.keyframe = m.changed_fraction >= p.max_changed_fraction;
     return m;
+}
+
+double ViewSelector::viewChange(const Pose2D& rel, const Pose2D& s) const {
+    // translation: every point moves |t|, against the range-free unit a
+    const double a = params_.tolerance_m;
+    double e2 = (rel.x * rel.x + rel.y * rel.y) / (a * a);
+    if (points_ > 0) {
+        // rotation: a point at range r moves 2 sin(phi / 2) r, against a + r tan b;
+        // sum w |p'|^2 in the robot frame, p' = Rs p + ts
+        const double cs = std::cos(s.phi), ss = std::sin(s.phi);
+        const double q = wq_ + 2.0 * (s.x * (cs * wx_ - ss * wy_) + s.y * (ss * wx_ + cs * wy_)) +
+                         w_sum_ * (s.x * s.x + s.y * s.y);
+        e2 += 2.0 * (1.0 - std::cos(rel.phi)) * q / static_cast<double>(points_);
+    }
+    return std::sqrt(std::max(0.0, e2));
+}
+
+std::optional<Pose2D> ViewSelector::odometrySinceKeyframe(const Scan& scan) const {
+    if (!have_keyframe_ || !scan.odometry || !kf_odometry_) return std::nullopt;
+    return between(*kf_odometry_, *scan.odometry);
 }
 
 void ViewSelector::accept(const Scan& scan) {

@@ -153,6 +153,8 @@ ScanReport Pipeline::process(Scan& scan) {
             report.microseconds += report.stage_reports[i].microseconds;
     }
     report.points_out = scan.countValid();
+    // The stages that ran hear the verdict (Stage::decided); a held scan is kept.
+    for (std::size_t i = 0; i < report.stage_count; ++i) stages_[i]->decided(scan, report.keep);
     if (report.pending) held_report_ = report;
     return report;
 }

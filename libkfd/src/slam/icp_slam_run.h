@@ -40,6 +40,7 @@
 #include "kfd/pipeline/format.h"
 #include "kfd/slam/gap_check.h"
 #include "kfd/stages/keyframe_stage.h"
+#include "kfd/stages/track_stage.h"
 
 #include "drop_rate_match.h"
 #include "icp_slam_steps.h"
@@ -126,6 +127,8 @@ class Run {
     template <class Process>
     void match(bool after_drops, Process&& process);
     void feedOdometry(const mrpt::poses::CPose2D& odometry);
+    void feedTrack(const DoorScan& d);
+    bool gapToBridge(std::size_t own) const;
     void rematch(const IcpSlamStep& step);
     bool toMapFrame(mrpt::obs::CObservationOdometry& odo);
     bool admitScan(DoorScan& d);
@@ -153,6 +156,9 @@ class Run {
     mrpt::obs::CActionCollection no_odometry_;  // laser_only: what the builder gets (empty)
     mrpt::obs::CActionCollection finite_actions_;
     bool origin_set_ = false;  // the first absolute odometry set res_.map_origin
+    // The pipeline lists the track stage: the map builder's odometry is the track (each scan's
+    // tracked pose, kept or dropped), not the log's (issue 35).
+    bool tracking_ = false;
     // ICP's correction of the current step and every one counted (icp_verdicts.h).
     std::optional<IcpVerdicts> icp_;
     using Verdict = IcpVerdicts::Verdict;
@@ -173,6 +179,7 @@ class Run {
         CObservation2DRangeScan::Ptr scan;
         std::optional<mrpt::poses::CPose2D> odometry;  // the builder's, when it had one
         std::size_t row;                               // its entry in unwritten_
+        bool tracked = false;                          // the tracker aligned it to its keyframe
     };
     struct UnwrittenRow {
         ScanRecord record;

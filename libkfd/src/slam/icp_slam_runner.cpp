@@ -17,6 +17,8 @@ void Run::prepare() {
         cfg_->sectionExists("KFD") ? loadIni(*cfg_, "KFD", nullptr, &sum_.notices) : kfdDefaults();
     applySlamGate(*cfg_, kfd_params_, sum_);
     sum_.pipeline = pipelineForMode(opts_.mode, kfd_params_);
+    const auto& stages = sum_.pipeline.stages;
+    tracking_ = std::find(stages.begin(), stages.end(), TrackStage::kName) != stages.end();
     sum_.laser_only = opts_.laser_only;
     checkEvaluationOptions(opts_, sum_);
 }
@@ -149,20 +151,22 @@ void Run::step(DoorStep& w) {
     if (st.observation) {
         bool process = true;
         if (dynamic_cast<CObservation2DRangeScan*>(st.observation.get())) {
+            feedTrack(*next);
             process = admitScan(*next++);
         } else if (auto* odo =
                        dynamic_cast<mrpt::obs::CObservationOdometry*>(st.observation.get())) {
-            process = !opts_.laser_only && toMapFrame(*odo);
+            process = !opts_.laser_only && !tracking_ && toMapFrame(*odo);
             if (process) {
                 builder_odometry_ = mrpt::poses::CPose2D(odo->odometry);
                 builder_odometry_t_ = odo->timestamp;
             }
         }
         if (process)
-            match(!rematch_.empty() && !rematch_this_step_,
+            match(!rematch_this_step_ && gapToBridge(0),
                   [&] { builder_.processObservation(st.observation); });
         return;
     }
+    for (const DoorScan& d : w.scans) feedTrack(d);
     for (auto it = st.frame->begin(); it != st.frame->end();) {
         if (dynamic_cast<CObservation2DRangeScan*>(it->get()) && !admitScan(*next++))
             it = st.frame->erase(it);
@@ -179,8 +183,36 @@ void Run::step(DoorStep& w) {
     }
     for (std::size_t k = rematch_.size() - rematch_this_step_; k < rematch_.size(); ++k)
         rematch_[k].odometry = builder_odometry_;
-    match(rematch_.size() > rematch_this_step_ && scanCount(st),
+    match(gapToBridge(rematch_this_step_) && scanCount(st),
           [&] { builder_.processActionObservation(*action, *st.frame); });
+}
+
+// With the track stage: the scan's tracked pose (kept or dropped) is the map builder's
+// odometry, stamped with the scan, so that a dropped scan's pose is the last correction plus
+// the track and the next keyframe's ICP starts from where the scans say the robot is.
+void Run::feedTrack(const DoorScan& d) {
+    if (!tracking_) return;
+    const TrackResult* t = d.record.report.find<TrackResult>();
+    if (!t) return;  // not through the stages (unusable geometry)
+    mrpt::obs::CObservationOdometry odo;
+    odo.odometry = mrpt::poses::CPose2D(t->pose.x, t->pose.y, t->pose.phi);
+    if (!toMapFrame(odo)) return;
+    odo.timestamp = std::max(d.scan->timestamp, builder_odometry_t_ + std::chrono::microseconds(1));
+    builder_odometry_ = odo.odometry;
+    builder_odometry_t_ = odo.timestamp;
+    timed([&] {
+        builder_.processObservation(std::make_shared<mrpt::obs::CObservationOdometry>(odo));
+    });
+}
+
+// Scans dropped since ICP's last accepted correction (those of the current step, `own`, left
+// out) that the next correction has to bridge: every one without the tracker, the ones it
+// could not align with it. The gap check applies then.
+bool Run::gapToBridge(std::size_t own) const {
+    if (rematch_.size() <= own) return false;
+    const auto end = rematch_.end() - static_cast<std::ptrdiff_t>(own);
+    return !tracking_ ||
+           std::any_of(rematch_.begin(), end, [](const RematchScan& r) { return !r.tracked; });
 }
 
 // An absolute odometry reading as the map builder gets it: in the local frame
@@ -201,7 +233,8 @@ bool Run::toMapFrame(mrpt::obs::CObservationOdometry& odo) {
 // The step's odometry action as the builder gets it: none with laser_only; a non-finite
 // movement left out (the map builder then matches without a motion prior).
 mrpt::obs::CActionCollection* Run::actionFor(const IcpSlamStep& st) {
-    mrpt::obs::CActionCollection* action = opts_.laser_only ? &no_odometry_ : st.action.get();
+    mrpt::obs::CActionCollection* action =
+        opts_.laser_only || tracking_ ? &no_odometry_ : st.action.get();
     if (auto mv = action->getBestMovementEstimation()) {
         const auto d = mv->rawOdometryIncrementReading;
         const auto m = mv->poseChange ? mv->poseChange->getMeanVal() : d;

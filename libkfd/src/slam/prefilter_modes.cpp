@@ -22,14 +22,14 @@ std::vector<PrefilterModeInfo> buildModes() {
     v.push_back(mode(PrefilterMode::None, "none", {}, "no pre-filter: plain ICP-SLAM"));
     v.push_back(mode(PrefilterMode::Odometry, "odometry", {"motion"},
                      defaultStageRegistry().find("motion")->help));
-    v.push_back(mode(PrefilterMode::Keyframe, "keyframe", {"distance", "view_keyframe"},
+    v.push_back(mode(PrefilterMode::Keyframe, "keyframe", {"distance", "track", "view_keyframe"},
                      "keyframe extraction only (distance + the [KFD] pipeline's keyframe "
                      "stage)"));
     PrefilterModeInfo kfd =
         mode(PrefilterMode::Kfd, "kfd",
-             {"odometry_check", "distance", "view_keyframe", "evidence_denoise"},
+             {"odometry_check", "distance", "track", "view_keyframe", "evidence_denoise"},
              "the full method: the [KFD] section's pipeline (default "
-             "odometry_check, distance, view_keyframe, evidence_denoise)");
+             "odometry_check, distance, track, view_keyframe, evidence_denoise)");
     kfd.uses_kfd_stages = true;
     v.push_back(kfd);
     v.push_back(mode(PrefilterMode::Dbscan, "dbscan", {"distance", "dbscan"}));

@@ -115,7 +115,9 @@ bool Run::admitScan(DoorScan& r) {
             rematch_.clear();
             flushUnwritten();
         }
-        rematch_.push_back({scan, builder_odometry_, unwritten_.size() + step_scans_.size()});
+        const TrackResult* t = r.record.report.find<TrackResult>();
+        rematch_.push_back(
+            {scan, builder_odometry_, unwritten_.size() + step_scans_.size(), t && t->tracked()});
         ++rematch_this_step_;
     }
     step_scans_.push_back(std::move(r.record));

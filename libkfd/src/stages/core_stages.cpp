@@ -8,6 +8,7 @@
 #include "kfd/stages/keyframe_stage.h"
 #include "kfd/stages/odometry_check_stage.h"
 #include "kfd/stages/range_aware_denoise_stage.h"
+#include "kfd/stages/track_stage.h"
 #include "kfd/stages/view_keyframe_stage.h"
 
 namespace kfd {
@@ -21,6 +22,7 @@ void registerCoreStages(StageRegistry& registry) {
     registry.add<EvidenceDenoiseStage>();    // kfd's, beyond the paper (issues 16-25)
     registry.add<OdometryCheckStage>();      // kfd's, beyond the paper
     registry.add<FuseStage>();               // kfd's, beyond the paper (issue 25)
+    registry.add<TrackStage>();              // kfd's, beyond the paper (issue 35)
     registry.addChoice({"selector",
                         "which keyframe stage runs: paper = keyframe (Formula 3), view = "
                         "view_keyframe (kfd's)",

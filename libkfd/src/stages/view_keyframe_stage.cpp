@@ -47,13 +47,17 @@ std::vector<StageKey> ViewKeyframeStage::keys() {
                  "corridor switch, odometry: keyframe after this turn (deg)", 0, 360, true,
                  &V::corridor_rotation_deg),
         viewReal("corridor_interval_s", "corridor switch, laser only: keyframe after this time (s)",
-                 0, 1e6, true, &V::corridor_interval_s)};
+                 0, 1e6, true, &V::corridor_interval_s),
+        viewReal("max_track_disagreement",
+                 "with the track stage: keyframe when the tracked motion and the odometry "
+                 "differ by this view change (0 = off)",
+                 0, 1e3, false, &V::max_track_disagreement)};
     for (auto& g : guardKeys<P>()) k.push_back(std::move(g));
     return k;
 }
 
-bool ViewKeyframeStage::process(Scan& scan, StageReport& report, const ScanReport&) {
-    const KeyframeDecision d = algo_.filter(scan);
+bool ViewKeyframeStage::process(Scan& scan, StageReport& report, const ScanReport& chain) {
+    const KeyframeDecision d = algo_.filter(scan, chain.find<TrackResult>());
     report.setDiagnostics(d);
     return d.keyframe;
 }

@@ -12,16 +12,18 @@ namespace kfd {
 
 /// Why a scan was kept or dropped.
 enum class KeyframeReason : std::uint8_t {
-    First,        // first scan of the stream (or after reset): always a keyframe
-    Dissimilar,   // P_common < P_threshold (Formula 3): new information
-    MaxDrops,     // guard: too many consecutive drops
-    MaxInterval,  // guard: too long since the last keyframe
-    Translation,  // guard: odometry moved too far since the last keyframe
-    Rotation,     // guard: odometry turned too far since the last keyframe (rotation in place)
-    Similar,      // P_common >= P_threshold: dropped
-    ViewChange,   // view selector: the view moved beyond the keyframe's
-    Corridor,     // view selector, degenerate scene: odometry (or time) since the keyframe
-    Covered,      // view selector: the keyframe covers this view: dropped
+    First,          // first scan of the stream (or after reset): always a keyframe
+    Dissimilar,     // P_common < P_threshold (Formula 3): new information
+    MaxDrops,       // guard: too many consecutive drops
+    MaxInterval,    // guard: too long since the last keyframe
+    Translation,    // guard: odometry moved too far since the last keyframe
+    Rotation,       // guard: odometry turned too far since the last keyframe (rotation in place)
+    Similar,        // P_common >= P_threshold: dropped
+    ViewChange,     // view selector: the view moved beyond the keyframe's
+    Corridor,       // view selector, degenerate scene: odometry (or time) since the keyframe
+    Covered,        // view selector: the keyframe covers this view: dropped
+    TrackPoor,      // view selector, tracker: the scan no longer aligns with the keyframe
+    TrackOdometry,  // view selector, tracker: the scans moved where the odometry does not
 };
 const char* toString(KeyframeReason r);
 

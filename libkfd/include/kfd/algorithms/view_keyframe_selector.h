@@ -3,6 +3,7 @@
 #pragma once
 
 #include "kfd/algorithms/keyframe_guards.h"
+#include "kfd/algorithms/scan_tracker.h"
 #include "kfd/algorithms/view_selector.h"
 #include "kfd/pipeline/scan.h"
 
@@ -24,10 +25,15 @@ class ViewKeyframeSelector {
     const Params& params() const { return params_; }
     void reset();
 
-    /// Decides on the scan (does not modify it).
-    KeyframeDecision filter(const Scan& scan);
+    /// Decides on the scan (does not modify it). With the scan's track (the track stage ran
+    /// before): the view change is measured from the tracked motion since the keyframe, a scan
+    /// the tracker could not align is a keyframe (track_poor), and so is one whose tracked
+    /// motion and odometry disagree by max_track_disagreement (track_odometry).
+    KeyframeDecision filter(const Scan& scan, const TrackResult* track = nullptr);
 
   private:
+    bool disagrees(const Scan& scan, const TrackResult* track) const;
+
     Params params_;
     ViewSelector view_;
     KeyframeGuards guards_;

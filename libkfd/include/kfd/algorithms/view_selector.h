@@ -59,6 +59,9 @@ class ViewSelector {
         double corridor_translation_m = 0.5;   // corridor with odometry: keyframe after this
         double corridor_rotation_deg = 15.0;   // ... or this turn
         double corridor_interval_s = 0.2;      // corridor without odometry: after this time
+        // With a track (the tracker's motion since the keyframe): a keyframe when the track and
+        // the odometry disagree by this view change (units as max_view_change; 0 = off).
+        double max_track_disagreement = 0.5;
     };
 
     ViewSelector() { initialize(Params{}); }
@@ -70,9 +73,15 @@ class ViewSelector {
     /// Forgets the keyframe.
     void reset();
 
-    /// Measures the scan against the keyframe (odometry used when both have it). Does not
+    /// Measures the scan against the keyframe (odometry used when both have it; `motion`, the
+    /// robot's motion since the keyframe as the tracker found it, instead when given). Does not
     /// change the keyframe: call accept() when the scan becomes one.
-    ViewMeasure measure(const Scan& scan);
+    ViewMeasure measure(const Scan& scan, const std::optional<Pose2D>& motion = std::nullopt);
+    /// The view change (the formula above) of a robot motion `rel`, over the returns the last
+    /// measure() sampled (0 before any).
+    double viewChange(const Pose2D& rel, const Pose2D& sensor_pose) const;
+    /// The odometry's motion since the keyframe, when both have odometry.
+    std::optional<Pose2D> odometrySinceKeyframe(const Scan& scan) const;
     /// Makes the scan the keyframe (its sampled ranges, odometry and stamp).
     void accept(const Scan& scan);
 
@@ -92,6 +101,9 @@ class ViewSelector {
     std::optional<Pose2D> kf_odometry_;
     double kf_stamp_ = 0.0;
     bool kf_have_stamp_ = false;
+    // the last measure()'s weighted moments of the sampled returns (sensor frame)
+    double w_sum_ = 0.0, wx_ = 0.0, wy_ = 0.0, wq_ = 0.0;
+    std::size_t points_ = 0;
 };
 
 }  // namespace kfd

@@ -117,6 +117,12 @@ class Stage {
     /// (a dropped scan's whole cost is the point of dropping it) and not allocate in steady
     /// state. The default ignores it.
     virtual void observeDropped(const Scan& /*scan*/) {}
+    /// The chain's verdict on a scan this stage's process() ran on: kept (no stage dropped it;
+    /// a scan held by a later stage counts as kept) or dropped, called for every such stage in
+    /// order once the chain has run, with the scan as the later stages left it. A stage that
+    /// needs to know which scans became keyframes (the tracker) learns it here. The default
+    /// ignores it.
+    virtual void decided(const Scan& /*scan*/, bool /*kept*/) {}
     /// Forget all stream state (called when the sensor's geometry changes).
     virtual void reset() {}
     /// True: a scan reaching this stage is finished only once the sensor's next scan reached it
