@@ -132,7 +132,7 @@ ViewMeasure ViewSelector::measure(const Scan& scan, const std::optional<Pose2D>&
     points_ = points;
     if (odometry) {
         m.used_odometry = true;
-        const Pose2D rel = motion ? *motion : between(*kf_odometry_, *scan.odometry);
+        const Pose2D rel = motion ? *motion : *odometrySinceKeyframe(scan);
         m.view_change = viewChange(rel, scan.sensor_pose);
         if (m.corridor) {
             const Travel t = travel(Pose2D{}, rel);
