@@ -1,5 +1,6 @@
 #include "kfd/ros1/node_config.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -82,11 +83,24 @@ double secondsParam(const std::string& key, XmlRpcValue v, double lo, double hi)
     return d;
 }
 
+// ~track_tf publishes odom_frame -> base_frame from the track: it needs the track stage, and
+// the node must not read the odometry it writes.
+void checkTrackTf(const NodeConfig& c) {
+    if (!c.track_tf) return;
+    const auto& stages = c.pipeline.stages;
+    if (std::find(stages.begin(), stages.end(), "track") == stages.end())
+        throw ConfigError("track_tf", "true, but the pipeline does not list the track stage");
+    if (c.odometry == NodeConfig::Odometry::Tf)
+        throw ConfigError("track_tf",
+                          "true with ~odom: tf would read back the transform it publishes (" +
+                              c.odom_frame + " -> " + c.base_frame + "); set ~odom: topic or none");
+}
+
 }  // namespace
 
 bool isNodeParameter(const std::string& name) {
     for (const char* n : {"config", "odom", "odom_frame", "base_frame", "tf_wait", "removed_as",
-                          "reset_jump", "queue_size"})
+                          "reset_jump", "queue_size", "track_topic", "track_tf"})
         if (name == n) return true;
     return false;
 }
@@ -125,6 +139,13 @@ NodeConfig nodeConfig(const std::map<std::string, XmlRpc::XmlRpcValue>& params) 
             if (q < 1 || q > 1000)
                 throw ConfigError(key, std::to_string(q) + " is outside [1, 1000]");
             c.queue_size = q;
+        } else if (key == "track_topic") {
+            c.track_topic = stringParam(key, value);
+        } else if (key == "track_tf") {
+            if (value.getType() != XmlRpc::XmlRpcValue::TypeBoolean)
+                throw ConfigError(key,
+                                  std::string("is ") + typeName(value.getType()) + ", not a bool");
+            c.track_tf = bool(XmlRpc::XmlRpcValue(value));
         } else if (key == "removed_as") {
             try {
                 c.removed = parseRemovedMark(stringParam(key, value));
@@ -144,6 +165,7 @@ NodeConfig nodeConfig(const std::map<std::string, XmlRpc::XmlRpcValue>& params) 
     applyConfig(c.pipeline, kfd_keys, defaultStageRegistry(),
                 ConfigSyntax{ConfigSyntax::RosParams, "KFD"}, &c.notes);
     validateConfig(c.pipeline, defaultStageRegistry());
+    checkTrackTf(c);
     return c;
 }
 

@@ -2,6 +2,7 @@
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <diagnostic_msgs/KeyValue.h>
+#include <geometry_msgs/TransformStamped.h>
 #include <tf2/exceptions.h>
 
 #include <algorithm>
@@ -10,6 +11,8 @@
 #include <cmath>
 #include <cstdio>
 #include <thread>
+
+#include "kfd/algorithms/scan_tracker.h"
 
 namespace kfd::ros1 {
 
@@ -66,6 +69,11 @@ ScanFilterNode::ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh, const No
     scan_pub_ = nh_.advertise<sensor_msgs::LaserScan>("scan_filtered", q);
     diag_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1);
     stats_pub_ = pnh_.advertise<diagnostic_msgs::DiagnosticStatus>("stats", 1, true);
+    const auto& stages = config_.pipeline.stages;
+    if (!config_.track_topic.empty() &&
+        std::find(stages.begin(), stages.end(), "track") != stages.end())
+        track_pub_ = nh_.advertise<nav_msgs::Odometry>(config_.track_topic, q);
+    if (config_.track_tf) track_tf_ = std::make_unique<tf2_ros::TransformBroadcaster>();
     if (config_.odometry == NodeConfig::Odometry::Topic) {
         ros::SubscribeOptions o = ros::SubscribeOptions::create<nav_msgs::Odometry>(
             "odom", 50, [this](const nav_msgs::Odometry::ConstPtr& m) { onOdometry(m); },
@@ -285,9 +293,38 @@ void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
                           in->header.frame_id.c_str(), stamp.toSec());
     publishReady();  // held keyframes (next_scan) finished by a reset or this scan, before it
     if (r.publish) scan_pub_.publish(out);
+    publishTrack(r, stamp);
     const auto end = std::chrono::steady_clock::now();
     latency_.add(std::chrono::duration<double, std::micro>(end - start).count());
     work_.add(std::chrono::duration<double, std::micro>(end - ready).count());
+}
+
+void ScanFilterNode::publishTrack(const LiveResult& r, const ros::Time& stamp) {
+    const TrackResult* t = r.stream.report.find<TrackResult>();
+    if (!t || (!track_pub_ && !track_tf_)) return;  // not through the stages, or nothing asked
+    geometry_msgs::Quaternion q;
+    q.z = std::sin(0.5 * t->pose.phi);
+    q.w = std::cos(0.5 * t->pose.phi);
+    if (track_pub_) {
+        auto m = boost::make_shared<nav_msgs::Odometry>();
+        m->header.stamp = stamp;
+        m->header.frame_id = config_.odom_frame;
+        m->child_frame_id = config_.base_frame;
+        m->pose.pose.position.x = t->pose.x;
+        m->pose.pose.position.y = t->pose.y;
+        m->pose.pose.orientation = q;
+        track_pub_.publish(m);
+    }
+    if (track_tf_) {
+        geometry_msgs::TransformStamped tf;
+        tf.header.stamp = stamp;
+        tf.header.frame_id = config_.odom_frame;
+        tf.child_frame_id = config_.base_frame;
+        tf.transform.translation.x = t->pose.x;
+        tf.transform.translation.y = t->pose.y;
+        tf.transform.rotation = q;
+        track_tf_->sendTransform(tf);
+    }
 }
 
 diagnostic_msgs::DiagnosticStatus ScanFilterNode::stats() const {

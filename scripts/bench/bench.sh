@@ -121,6 +121,8 @@ rows = [
     ("BM_KeyframeDecision", "keyframe decision, m = 8 (histogram + 8 correlations), dropped scan"),
     ("BM_KeyframeView/0", "keyframe decision, view selector (kfd's default), odometry, dropped scan"),
     ("BM_KeyframeView/1", "keyframe decision, view selector, laser only, dropped scan"),
+    ("BM_Tracker", "scan tracker (issue 35), dropped scan against its keyframe"),
+    ("BM_IcpMrpt", "MRPT ICP, every-scan config's [ICP], scan vs local map (no insertion)"),
     ("BM_DenoiseReference", "denoise, reference (rings + filter) *"),
     ("BM_DenoiseRangeAware", "denoise, range-aware *"),
     ("BM_DenoiseEvidence", "denoise, evidence (kfd's default), loop keyframes *"),
@@ -232,6 +234,18 @@ if ir.get("pipeline_dropped_view"):
     print(f"| dropped scan through the pipeline <= 15 000 instructions (kfd's default; {parts}) | {n:,.0f} | {verdict(n <= 15000)} |")
 if ir.get("door_dropped_view"):
     print(f"| dropped scan through the door (StreamFilter::process, MRPT scan), reported | {ir['door_dropped_view'] / calls:,.0f} | reported |")
+# Issue 35: the scan tracker per dropped scan beside MRPT's ICP per scan (CPU, same run of
+# kfd_bench_stages: valgrind cannot run mrpt-slam's libraries), and the dropped scan through
+# kfd's default pipeline since issue 35 (odometry check, distance, track, view keyframe,
+# evidence denoise) <= 40 000 instructions.
+tr, icp = st.get("BM_Tracker"), st.get("BM_IcpMrpt")
+if tr and icp and "error" not in tr and "error" not in icp:
+    trn = f", {ir['tracker'] / calls:,.0f} instructions" if ir.get("tracker") else ""
+    print(f"| scan tracker beside MRPT ICP per scan (CPU, same run), reported | tracker {us(tr):.1f} us{trn}; ICP {us(icp):.0f} us, {us(icp) / us(tr):.0f}x the tracker | reported |")
+if ir.get("pipeline_dropped_track"):
+    n = ir["pipeline_dropped_track"] / calls
+    tn = f"; tracker {ir['tracker'] / calls:,.0f}" if ir.get("tracker") else ""
+    print(f"| dropped scan through kfd's default pipeline with the tracker <= 40 000 instructions{tn} | {n:,.0f} | {verdict(n <= 40000)} |")
 # Issue 11: the evidence denoiser, on the loop keyframes (its temporal evidence needs the
 # previous keyframe), against DBSCAN on the same scans and in the same run.
 ev, dbl = st.get("BM_DenoiseEvidence"), st.get("BM_DbscanLoop")

@@ -17,6 +17,7 @@
 
 #include "bench_scans.h"
 #include "kfd/algorithms/keyframe_selector.h"
+#include "kfd/algorithms/scan_tracker.h"
 #include "kfd/baselines/dbscan.h"
 #include "kfd/baselines/radius_outlier.h"
 #include "kfd/baselines/statistical_outlier.h"
@@ -42,6 +43,14 @@ kfd::Pipeline::Params viewDropParams(std::size_t temporal_scans = 0) {
     return p;
 }
 
+// kfd's default pipeline since issue 35 (odometry check, distance, track, view keyframe,
+// evidence denoise) with the view selector's thresholds out of reach, as viewDropParams.
+kfd::Pipeline::Params trackDropParams() {
+    kfd::Pipeline::Params p = viewDropParams();
+    p.stages = {"odometry_check", "distance", "track", "view_keyframe", "evidence_denoise"};
+    return p;
+}
+
 // The evidence denoiser on the keyframes alone (temporal_scans 0: before issue 25).
 kfd::Pipeline::Params keyframesOnlyParams() {
     kfd::Pipeline::Params p = kb::paperParams(kfd::DenoiseVariant::Evidence);
@@ -61,21 +70,6 @@ kfd::Pipeline::Params nextScanParams() {
     kfd::Pipeline::Params p = temporalParams();
     p.get<kfd::EvidenceDenoiseStage>().next_scan = true;
     return p;
-}
-
-// The MRPT form of a core scan (what a driver gives the door).
-mrpt::obs::CObservation2DRangeScan toMrpt(const kfd::Scan& s) {
-    mrpt::obs::CObservation2DRangeScan o;
-    o.sensorLabel = "LASER";
-    o.aperture = static_cast<float>(s.geometry.aperture);
-    o.rightToLeft = s.geometry.right_to_left;
-    o.resizeScan(s.size());
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        o.setScanRange(i, s.range[i]);
-        o.setScanRangeValidity(i, s.valid[i] != 0);
-    }
-    o.timestamp = mrpt::Clock::fromDouble(s.timestamp);
-    return o;
 }
 
 struct Context {
@@ -109,7 +103,9 @@ struct Context {
     kfd::Pipeline pipe_range_aware{kb::paperParams(kfd::DenoiseVariant::RangeAware)};
     kfd::Pipeline pipe_view{viewDropParams()};            // kfd's default pipeline, dropping
     kfd::Pipeline pipe_view_temporal{viewDropParams(1)};  // the same, keeping the dropped scan
-    kfd::StreamFilter door{viewDropParams()};  // the same behind the one door (MRPT scans)
+    kfd::StreamFilter door{viewDropParams()};     // the same behind the one door (MRPT scans)
+    kfd::Pipeline pipe_track{trackDropParams()};  // kfd's default pipeline since issue 35
+    kfd::ScanTracker tracker;                     // the track stage's algorithm alone
     std::vector<mrpt::obs::CObservation2DRangeScan> obs_dropped, obs_work;
     std::size_t sink = 0;       // results feed this so nothing is optimised away
     std::size_t surprises = 0;  // dropped-set scans kept or keyframe-set scans dropped
@@ -126,10 +122,14 @@ struct Context {
         pipe_view.process(first);  // the keyframe every dropped-set scan is measured against
         kfd::Scan first_t = sc.prefix.back();
         pipe_view_temporal.process(first_t);
-        auto first_obs = toMrpt(sc.prefix.back());
+        auto first_obs = kb::toMrpt(sc.prefix.back());
         door.process(first_obs, sc.prefix.back().odometry);
-        for (const auto& s : sc.dropped) obs_dropped.push_back(toMrpt(s));
+        for (const auto& s : sc.dropped) obs_dropped.push_back(kb::toMrpt(s));
         obs_work = obs_dropped;
+        kfd::Scan first_track = sc.prefix.back();
+        pipe_track.process(first_track);
+        tracker.track(sc.prefix.back());
+        tracker.accept();
     }
 };
 
@@ -214,6 +214,12 @@ __attribute__((noinline)) void kfd_ir_pipeline_dropped_view_temporal(Context& c,
 __attribute__((noinline)) void kfd_ir_door_dropped_view(Context& c, std::size_t k) {
     c.surprises += c.door.process(c.obs_work[k], c.sc.dropped[k].odometry).keep;
 }
+__attribute__((noinline)) void kfd_ir_pipeline_dropped_track(Context& c, std::size_t k) {
+    c.surprises += c.pipe_track.process(c.work_dropped[k]).keep;
+}
+__attribute__((noinline)) void kfd_ir_tracker(Context& c, std::size_t k) {
+    c.sink += c.tracker.track(c.sc.dropped[k]).pairs;
+}
 __attribute__((noinline)) void kfd_ir_pipeline_keyframe_reference(Context& c, std::size_t k) {
     c.surprises += !c.pipe_reference.process(c.work[k]).keep;
 }
@@ -251,6 +257,8 @@ const Case kCases[] = {
     {"pipeline_dropped_view", kfd_ir_pipeline_dropped_view, true},
     {"pipeline_dropped_view_temporal", kfd_ir_pipeline_dropped_view_temporal, true},
     {"door_dropped_view", kfd_ir_door_dropped_view, true},
+    {"pipeline_dropped_track", kfd_ir_pipeline_dropped_track, true},
+    {"tracker", kfd_ir_tracker, true},
     {"pipeline_keyframe_reference", kfd_ir_pipeline_keyframe_reference, false},
     {"pipeline_keyframe_range_aware", kfd_ir_pipeline_keyframe_range_aware, false},
 };
@@ -295,6 +303,8 @@ void warmUp(Context& c, const Case& cs) {
             c.obs_work[k] = c.obs_dropped[k];
             c.door.process(c.obs_work[k], c.sc.dropped[k].odometry);
         }
+        if (name == "pipeline_dropped_track") c.pipe_track.process(s);
+        if (name == "tracker") c.tracker.track(c.sc.dropped[k]);
         if (name == "pipeline_keyframe_reference") c.pipe_reference.process(s);
         if (name == "pipeline_keyframe_range_aware") c.pipe_range_aware.process(s);
     }

@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include <mrpt/obs/CObservation2DRangeScan.h>
+
 #include "kfd/algorithms/keyframe_selector.h"
 #include "kfd/paper/distance_filter.h"
 #include "kfd/pipeline/pipeline.h"
@@ -280,6 +282,21 @@ class StageFilter {
     S stage_;
     ScanReport chain_{};
 };
+
+/// The MRPT form of a core scan (what a driver gives the door).
+inline mrpt::obs::CObservation2DRangeScan toMrpt(const Scan& s) {
+    mrpt::obs::CObservation2DRangeScan o;
+    o.sensorLabel = "LASER";
+    o.aperture = static_cast<float>(s.geometry.aperture);
+    o.rightToLeft = s.geometry.right_to_left;
+    o.resizeScan(s.size());
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        o.setScanRange(i, s.range[i]);
+        o.setScanRangeValidity(i, s.valid[i] != 0);
+    }
+    o.timestamp = mrpt::Clock::fromDouble(s.timestamp);
+    return o;
+}
 
 /// The scan without its odometry (what a robot without wheel encoders gives the selector).
 inline Scan laserOnly(Scan s) {

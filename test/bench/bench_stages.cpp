@@ -10,8 +10,13 @@
 #include <string>
 #include <vector>
 
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/slam/CICP.h>
+
 #include "bench_scans.h"
 #include "kfd/algorithms/keyframe_selector.h"
+#include "kfd/algorithms/scan_tracker.h"
 #include "kfd/baselines/dbscan.h"
 #include "kfd/baselines/radius_outlier.h"
 #include "kfd/baselines/statistical_outlier.h"
@@ -160,6 +165,61 @@ void BM_KeyframeView(benchmark::State& state) {
     perScan(state);
 }
 BENCHMARK(BM_KeyframeView)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// kfd's scan tracker (issue 35, the track stage's algorithm, default parameters) on the same
+// dropped scans, each aligned to the last scan of the prefix (its keyframe).
+void BM_Tracker(benchmark::State& state) {
+    const auto& sc = scenario();
+    kfd::ScanTracker tracker;
+    tracker.track(sc.prefix.back());
+    tracker.accept();
+    std::size_t k = 0, tracked = 0;
+    for (auto _ : state) {
+        tracked += tracker.track(sc.dropped[k]).tracked() ? 1 : 0;
+        k = (k + 1) % sc.dropped.size();
+    }
+    state.counters["tracked_share"] =
+        benchmark::Counter(double(tracked), benchmark::Counter::kAvgIterations);
+    perScan(state);
+}
+BENCHMARK(BM_Tracker)->Unit(benchmark::kMicrosecond);
+
+// MRPT's ICP as kfd-icp-slam runs it on every scan (the [ICP] section of share/kfd-icp-slam/
+// sick-180-5hz-every-scan.ini): the same dropped scans' points built and aligned, from their
+// odometry, to a local point map of the prefix scans. icp-slam also inserts kept scans into
+// its map, which this leaves out.
+void BM_IcpMrpt(benchmark::State& state) {
+    const auto& sc = scenario();
+    mrpt::slam::CICP icp;
+    icp.options.loadFromConfigFile(
+        mrpt::config::CConfigFile(std::string(KFD_SOURCE_DIR) +
+                                  "/share/kfd-icp-slam/sick-180-5hz-every-scan.ini"),
+        "ICP");
+    mrpt::maps::CSimplePointsMap local;
+    for (const auto& s : sc.prefix) {
+        const kfd::Pose2D p = s.odometry.value_or(kfd::Pose2D{});
+        local.insertObservation(kb::toMrpt(s),
+                                mrpt::poses::CPose3D(p.x, p.y, 0.0, p.phi, 0.0, 0.0));
+    }
+    std::vector<mrpt::obs::CObservation2DRangeScan> obs;
+    for (const auto& s : sc.dropped) obs.push_back(kb::toMrpt(s));
+    std::size_t k = 0;
+    double iterations = 0.0;
+    for (auto _ : state) {
+        mrpt::maps::CSimplePointsMap points;
+        points.insertObservation(obs[k]);
+        const kfd::Pose2D g = sc.dropped[k].odometry.value_or(kfd::Pose2D{});
+        mrpt::slam::CICP::TReturnInfo info;
+        auto pdf = icp.Align(&local, &points, mrpt::poses::CPose2D(g.x, g.y, g.phi), info);
+        benchmark::DoNotOptimize(pdf);
+        iterations += double(info.nIterations);
+        k = (k + 1) % obs.size();
+    }
+    state.counters["icp_iterations"] =
+        benchmark::Counter(iterations, benchmark::Counter::kAvgIterations);
+    perScan(state);
+}
+BENCHMARK(BM_IcpMrpt)->Unit(benchmark::kMicrosecond);
 
 // Algorithm 2 as published (t = 5 rings, theta = 10 x resolution) + the m_threshold = 10
 // cluster filter.

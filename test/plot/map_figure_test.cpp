@@ -197,6 +197,30 @@ TEST(MapFigure, LayersAreExactlyTheOnesDrawn) {
         EXPECT_NE(caption.find(word), std::string::npos) << word;
 }
 
+// kfd's scan track (issue 35) is drawn in purple from the estimate's start, whatever its own
+// frame: a track starting at the origin of a laser-only run lands on the estimate.
+TEST(MapFigure, TheScanTrackIsDrawnFromTheEstimatesStart) {
+    mrpt::maps::COccupancyGridMap2D grid(-5, 5, -5, 5, 0.05f);
+    kfd::MapFigureInput in;
+    in.grid = &grid;
+    for (int k = 0; k <= 20; ++k) in.estimate.push_back({double(k), {-2.0 + 0.2 * k, 1.0, 0.0}});
+    for (int k = 0; k <= 20; ++k)  // its own frame, and 0.5 m to the left of the estimate
+        in.track.push_back({double(k), {0.2 * k, 0.5, 0.0}});
+    in.track.front().pose.y = 0.0;
+    in.track[1].pose.y = 0.0;
+    const auto fig = kfd::renderMapFigure(in);
+    EXPECT_EQ(names(fig),
+              (std::vector<std::string>{"estimate", "kfd's scan track from the estimate's start"}));
+    auto purple = [&](double x, double y) {
+        const auto p = fig.frame.pixel(x, y);
+        const auto c = rgbAt(fig.image, p.first, p.second);
+        return c[0] == 160 && c[1] == 40 && c[2] == 180;
+    };
+    EXPECT_TRUE(purple(1.0, 1.5));   // x -2 + 3 m, y 1 + 0.5 m
+    EXPECT_FALSE(purple(1.0, 2.5));  // nothing where the track's own frame would put it
+    EXPECT_NE(kfd::mapFigureCaption(fig.layers).find("purple"), std::string::npos);
+}
+
 TEST(MapFigure, PointsFarAwayOrNotFiniteAreClampedNotCastBeyondAnInt) {
     mrpt::maps::COccupancyGridMap2D grid(-5, 5, -5, 5, 0.05f);
     kfd::MapFigureFrame frame;

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <thread>
 #include <vector>
@@ -319,6 +320,85 @@ TEST_F(ScanFilterNodeTest, ABagLoopingResetsWithAWarning) {
     EXPECT_EQ(n->counters().resets, 2u);
     EXPECT_EQ(n->counters().scans_in, 48u);
     EXPECT_EQ(n->counters().out_of_order, 0u);
+}
+
+// The track stage's pose of every scan, kept or dropped, on ~track_topic: the robot walking
+// 5 cm a scan towards the room's front wall, without odometry, is tracked by the scans alone.
+TEST_F(ScanFilterNodeTest, PublishesTheTrackedPoseOfEveryScan) {
+    ros::param::set("/tracknode/odom", std::string("none"));
+    auto n = node("tracknode");
+    ros::NodeHandle nh("/tracknode_ns");
+    std::vector<nav_msgs::Odometry> poses;
+    auto sub = nh.subscribe<nav_msgs::Odometry>(
+        "tracked_odom", 50, [&](const nav_msgs::Odometry::ConstPtr& m) { poses.push_back(*m); });
+    waitForPublisher(sub);
+    for (int i = 0; i < 10; ++i)
+        n->onScan(boost::make_shared<sensor_msgs::LaserScan>(
+            roomScan(2.0 + 0.1 * i, "laser", 181, 0.05 * i)));
+    spinUntil([&] { return poses.size() >= 10; }, 200);
+    ASSERT_EQ(poses.size(), 10u);  // every scan, not only the kept ones
+    EXPECT_LT(n->counters().scans_kept, 10u);
+    EXPECT_EQ(poses.back().header.frame_id, "odom");
+    EXPECT_EQ(poses.back().child_frame_id, "base_link");
+    EXPECT_DOUBLE_EQ(poses.back().header.stamp.toSec(), 2.9);
+    EXPECT_NEAR(poses.back().pose.pose.position.x, 0.45, 0.02);
+    EXPECT_NEAR(poses.back().pose.pose.position.y, 0.0, 0.02);
+}
+
+// Scans that never reach the stages (no beams, a NaN increment, every range NaN) publish no
+// tracked pose and do not stop the node; the next good scan is tracked.
+TEST_F(ScanFilterNodeTest, AnUnusableScanPublishesNoTrackedPose) {
+    ros::param::set("/badtrack/odom", std::string("none"));
+    auto n = node("badtrack");
+    ros::NodeHandle nh("/badtrack_ns");
+    int received = 0;
+    auto sub = nh.subscribe<nav_msgs::Odometry>(
+        "tracked_odom", 50, [&](const nav_msgs::Odometry::ConstPtr&) { ++received; });
+    waitForPublisher(sub);
+    auto empty = boost::make_shared<sensor_msgs::LaserScan>(roomScan(3.0));
+    empty->ranges.clear();
+    auto nan_step = boost::make_shared<sensor_msgs::LaserScan>(roomScan(3.1));
+    nan_step->angle_increment = std::numeric_limits<float>::quiet_NaN();
+    auto blind = boost::make_shared<sensor_msgs::LaserScan>(roomScan(3.2));
+    for (float& r : blind->ranges) r = std::numeric_limits<float>::quiet_NaN();
+    for (const auto& m : {empty, nan_step}) n->onScan(m);
+    n->onScan(blind);
+    n->onScan(scanAt(3.3));
+    spinUntil([&] { return received >= 2; }, 100);
+    EXPECT_EQ(n->counters().scans_in, 4u);
+    EXPECT_GE(n->counters().scans_skipped, 2u);
+    EXPECT_LE(received, 2);  // the blind scan may be tracked (its prior), the unusable ones never
+    EXPECT_GE(received, 1);  // the good scan
+}
+
+TEST_F(ScanFilterNodeTest, TrackTfIsRefusedWhereItWouldReadItsOwnTransform) {
+    ros::param::set("/tftrack1/track_tf", true);  // ~odom: tf (the default) reads odom -> base
+    EXPECT_EQ(refusedKey("tftrack1"), "track_tf");
+    ros::param::set("/tftrack2/track_tf", std::string("yes"));
+    EXPECT_EQ(refusedKey("tftrack2"), "track_tf");
+    ros::param::set("/tftrack3/odom", std::string("none"));
+    ros::param::set("/tftrack3/track_tf", true);
+    ros::param::set("/tftrack3/pipeline", std::string("distance,view_keyframe"));
+    EXPECT_EQ(refusedKey("tftrack3"), "track_tf");  // no track stage to publish
+    ros::param::set("/tftrack4/odom", std::string("none"));
+    ros::param::set("/tftrack4/track_tf", true);
+    EXPECT_EQ(refusedKey("tftrack4"), "");
+}
+
+// ~track_tf with ~odom: none: the track is broadcast as odom -> base_link at each scan's stamp
+// (the node's own tf listener hears it).
+TEST_F(ScanFilterNodeTest, TrackTfBroadcastsTheTrackedPose) {
+    ros::param::set("/tfbcast/odom", std::string("none"));
+    ros::param::set("/tfbcast/track_tf", true);
+    auto n = node("tfbcast");
+    for (int i = 0; i < 3; ++i)
+        n->onScan(boost::make_shared<sensor_msgs::LaserScan>(
+            roomScan(4.0 + 0.1 * i, "laser", 181, 0.05 * i)));
+    const ros::Time last(4.2);
+    spinUntil([&] { return n->tfBuffer().canTransform("odom", "base_link", last); }, 200);
+    ASSERT_TRUE(n->tfBuffer().canTransform("odom", "base_link", last));
+    const auto t = n->tfBuffer().lookupTransform("odom", "base_link", last);
+    EXPECT_NEAR(t.transform.translation.x, 0.10, 0.02);
 }
 
 }  // namespace

@@ -134,11 +134,17 @@ std::pair<int, int> MapFigureFrame::pixel(double x, double y) const {
 
 namespace {
 
-// The ground truth brought to the estimate's frame (gt ~ T (+) est) and the odometry started
-// where the estimate starts.
-void alignToEstimate(const MapFigureInput& in, Trajectory& gt, Trajectory& odo) {
+// `t` started where the estimate starts (its first pose on the estimate's first pose).
+Trajectory fromEstimateStart(const MapFigureInput& in, Trajectory t) {
+    if (t.empty() || in.estimate.empty()) return t;
+    const Pose2D to = compose(in.estimate.front().pose, inverse(t.front().pose));
+    for (auto& p : t) p.pose = compose(to, p.pose);
+    return t;
+}
+
+// The ground truth brought to the estimate's frame (gt ~ T (+) est).
+void alignToEstimate(const MapFigureInput& in, Trajectory& gt) {
     gt = in.ground_truth;
-    odo = in.odometry;
     if (gt.size() >= 2 && in.estimate.size() >= 2) {
         Trajectory sorted_gt = gt;
         sortByTime(sorted_gt);
@@ -146,19 +152,15 @@ void alignToEstimate(const MapFigureInput& in, Trajectory& gt, Trajectory& odo) 
         const Pose2D inv = inverse(ate.alignment);
         for (auto& p : gt) p.pose = compose(inv, p.pose);
     }
-    if (!odo.empty() && !in.estimate.empty()) {
-        const Pose2D t = compose(in.estimate.front().pose, inverse(odo.front().pose));
-        for (auto& p : odo) p.pose = compose(t, p.pose);
-    }
 }
 
 const TColor kGrey(150, 150, 150), kGreen(30, 160, 60), kBlue(30, 90, 220), kNavy(10, 20, 90),
-    kBlack(0, 0, 0), kOrange(240, 130, 0);
+    kBlack(0, 0, 0), kOrange(240, 130, 0), kPurple(160, 40, 180);
 
 // The layers drawn (in legend order) and their bounds, with the margin: nothing else sets the
 // figure's extent.
 Bounds layersAndBounds(const MapFigureInput& in, const Trajectory& gt, const Trajectory& odo,
-                       const std::vector<std::size_t>& keyframes,
+                       const Trajectory& track, const std::vector<std::size_t>& keyframes,
                        const std::vector<std::size_t>& corridor, std::vector<Layer>& layers) {
     const auto& g = *in.grid;
     const double res = g.getResolution();
@@ -169,16 +171,19 @@ Bounds layersAndBounds(const MapFigureInput& in, const Trajectory& gt, const Tra
         b.add(g.getXMin() + (cells->x1 + 1) * res, g.getYMin() + (cells->y1 + 1) * res);
     }
     const bool draw_est = hasSegment(in.estimate), draw_gt = hasSegment(gt),
-               draw_odo = hasSegment(odo);
+               draw_odo = hasSegment(odo), draw_track = hasSegment(track);
     if (draw_est) layers.push_back({{"estimate", "blue"}, kBlue});
     if (!keyframes.empty()) layers.push_back({{"keyframes", "navy dots"}, kNavy, true});
     if (draw_gt) layers.push_back({{"ground truth, aligned to the estimate", "green"}, kGreen});
     if (draw_odo) layers.push_back({{"odometry from the estimate's start", "grey"}, kGrey});
+    if (draw_track)
+        layers.push_back({{"kfd's scan track from the estimate's start", "purple"}, kPurple});
     if (!corridor.empty())
         layers.push_back({{"scans the corridor switch found degenerate", "orange"}, kOrange, true});
     if (draw_est || !keyframes.empty() || !corridor.empty()) addPath(b, in.estimate);
     if (draw_gt) addPath(b, gt);
     if (draw_odo) addPath(b, odo);
+    if (draw_track) addPath(b, track);
     if (b.empty()) b.add(0.5 * (g.getXMin() + g.getXMax()), 0.5 * (g.getYMin() + g.getYMax()));
     const double margin = std::max(in.margin_m, 0.0) + 0.5 * res;
     b.x0 -= margin, b.y0 -= margin, b.x1 += margin, b.y1 += margin;
@@ -286,12 +291,14 @@ void drawBand(MapFigure& fig, const Band& band, const std::vector<Layer>& layers
 
 MapFigure renderMapFigure(const MapFigureInput& in) {
     if (!in.grid) throw PlotError("map figure: no grid");
-    Trajectory gt, odo;
-    alignToEstimate(in, gt, odo);
+    Trajectory gt;
+    alignToEstimate(in, gt);
+    const Trajectory odo = fromEstimateStart(in, in.odometry);
+    const Trajectory track = fromEstimateStart(in, in.track);
     const auto keyframes = drawable(in.keyframes, in.estimate);
     const auto corridor = drawable(in.corridor, in.estimate);
     std::vector<Layer> layers;
-    const Bounds b = layersAndBounds(in, gt, odo, keyframes, corridor, layers);
+    const Bounds b = layersAndBounds(in, gt, odo, track, keyframes, corridor, layers);
     const Band band = legendBand(in, layers);
     MapFigure fig;
     fig.frame = frameFor(in, b, band);
@@ -302,6 +309,7 @@ MapFigure renderMapFigure(const MapFigureInput& in) {
     img.filledRectangle(0, 0, img_w - 1, band.height + f.height - 1, TColor(255, 255, 255));
     drawGrid(img, *in.grid, f);
     path(img, f, odo, kGrey, 1);
+    path(img, f, track, kPurple, 1);
     path(img, f, gt, kGreen, 5);  // wide: stays visible under an accurate estimate
     path(img, f, in.estimate, kBlue, 2);
     for (const auto k : corridor) {  // under the keyframe dots

@@ -189,6 +189,7 @@ std::vector<MapFigureLayer> writeMap(const IcpSlamResult& res, const StagedOutpu
     fig.ground_truth = res.ground_truth;  // aligned to the estimate by the figure
     if (!sum.laser_only)                  // a laser-only run never saw it: not drawn, not named
         fig.odometry = res.odometry;      // put on the estimate's start by the figure
+    fig.track = res.track;                // put on the estimate's start by the figure
     fig.keyframes = res.keyframes;
     fig.corridor = res.corridor;
     fig.title = fs::path(sum.rawlog).filename().string() + "  mode " + toString(sum.mode);

@@ -32,6 +32,8 @@ void Run::writeStep(double builder_ms) {
             res_.corridor.push_back(traj.size());
         const double t = stampForOutput(s.stamp);
         if (s.odometry) res_.odometry.push_back(StampedPose{t, *s.odometry});
+        if (const TrackResult* tr = s.report.find<TrackResult>())
+            res_.track.push_back(StampedPose{t, tr->pose});
         traj.push_back(StampedPose{t, p});
         unwritten_.push_back({s, p, traj.size() - 1});
     }

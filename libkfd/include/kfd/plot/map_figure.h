@@ -20,6 +20,7 @@ struct MapFigureInput {
     Trajectory estimate;                                    // map frame
     Trajectory ground_truth;  // any frame: aligned to the estimate (SE(2), least squares)
     Trajectory odometry;      // any frame: its first pose is put on the estimate's first pose
+    Trajectory track;         // kfd's scan track (laser odometry): put on the estimate's start too
     std::vector<std::size_t> keyframes;  // indices into `estimate` of scans that were kept
     std::vector<std::size_t> corridor;   // indices into `estimate` of degenerate scans (orange)
     std::string title;
@@ -57,15 +58,15 @@ struct MapFigure {
 };
 
 /// Draws with MRPT's 2D canvas (no OpenGL): the grid's known cells (+y up), the odometry
-/// (grey), the ground truth (green), the estimate (blue) with keyframes as small dots and the
-/// scans the corridor switch found degenerate in orange. The map part spans what is drawn (the
-/// grid's known cells and the finite poses of the drawn trajectories, plus margin_m; never the
-/// grid's empty extent or the origin for its own sake) at the grid's cell size, coarser when
-/// that exceeds the budget. Above it, a white band holds the title, the legend (one entry per
-/// drawn layer) and a scale bar (1, 2 or 5 times a power of ten metres, at least 20 pixels).
-/// A trajectory is drawn (and listed) when it has two finite poses, keyframes and degenerate
-/// scans when one index is in range, the grid when one cell is known. Throws PlotError without
-/// a grid or with a budget too small for the legend.
+/// (grey), kfd's scan track (purple), the ground truth (green), the estimate (blue) with keyframes
+/// as small dots and the scans the corridor switch found degenerate in orange. The map part spans
+/// what is drawn (the grid's known cells and the finite poses of the drawn trajectories, plus
+/// margin_m; never the grid's empty extent or the origin for its own sake) at the grid's cell size,
+/// coarser when that exceeds the budget. Above it, a white band holds the title, the legend (one
+/// entry per drawn layer) and a scale bar (1, 2 or 5 times a power of ten metres, at least 20
+/// pixels). A trajectory is drawn (and listed) when it has two finite poses, keyframes and
+/// degenerate scans when one index is in range, the grid when one cell is known. Throws PlotError
+/// without a grid or with a budget too small for the legend.
 MapFigure renderMapFigure(const MapFigureInput& in);
 
 /// The smallest box of cells (indices, inclusive) holding every known cell of the grid (log-odds

@@ -135,8 +135,9 @@ inline constexpr std::size_t kLostTrackRejections = 3;
 /// Everything a run produced, for the report (kfd/report/slam_report.h) and other callers.
 struct IcpSlamResult {
     IcpSlamSummary summary;
-    Trajectory trajectory;               // one pose per input scan (time order of the log)
-    Trajectory odometry;                 // the odometry of every input scan that had one
+    Trajectory trajectory;  // one pose per input scan (time order of the log)
+    Trajectory odometry;    // the odometry of every input scan that had one
+    Trajectory track;  // the track stage's pose of every scan it saw (laser odometry; kfd's modes)
     std::vector<std::size_t> keyframes;  // indices into `trajectory` of the kept scans
     std::vector<std::size_t> corridor;   // ... of the scans the corridor switch found degenerate
     Trajectory ground_truth;             // ground_truth_tum, sorted by time (empty without it)

@@ -28,6 +28,12 @@ struct NodeConfig {
     RemovedMark removed = RemovedMark::NaN;  // ~removed_as: nan | inf
     double reset_jump = 1.0;                 // ~reset_jump, s (LiveFilter::Params::reset_jump)
     int queue_size = 10;  // ~queue_size: the scan subscriber's and publisher's queues
+    /// ~track_topic: where the tracked pose of every scan goes (nav_msgs/Odometry, frame
+    /// odom_frame, child base_frame) when the pipeline lists the track stage; "" publishes none.
+    std::string track_topic = "tracked_odom";
+    /// ~track_tf: also broadcast the tracked pose as the transform odom_frame -> base_frame
+    /// (a robot without wheel odometry); refused with ~odom: tf, which reads that transform.
+    bool track_tf = false;
     /// What the user should know (flat kfd keys read for this release, with their new
     /// spelling ~<stage>/<key>): the node logs them at start.
     std::vector<std::string> notes;

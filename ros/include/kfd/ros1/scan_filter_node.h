@@ -8,6 +8,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
 #include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
 #include <ros/callback_queue.h>
@@ -32,7 +33,7 @@ class ScanFilterNode {
   public:
     /// Reads the private parameters of `pnh` (nodeConfig: kfd::ConfigError naming the key when
     /// one is unknown or bad; the wrappers refuse to start), then subscribes and advertises on
-    /// `nh` (`scan`, `odom`, `scan_filtered`, /diagnostics) and `pnh` (~stats).
+    /// `nh` (`scan`, `odom`, `scan_filtered`, ~track_topic, /diagnostics) and `pnh` (~stats).
     ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh);
     ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeConfig& config);
     /// finish(), and publishes ~stats once more.
@@ -65,6 +66,8 @@ class ScanFilterNode {
 
   private:
     std::size_t publishReady();  // LiveFilter::takeReady's messages on scan_filtered; mutex_ held
+    // The track stage's pose of the scan `r` is about, on ~track_topic (and /tf with ~track_tf).
+    void publishTrack(const LiveResult& r, const ros::Time& stamp);
     std::optional<Pose2D> tfAtTheEdges(const ros::Time& stamp);
     bool newestTfAfter(const ros::Time& stamp) const;  // odom -> base known after stamp
     std::optional<ros::Time> newestTf() const;         // the newest odom -> base stamp
@@ -104,6 +107,8 @@ class ScanFilterNode {
     ros::Subscriber scan_sub_, odom_sub_;
     std::unique_ptr<ros::AsyncSpinner> odom_spinner_;
     ros::Publisher scan_pub_, diag_pub_, stats_pub_;
+    ros::Publisher track_pub_;  // ~track_topic, when the pipeline lists the track stage
+    std::unique_ptr<tf2_ros::TransformBroadcaster> track_tf_;  // ~track_tf
     ros::WallTimer timer_;
 };
 
