@@ -1,5 +1,6 @@
-// libFuzzer target: the core pipeline (default stage registry: the paper's stages and the
-// baselines) fed arbitrary parameters and a stream of arbitrary scans.
+// libFuzzer target: the core pipeline (default stage registry: the paper's stages, kfd's and
+// the baselines; kfd's default pipeline unless a key changes it) fed arbitrary parameters and a
+// stream of arbitrary scans.
 //
 // Input layout (FuzzedDataProvider): up to 8 key = value pairs set through the config layer
 // (kfd::applyConfigKey, the key picked from kfd::configKeys()), then up to 8 scans through one
@@ -36,7 +37,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FuzzedDataProvider in(data, size);
     const auto& registry = kfd::defaultStageRegistry();
     const auto& keys = kfd::configKeys();
-    kfd::Pipeline::Params params;
+    kfd::Pipeline::Params params = kfd::kfdDefaults();  // kfd's default pipeline (track too)
     const int n_keys = in.ConsumeIntegralInRange<int>(0, 8);
     for (int k = 0; k < n_keys; ++k) {
         const auto& key = keys[in.ConsumeIntegralInRange<std::size_t>(0, keys.size() - 1)];

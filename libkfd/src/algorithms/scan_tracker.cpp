@@ -109,20 +109,26 @@ TrackResult ScanTracker::track(const Scan& scan) {
     }
     r.prior = prior(scan, r.odometry_prior);
     // The prior as the scan's sensor frame in the keyframe's.
-    const Pose2D prior_sensor = compose(inverse(kf_mount_), compose(r.prior, scan.sensor_pose));
-    const Fit f = align(scan, prior_sensor);
+    const auto sensorFrame = [&](const Pose2D& robot) {
+        return compose(inverse(kf_mount_), compose(robot, scan.sensor_pose));
+    };
+    Fit f = align(scan, sensorFrame(r.prior));
+    r.verdict = verdictOf(f);
+    // The odometry may be what failed (a wheel slipping or glitching in a fast turn): when its
+    // fit is poor, the fit from the scans' own motion (constant velocity, then none since the
+    // last scan) is taken if it passes the gates. The prior reported stays the odometry's.
+    for (const Pose2D& own : {compose(last_offset_, velocity_), last_offset_}) {
+        if (r.verdict != TrackVerdict::Poor || !r.odometry_prior) break;
+        const Fit g = align(scan, sensorFrame(own));
+        if (verdictOf(g) != TrackVerdict::Tracked) continue;
+        f = g;
+        r.verdict = TrackVerdict::Tracked;
+    }
     r.iterations = static_cast<std::uint16_t>(f.iterations);
     r.pairs = static_cast<std::uint16_t>(std::min<std::size_t>(f.pairs, 65535));
-    r.overlap = f.samples ? static_cast<float>(f.pairs) / static_cast<float>(f.samples) : 0.0f;
+    r.overlap = overlapOf(f);
     r.rms_m = static_cast<float>(f.rms);
     r.conditioning = static_cast<float>(f.conditioning);
-    const Params& p = params_;
-    if (f.pairs < kMinPairs || r.overlap < p.min_overlap || f.rms > p.max_spread * f.gate)
-        r.verdict = TrackVerdict::Poor;
-    else if (f.conditioning < p.min_conditioning)
-        r.verdict = TrackVerdict::Degenerate;
-    else
-        r.verdict = TrackVerdict::Tracked;
     // A degenerate fit keeps the odometry; without odometry the fit is still the better guess
     // (its damping leaves the unconstrained direction at the prior).
     const bool use_fit = r.verdict == TrackVerdict::Tracked ||
@@ -133,6 +139,17 @@ TrackResult ScanTracker::track(const Scan& scan) {
     last_offset_ = r.offset;
     last_ = r;
     return r;
+}
+
+float ScanTracker::overlapOf(const Fit& f) {
+    return f.samples ? static_cast<float>(f.pairs) / static_cast<float>(f.samples) : 0.0f;
+}
+
+TrackVerdict ScanTracker::verdictOf(const Fit& f) const {
+    const Params& p = params_;
+    if (f.pairs < kMinPairs || overlapOf(f) < p.min_overlap || f.rms > p.max_spread * f.gate)
+        return TrackVerdict::Poor;
+    return f.conditioning < p.min_conditioning ? TrackVerdict::Degenerate : TrackVerdict::Tracked;
 }
 
 ScanTracker::Fit ScanTracker::align(const Scan& scan, const Pose2D& prior_sensor) {

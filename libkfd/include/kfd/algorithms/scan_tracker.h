@@ -43,7 +43,10 @@ struct TrackResult {
 /// min_gate_m, until the step is below 0.1 mm and 0.006 degrees. The prior is the odometry
 /// since the keyframe when both scans have it, else the last scan's offset plus the last
 /// inter-scan motion (constant velocity). The verdict gates the fit on its overlap, its
-/// residuals and the conditioning of its translation; a fit that fails keeps the prior.
+/// residuals and the conditioning of its translation. Odometry that slips or glitches in a
+/// turn: when the odometry prior's fit is poor, the fit is tried again from constant
+/// velocity, then from the last scan's offset, and the first that passes is taken. A fit that
+/// fails keeps the prior.
 ///
 /// The track (TrackResult::pose) starts at the first scan's odometry (the origin without it)
 /// and composes every keyframe's offset: a laser odometry in the odometry's frame.
@@ -84,6 +87,8 @@ class ScanTracker {
         double rms = 0.0, gate = 0.0, conditioning = 0.0;
     };
     Fit align(const Scan& scan, const Pose2D& prior_sensor);
+    TrackVerdict verdictOf(const Fit& f) const;  // the gates on overlap, spread, conditioning
+    static float overlapOf(const Fit& f);
     Pose2D prior(const Scan& scan, bool& from_odometry) const;
     void keyframeLines();
 
