@@ -1,5 +1,6 @@
 #include "kfd/algorithms/scan_tracker.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -122,6 +123,28 @@ TEST(ScanTracker, LaserOnlyTheTrackFollowsConstantVelocity) {
         if (i % 4 == 0) t.accept();  // every fourth scan a keyframe
         truth = compose(truth, Pose2D{0.06, 0.01, 2 * kDeg});
     }
+}
+
+// Without odometry a scan that cannot be aligned stops constant velocity (laser-only intel,
+// issue 35: a wrong step extrapolated scan after scan lost the track for good); the scan after
+// it is then aligned from the last offset, also when the robot stood still meanwhile.
+TEST(ScanTracker, LaserOnlyABlindScanStopsConstantVelocity) {
+    ScanTracker t;
+    t.track(scanAt(office(), Pose2D{}, std::nullopt));
+    t.accept();
+    const Pose2D step{0.15, 0.0, 0.0};
+    TrackResult r = t.track(scanAt(office(), step, std::nullopt, 2));
+    ASSERT_EQ(r.verdict, TrackVerdict::Tracked);
+    Scan blind = scanAt(office(), compose(step, step), std::nullopt, 3);
+    std::fill(blind.valid.begin(), blind.valid.end(), 0);
+    r = t.track(blind);
+    EXPECT_EQ(r.verdict, TrackVerdict::Poor);
+    expectNear(r.offset, compose(step, step), 0.01, 0.2);  // constant velocity, this once
+    // The robot stopped at 2 steps: the prior is the last offset, not a third step.
+    r = t.track(scanAt(office(), compose(step, step), std::nullopt, 4));
+    expectNear(r.prior, compose(step, step), 0.01, 0.2);
+    EXPECT_EQ(r.verdict, TrackVerdict::Tracked);
+    expectNear(r.offset, compose(step, step), 0.01, 0.2);
 }
 
 TEST(ScanTracker, ACorridorIsDegenerateAndKeepsTheOdometry) {

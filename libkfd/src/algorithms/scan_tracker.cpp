@@ -114,12 +114,13 @@ TrackResult ScanTracker::track(const Scan& scan) {
     };
     Fit f = align(scan, sensorFrame(r.prior));
     r.verdict = verdictOf(f);
-    // The odometry may be what failed (a wheel slipping or glitching in a fast turn): when its
-    // fit is poor, the fit from the scans' own motion (constant velocity, then none since the
-    // last scan) is taken if it passes the gates. The prior reported stays the odometry's.
-    for (const Pose2D& own : {compose(last_offset_, velocity_), last_offset_}) {
-        if (r.verdict != TrackVerdict::Poor || !r.odometry_prior) break;
-        const Fit g = align(scan, sensorFrame(own));
+    // The prior may be what failed (odometry slipping or glitching in a fast turn; constant
+    // velocity after a wrong step): when its fit is poor, the fit from the scans' own motion
+    // (constant velocity when the prior was the odometry, then no motion since the last scan)
+    // is taken if it passes the gates. The prior reported stays the first one.
+    const Pose2D own[] = {compose(last_offset_, velocity_), last_offset_};
+    for (std::size_t k = r.odometry_prior ? 0 : 1; k < 2 && r.verdict == TrackVerdict::Poor; ++k) {
+        const Fit g = align(scan, sensorFrame(own[k]));
         if (verdictOf(g) != TrackVerdict::Tracked) continue;
         f = g;
         r.verdict = TrackVerdict::Tracked;
@@ -135,7 +136,10 @@ TrackResult ScanTracker::track(const Scan& scan) {
                          (r.verdict == TrackVerdict::Degenerate && !r.odometry_prior);
     r.offset = use_fit ? compose(kf_mount_, compose(f.d, inverse(scan.sensor_pose))) : r.prior;
     r.pose = compose(kf_pose_, r.offset);
-    velocity_ = between(last_offset_, r.offset);
+    // Without odometry a scan that could not be aligned says nothing of the motion: constant
+    // velocity stops there (else a wrong step would be extrapolated scan after scan).
+    const bool blind = r.verdict == TrackVerdict::Poor && !r.odometry_prior;
+    velocity_ = blind ? Pose2D{} : between(last_offset_, r.offset);
     last_offset_ = r.offset;
     last_ = r;
     return r;

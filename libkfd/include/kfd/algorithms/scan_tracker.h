@@ -43,10 +43,11 @@ struct TrackResult {
 /// min_gate_m, until the step is below 0.1 mm and 0.006 degrees. The prior is the odometry
 /// since the keyframe when both scans have it, else the last scan's offset plus the last
 /// inter-scan motion (constant velocity). The verdict gates the fit on its overlap, its
-/// residuals and the conditioning of its translation. Odometry that slips or glitches in a
-/// turn: when the odometry prior's fit is poor, the fit is tried again from constant
-/// velocity, then from the last scan's offset, and the first that passes is taken. A fit that
-/// fails keeps the prior.
+/// residuals and the conditioning of its translation. When the prior's fit is poor (odometry
+/// slipping or glitching in a turn, constant velocity after a wrong step) the fit is tried
+/// again from constant velocity (after an odometry prior), then from the last scan's offset,
+/// and the first that passes is taken. A fit that fails keeps the prior; without odometry
+/// constant velocity then stops (the next prior is the last offset).
 ///
 /// The track (TrackResult::pose) starts at the first scan's odometry (the origin without it)
 /// and composes every keyframe's offset: a laser odometry in the odometry's frame.
