@@ -1,11 +1,11 @@
 #include "kfd/ros1/node_config.h"
 
-#include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/default_stages.h"
+#include "kfd/stages/track_stage.h"
 
 namespace kfd::ros1 {
 
@@ -87,8 +87,7 @@ double secondsParam(const std::string& key, XmlRpcValue v, double lo, double hi)
 // the node must not read the odometry it writes.
 void checkTrackTf(const NodeConfig& c) {
     if (!c.track_tf) return;
-    const auto& stages = c.pipeline.stages;
-    if (std::find(stages.begin(), stages.end(), "track") == stages.end())
+    if (!c.pipeline.lists(TrackStage::kName))
         throw ConfigError("track_tf", "true, but the pipeline does not list the track stage");
     if (c.odometry == NodeConfig::Odometry::Tf)
         throw ConfigError("track_tf",

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "kfd/algorithms/scan_tracker.h"
+#include "kfd/stages/track_stage.h"
 
 namespace kfd::ros1 {
 
@@ -69,9 +70,7 @@ ScanFilterNode::ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh, const No
     scan_pub_ = nh_.advertise<sensor_msgs::LaserScan>("scan_filtered", q);
     diag_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1);
     stats_pub_ = pnh_.advertise<diagnostic_msgs::DiagnosticStatus>("stats", 1, true);
-    const auto& stages = config_.pipeline.stages;
-    if (!config_.track_topic.empty() &&
-        std::find(stages.begin(), stages.end(), "track") != stages.end())
+    if (!config_.track_topic.empty() && config_.pipeline.lists(TrackStage::kName))
         track_pub_ = nh_.advertise<nav_msgs::Odometry>(config_.track_topic, q);
     if (config_.track_tf) track_tf_ = std::make_unique<tf2_ros::TransformBroadcaster>();
     if (config_.odometry == NodeConfig::Odometry::Topic) {

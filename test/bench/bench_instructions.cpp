@@ -21,6 +21,7 @@
 #include "kfd/baselines/dbscan.h"
 #include "kfd/baselines/radius_outlier.h"
 #include "kfd/baselines/statistical_outlier.h"
+#include "kfd/mrpt/config.h"
 #include "kfd/mrpt/stream_filter.h"
 #include "kfd/paper/correlation.h"
 #include "kfd/paper/distance_filter.h"
@@ -47,7 +48,7 @@ kfd::Pipeline::Params viewDropParams(std::size_t temporal_scans = 0) {
 // evidence denoise) with the view selector's thresholds out of reach, as viewDropParams.
 kfd::Pipeline::Params trackDropParams() {
     kfd::Pipeline::Params p = viewDropParams();
-    p.stages = {"odometry_check", "distance", "track", "view_keyframe", "evidence_denoise"};
+    p.stages = kfd::kfdDefaults().stages;
     return p;
 }
 

@@ -148,9 +148,7 @@ TEST(Config, EveryShippedNonPaperPresetUsesTheViewSelectorAndTheEvidenceDenoiser
             SCOPED_TRACE(e.path().string());
             const auto p = kfd::loadConfigFile(e.path().string());
             const bool paper = e.path().filename().string().rfind("paper-", 0) == 0;
-            auto lists = [&p](const char* stage) {
-                return std::find(p.stages.begin(), p.stages.end(), stage) != p.stages.end();
-            };
+            auto lists = [&p](const char* stage) { return p.lists(stage); };
             EXPECT_EQ(lists("denoise"), paper);
             EXPECT_EQ(lists("keyframe"), paper);
             EXPECT_EQ(lists("evidence_denoise"), !paper);

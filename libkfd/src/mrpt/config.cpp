@@ -199,7 +199,7 @@ std::string keyValue(const Pipeline::Params& p, const StageRegistry& registry,
     const auto found = findKey(registry, name);
     auto from = found.front();
     for (const auto& f : found)
-        if (std::find(p.stages.begin(), p.stages.end(), f.first->name) != p.stages.end()) {
+        if (p.lists(f.first->name)) {
             from = f;
             break;
         }
@@ -299,7 +299,7 @@ std::string flatKeysNote(const std::vector<std::string>& flat, const Pipeline::P
     for (const std::string& key : flat) {
         bool listed = false;
         for (const auto& [stage, k] : findKey(registry, key))
-            if (std::find(p.stages.begin(), p.stages.end(), stage->name) != p.stages.end()) {
+            if (p.lists(stage->name)) {
                 if (!by_stage.count(stage->name)) order.push_back(stage->name);
                 std::string& keys = by_stage[stage->name];
                 keys += (keys.empty() ? "" : ", ") + key;

@@ -1,5 +1,6 @@
 #include "kfd/pipeline/pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <string>
 
@@ -23,6 +24,10 @@ StageParams& PipelineParams::at(const StageInfo& stage, std::string_view instanc
     if (StageParams* p = find(instance)) return *p;
     entries_.push_back(Entry{std::string(instance), stage.defaults()});
     return *entries_.back().params;
+}
+
+bool PipelineParams::lists(std::string_view stage) const {
+    return std::find(stages.begin(), stages.end(), stage) != stages.end();
 }
 
 std::vector<std::string> instanceNames(const std::vector<std::string>& stages) {

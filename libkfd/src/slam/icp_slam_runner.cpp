@@ -17,8 +17,7 @@ void Run::prepare() {
         cfg_->sectionExists("KFD") ? loadIni(*cfg_, "KFD", nullptr, &sum_.notices) : kfdDefaults();
     applySlamGate(*cfg_, kfd_params_, sum_);
     sum_.pipeline = pipelineForMode(opts_.mode, kfd_params_);
-    const auto& stages = sum_.pipeline.stages;
-    tracking_ = std::find(stages.begin(), stages.end(), TrackStage::kName) != stages.end();
+    tracking_ = sum_.pipeline.lists(TrackStage::kName);
     sum_.laser_only = opts_.laser_only;
     checkEvaluationOptions(opts_, sum_);
 }

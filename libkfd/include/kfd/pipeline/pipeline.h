@@ -32,6 +32,9 @@ class PipelineParams {
     /// odometry check).
     std::vector<std::string> stages{"distance", "view_keyframe", "evidence_denoise"};
 
+    /// Whether `stages` lists `stage` (once or more).
+    bool lists(std::string_view stage) const;
+
     PipelineParams() = default;
     PipelineParams(const PipelineParams& o);
     PipelineParams& operator=(const PipelineParams& o);
