@@ -9,6 +9,10 @@ werror=OFF
 cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKFD_BUILD_TESTS=ON \
   -DKFD_WARNINGS_AS_ERRORS=$werror >/dev/null
 cmake --build "$root/build" -j"$(nproc)"
+# npm's MCAP and rosbag2 readers for the ROS 2 output tests (CI: required; elsewhere they skip).
+if ! bash "$root/scripts/ci/npm-peers.sh" "$root/build"; then
+  [ -n "${CI:-}" ] && { echo "[kfd] CI: npm peers are required" >&2; exit 1; }
+fi
 cd "$root/build"
 status=0
 ctest --output-on-failure -j"$(nproc)" || status=$?

@@ -81,12 +81,18 @@ void printObjects(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
         std::printf(
             "  lines    out %zu (FLASER/RLASER for the kept scans, ODOM), scans dropped %zu\n",
             s.objects_out, s.objects_dropped);
-    else if (s.output_format == kfd::LogFormat::Bag)
+    else if (s.output_format == kfd::LogFormat::Bag || s.output_format == kfd::LogFormat::Rosbag2 ||
+             s.output_format == kfd::LogFormat::Mcap) {
         std::printf("  messages in %zu, out %zu, scans dropped %zu; %s written as %s\n",
                     s.objects_in, s.objects_out, s.objects_dropped,
                     kfd::plural(s.points_marked, "removed point").c_str(),
                     kfd::toString(o.bag.removed));
-    else if (s.input_format == kfd::LogFormat::Rawlog)
+        if (s.messages_left_out)
+            std::printf(
+                "  left out %zu ROS 1 messages of types kfd cannot write as ROS 2 (it "
+                "converts LaserScan, Odometry and TFMessage)\n",
+                s.messages_left_out);
+    } else if (s.input_format == kfd::LogFormat::Rawlog)
         std::printf("  objects  in %zu, out %zu, dropped %zu, odometry actions merged %zu\n",
                     s.objects_in, s.objects_out, s.objects_dropped, s.actions_merged);
     else  // the same unit on both sides: MRPT objects, read from lines or messages
@@ -219,11 +225,13 @@ struct Flags {
 void addInputOutputOptions(kfd::app::Cli& cli, kfd::RawlogFilterOptions& opts, Flags& f) {
     cli.option("-i,--input", opts.input,
                "input log: rawlog (either MRPT layout, plain or gzip),\n"
-               "ROS 1 bag, or CARMEN log (.clf/.log, plain or gzip)")
+               "ROS 1 bag, ROS 2 bag (a rosbag2 folder, a .db3 or an\n"
+               ".mcap), or CARMEN log (.clf/.log, plain or gzip)")
         ->type_name("FILE");
     cli.option("-o,--output", opts.output,
-               "output, its format by its name: X.rawlog, X.bag (for a bag\n"
-               "input), X.clf or X.log (CARMEN; X.clf.gz, X.log.gz: gzip);\n"
+               "output, its format by its name: X.rawlog, X.bag (for a ROS 1\n"
+               "bag input), X.db3 or X.mcap (ROS 2, for any bag input), X.clf\n"
+               "or X.log (CARMEN; X.clf.gz, X.log.gz: gzip);\n"
                "written to a temporary file, then renamed")
         ->type_name("FILE");
     kfd::app::addSourceOptions(cli, opts.source, f.list, opts.laser_only, " (the output keeps it)");
@@ -232,9 +240,10 @@ void addInputOutputOptions(kfd::app::Cli& cli, kfd::RawlogFilterOptions& opts, F
         ->check(CLI::IsMember({"nan", "inf"}))
         ->capture_default_str();
     cli.option("--bag-compression", f.compression,
-               "bag output's chunks: input (the input bag's), none, lz4 or bz2")
+               "bag output's chunks: input (the input bag's), none, lz4, bz2\n"
+               "(ROS 1) or zstd (MCAP); .mcap from another input: zstd")
         ->type_name("C")
-        ->check(CLI::IsMember({"input", "none", "lz4", "bz2"}))
+        ->check(CLI::IsMember({"input", "none", "lz4", "bz2", "zstd"}))
         ->capture_default_str();
 }
 
@@ -303,15 +312,20 @@ void run(kfd::app::Cli& cli, kfd::RawlogFilterOptions& opts, const Flags& f) {
 
 int main(int argc, char** argv) {
     kfd::app::Cli cli(
-        "kfd-filter", "-i IN.{rawlog,bag,clf,log[.gz]} -o OUT.{rawlog,bag,clf,log[.gz]} [options]",
+        "kfd-filter",
+        "-i IN.{rawlog,bag,db3,mcap,clf,log[.gz]} -o OUT.{rawlog,bag,db3,mcap,clf,log[.gz]} "
+        "[options]",
         "Drops 2D range scans that carry no new information (keyframe extraction, Hu et al. 2023)\n"
         "and removes noise points from the kept scans (clustering denoise). Every other object is\n"
         "copied unchanged and in order; odometry of dropped frames is composed into the next kept\n"
         "action. Removed points are marked invalid (beam count and angles are kept).\n"
         "The input's format is told by its content: an MRPT rawlog, a ROS 1 bag (LaserScan with\n"
-        "Odometry or /tf; plain, bz2 or lz4) or a CARMEN log (plain or gzip). A bag input can\n"
-        "give a bag output (-o X.bag): every other topic copied in order, the dropped scans\n"
-        "left out, removed points written as NaN (or +Inf, --removed-as; REP 117). Any input\n"
+        "Odometry or /tf; plain, bz2 or lz4), a ROS 2 bag (a rosbag2 folder or .db3, or an MCAP\n"
+        "file) or a CARMEN log (plain or gzip). A bag input can give a bag output (-o X.bag for\n"
+        "a ROS 1 bag; -o X.db3 or X.mcap for any bag): every other topic copied in order, the\n"
+        "dropped scans left out, removed points written as NaN (or +Inf, --removed-as; REP 117).\n"
+        "A ROS 1 bag's LaserScan, Odometry and TFMessage become ROS 2 messages in a .db3 or\n"
+        "an .mcap; its other topics are left out (counted). Any input\n"
         "can give a CARMEN log (-o X.clf or X.log, .gz for gzip): FLASER lines for the kept\n"
         "scans (removed points as 0, no reading), ODOM lines for the odometry.",
         "Exit status: 0 on success, 1 on bad input or configuration (an output that is an input\n"

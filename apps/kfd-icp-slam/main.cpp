@@ -1,6 +1,6 @@
-// kfd-icp-slam: MRPT ICP-SLAM over a log (rawlog, ROS 1 bag, CARMEN) with the kfd pre-filter in
-// front.
-// All logic lives in kfd::IcpSlamRunner; this file parses arguments and reports.
+// kfd-icp-slam: MRPT ICP-SLAM over a log (rawlog, ROS 1 or ROS 2 bag, CARMEN) with the kfd
+// pre-filter in front. All logic lives in kfd::IcpSlamRunner; this file parses arguments and
+// reports.
 #include <cstdio>
 #include <string>
 
@@ -38,7 +38,9 @@ std::string listModes() {
 void addInputOptions(kfd::app::Cli& cli, Args& a) {
     cli.option("CONFIG.ini", a.o.config_file, "ICP-SLAM configuration (and optional [KFD])")
         ->type_name("FILE");
-    cli.option("LOG", a.rawlog_arg, "input log: rawlog, ROS 1 bag or CARMEN log (or -i)")
+    cli.option("LOG", a.rawlog_arg,
+               "input log: rawlog, ROS 1 bag, ROS 2 bag (rosbag2 folder, .db3,\n"
+               ".mcap) or CARMEN log (or -i)")
         ->type_name("FILE");
     cli.option("-i,--rawlog", a.o.rawlog, "input log (default: [MappingApplication] rawlog_file)")
         ->type_name("FILE");
@@ -128,7 +130,8 @@ int main(int argc, char** argv) {
         "Runs MRPT's ICP-SLAM (CMetricMapBuilderICP) like icp-slam does, reading the same .ini\n"
         "([ICP], [MappingApplication], map definitions), with a pre-filter in front of scan\n"
         "matching configured by an optional [KFD] section (see kfd-filter --list-keys).\n"
-        "LOG is an MRPT rawlog, a ROS 1 bag (LaserScan with Odometry or /tf) or a CARMEN log.",
+        "LOG is an MRPT rawlog, a ROS 1 or ROS 2 bag (LaserScan with Odometry or /tf; a rosbag2\n"
+        "folder, a .db3 or an .mcap) or a CARMEN log.",
         "Writes trajectory.tum (a pose for every input scan), scans.csv, summary.json,\n"
         "final_map.simplemap, map.png, map_figure.png and report.md into the output folder, and\n"
         "icp-slam's files as [MappingApplication] asks: log_estimated_path.txt,\n"

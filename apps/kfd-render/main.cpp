@@ -47,7 +47,7 @@ struct Options {
 };
 
 void addOptions(kfd::app::Cli& cli, Options& o) {
-    cli.option("-i", o.in, "input log (rawlog, ROS 1 bag or CARMEN log)")
+    cli.option("-i", o.in, "input log (rawlog, ROS 1 or ROS 2 bag, or CARMEN log)")
         ->type_name("FILE")
         ->required();
     cli.option("--index", o.index, "the N-th 2D scan (0-based)")->type_name("N");
@@ -176,7 +176,7 @@ void draw(const Options& o, const kfd::Pipeline::Params& p, const Chosen& c,
 
 int main(int argc, char** argv) {
     kfd::app::Cli cli(
-        "kfd-render", "-i IN.{rawlog,bag,clf} (--index N | --time T) -o OUT.png [options]",
+        "kfd-render", "-i IN.{rawlog,bag,db3,mcap,clf} (--index N | --time T) -o OUT.png [options]",
         "Runs the distance filter and the denoiser of CONFIG on one scan and draws its clusters\n"
         "(each in its own colour), the removed noise points (red), the ring boundaries, the "
         "sensor\n"

@@ -82,7 +82,7 @@ class CompareError(Exception):
 # --- logs, modes, jobs ----------------------------------------------------------------------
 
 # The logs kfd-icp-slam reads (by content; these extensions mark a spec as a path).
-LOG_EXTENSIONS = (".rawlog", ".bag", ".clf", ".log", ".clf.gz", ".log.gz")
+LOG_EXTENSIONS = (".rawlog", ".bag", ".clf", ".log", ".clf.gz", ".log.gz", ".db3", ".mcap")
 
 
 def log_stem(filename):
@@ -110,7 +110,9 @@ def resolve_log(spec, datasets):
     else:
         rawlog = os.path.abspath(os.path.join(datasets, spec, spec + ".rawlog"))
         name = spec
-    if not os.path.isfile(rawlog):
+    if os.path.isdir(rawlog) and os.path.isfile(os.path.join(rawlog, "metadata.yaml")):
+        name = os.path.basename(rawlog.rstrip(os.path.sep))  # a rosbag2 folder
+    elif not os.path.isfile(rawlog):
         if spec == name and not os.path.isdir(datasets):
             raise CompareError(
                 "log not found: %s: a dataset name is looked up as DATASETS/%s/%s.rawlog, and "

@@ -109,7 +109,7 @@ TEST(BadBagsAndCarmen, ABagOutputNeedsABagInput) {
     const Snapshot snap({in});
     const Result r = run(KFD_FILTER_EXE, {"-q", "-i", in, "-o", d / "out.bag"}, d.path);
     EXPECT_EQ(r.status, 1);
-    EXPECT_NE(r.first().find("a bag output (" + (d / "out.bag") + ") needs a ROS bag input"),
+    EXPECT_NE(r.first().find("a bag output (" + (d / "out.bag") + ") needs a ROS 1 bag input"),
               std::string::npos)
         << r.err;
     EXPECT_EQ(listing(d.path), std::set<std::string>{"in.rawlog"});
@@ -127,8 +127,9 @@ TEST(BadBagsAndCarmen, AnOutputNameOfNoFormatKfdWritesIsRefused) {
         EXPECT_EQ(r.status, 1) << name;
         EXPECT_EQ(r.first(), "kfd-filter: the output " + (d / name) +
                                  ": kfd-filter writes .rawlog (an MRPT rawlog), .bag (a ROS 1 "
-                                 "bag, for a bag input), .clf or .log (a CARMEN log; .clf.gz, "
-                                 ".log.gz: gzip); its name says none of them")
+                                 "bag, for a ROS 1 bag input), .db3 or .mcap (ROS 2, for any "
+                                 "bag input), .clf or .log (a CARMEN log; .clf.gz, .log.gz: "
+                                 "gzip); its name says none of them")
             << r.err;
     }
     // kfd-simulate and kfd-inject write rawlogs only.

@@ -243,7 +243,9 @@ TEST(BagSource, AnglesThatDoNotMatchTheBeamCountAreSkippedAndCounted) {
         m.angle_max = kInf;
         b.scan("/scan", m);
         m = msg(6.0);
-        m.angle_increment = (m.angle_max - m.angle_min) / 20;  // n increments: within one beam
+        // n increments (angle_max one increment past the last beam, as 360-degree drivers give
+        // it): the beams span n - 1 increments.
+        m.angle_increment = (m.angle_max - m.angle_min) / 20;
         b.scan("/scan", m);
     }
     kfd::BagSource src(d / "a.bag");
@@ -263,7 +265,7 @@ TEST(BagSource, AnglesThatDoNotMatchTheBeamCountAreSkippedAndCounted) {
                                        R::BadAperture, R::None}));
     EXPECT_EQ(src.counters().scans_bad_angles, 4u);
     EXPECT_TRUE(scans[0]->rightToLeft);
-    EXPECT_FLOAT_EQ(scans[5]->aperture, 3.0f);
+    EXPECT_FLOAT_EQ(scans[5]->aperture, 3.0f * 19 / 20);
 }
 
 TEST(BagSource, ZeroStampsTakeTheBagTimeAndOdometryIsHeldOneSecondAtMost) {

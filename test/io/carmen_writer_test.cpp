@@ -217,7 +217,8 @@ TEST(CarmenOutput, AnOutputNameOfNoFormatKfdWritesIsRefused) {
             EXPECT_EQ(std::string(e.what()),
                       "the output " + (d / name) +
                           ": kfd-filter writes .rawlog (an MRPT rawlog), .bag (a ROS 1 bag, for "
-                          "a bag input), .clf or .log (a CARMEN log; .clf.gz, .log.gz: gzip); "
+                          "a ROS 1 bag input), .db3 or .mcap (ROS 2, for any bag input), .clf "
+                          "or .log (a CARMEN log; .clf.gz, .log.gz: gzip); "
                           "its name says none of them");
         }
         EXPECT_FALSE(fs::exists(d / name));

@@ -126,8 +126,8 @@ class Scratch:
 
     def log_as(self, ext):
         """A bag (kfd_bench_fast_bag's: /scan with odometry and other high-rate topics, 3 s;
-        the bundled log has no bag form) or the bundled log as a CARMEN log (kfd-filter's, every
-        scan kept), written once."""
+        the bundled log has no bag form), that bag as a rosbag2 .db3, or the bundled log as a
+        CARMEN log (kfd-filter's, every scan kept), written once."""
         path = os.path.join(self.dir, "in", "office" + ext)
         if not os.path.exists(path) and ext == ".bag":
             exe = os.environ.get("KFD_FAST_BAG_EXE", "")
@@ -141,7 +141,9 @@ class Scratch:
             keep = os.path.join(self.dir, "in", "keep-all.ini")
             with open(keep, "w") as f:
                 f.write("[KFD]\npipeline = distance\n")
-            r = self.run([os.path.join(APPS, "kfd-filter"), "-i", BUNDLED, "-o", path,
+            # A ROS 2 bag (.db3) is made of the test bag; a CARMEN log of the bundled log.
+            source = self.log_as(".bag") if ext == ".db3" else BUNDLED
+            r = self.run([os.path.join(APPS, "kfd-filter"), "-i", source, "-o", path,
                           "-c", keep, "-q"])
             if r.returncode != 0:
                 raise AssertionError(f"cannot write the bundled log as {ext}: {r.stderr}")
@@ -172,6 +174,8 @@ def resolve(scratch, cmd):
         prev = tokens[i - 1] if i else ""
         if tok in ("IN.bag", "X.bag"):
             tok = scratch.log_as(".bag")
+        elif tok == "ROSBAG2_DIR":
+            tok = scratch.log_as(".db3")
         elif tok == "IN.clf":
             tok = scratch.log_as(".clf")
         elif tok == "T":

@@ -202,6 +202,20 @@ class KfdCompare(unittest.TestCase):
                              os.path.abspath(os.path.join(DATASETS, folder, folder + ".relations")))
         self.assertEqual(kfd_compare.log_stem("aces.orig.bag"), "aces.orig")
         self.assertEqual(kfd_compare.log_stem("intel.clf.gz"), "intel")
+        self.assertEqual(kfd_compare.log_stem("run.mcap"), "run")
+        # A ROS 2 bag: a rosbag2 folder is a log named after the folder.
+        ros2 = os.path.join(DATASETS, "mumble-rplidar-ros2", "straight")
+        if os.path.isdir(ros2):
+            log = kfd_compare.resolve_log(ros2 + os.sep, DATASETS)
+            self.assertEqual((log["name"], log["kind"]), ("straight", "file"))
+            out = os.path.join(self.tmp, "ros2")
+            r = compare("run", "--logs", ros2, "--modes", "none", "kfd", "--repeats", "1",
+                        "--out", out, "--no-plots", "-q", *self.exe)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            with open(os.path.join(out, "runs.csv")) as f:
+                runs = list(csv.DictReader(f))
+            self.assertEqual(len(runs), 2)
+            self.assertTrue(all(x["finished"] == "True" for x in runs))
         # A laser-only bag through kfd-icp-slam, the topic passed on (also to emitted jobs).
         bag = os.path.join(DATASETS, "ccny-urg", "demo.bag")
         if not os.path.isfile(bag):

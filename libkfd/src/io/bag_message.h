@@ -13,38 +13,65 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "kfd/io/laser_scan.h"
 #include "kfd/io/source.h"
+#include "ros2_message.h"
 
 namespace kfd {
 
+/// A topic of a ROS 2 log (rosbag2 or MCAP): what its messages need to be read and copied.
+struct Ros2Connection {
+    std::string topic;
+    std::string type;                             // "sensor_msgs/msg/LaserScan"
+    std::string encoding = "cdr";                 // serialization_format / MCAP message_encoding
+    std::string offered_qos_profiles;             // rosbag2's YAML (MCAP: the channel's metadata)
+    std::string type_description_hash;            // Jazzy's RIHS01_..., when the file has it
+    std::string schema_encoding;                  // MCAP: "ros2msg", "ros1msg", ... ("" : none)
+    std::string schema_data;                      // MCAP: the schema's definition
+    std::map<std::string, std::string> metadata;  // MCAP channel metadata
+};
+
 /// One message of a bag: its connection (topic, type, MD5 sum, definition, connection header),
 /// bag time and serialized bytes, copied out of its chunk (BagReader): writing or
-/// deserializing it reads nothing from the bag again.
+/// deserializing it reads nothing from the bag again. A message of a ROS 2 log (rosbag2, MCAP)
+/// has `ros2` instead of `connection`, and its log time in nanoseconds.
 struct NativeMessage {
     /// Valid while the BagSource that read it is alive (it belongs to the open bag).
     const rosbag::ConnectionInfo* connection = nullptr;
+    const Ros2Connection* ros2 = nullptr;
     ros::Time time;
+    std::int64_t time_ns = 0;  // ROS 2: the receive (log) time; ROS 1: 0
     std::vector<std::uint8_t> bytes;
 
-    const std::string& topic() const { return connection->topic; }
-    /// True when the message is a T (by MD5 sum, as rosbag::MessageInstance::isType).
+    const std::string& topic() const { return ros2 ? ros2->topic : connection->topic; }
+    /// True when the message is a T (ROS 1: by MD5 sum, as rosbag::MessageInstance::isType;
+    /// ROS 2: by type name, in CDR or in ROS 1's encoding, as MCAP's ros1 profile holds).
     template <class T>
     bool isType() const {
+        if (ros2)
+            return (ros2->encoding == "cdr" || ros2->encoding == "ros1") &&
+                   ros1TypeName(ros2->type) == ros::message_traits::DataType<T>::value();
         const char* md5 = ros::message_traits::MD5Sum<T>::value();
         return std::strcmp(md5, "*") == 0 || connection->md5sum == md5;
     }
     /// The message deserialized as a T (as rosbag::MessageInstance::instantiate, without
-    /// checking its bytes: see instantiateChecked), or null when it is not a T.
+    /// checking its bytes: see instantiateChecked), or null when it is not a T. A CDR message
+    /// is always checked (decodeRos2).
     template <class T>
     boost::shared_ptr<T> instantiate() const {
         if (!isType<T>()) return nullptr;
         auto p = boost::make_shared<T>();
+        if (ros2 && ros2->encoding == "cdr") {
+            decodeRos2(bytes.data(), bytes.size(), *p);
+            return p;
+        }
         ros::serialization::PreDeserializeParams<T> params;
         params.message = p;
-        params.connection_header = connection->header;
+        if (connection) params.connection_header = connection->header;
         ros::serialization::PreDeserialize<T>::notify(params);
         ros::serialization::IStream s(const_cast<std::uint8_t*>(bytes.data()),
                                       static_cast<std::uint32_t>(bytes.size()));
@@ -89,7 +116,8 @@ struct LayoutOf<tf2_msgs::TFMessage> {
 template <class T>
 boost::shared_ptr<T> instantiateChecked(const NativeMessage& m) {
     if (!m.isType<T>()) return nullptr;
-    checkMessageBytes(LayoutOf<T>::value, m);
+    if (!m.ros2 || m.ros2->encoding != "cdr")  // CDR is checked as it is decoded
+        checkMessageBytes(LayoutOf<T>::value, m);
     return m.instantiate<T>();
 }
 

@@ -17,10 +17,11 @@
 
 #include "bag_file.h"
 #include "bag_message.h"
-#include "bag_reader.h"
 #include "kfd/algorithms/pose.h"
 #include "kfd/io/laser_scan.h"
+#include "kfd/io/open_source.h"
 #include "kfd/pipeline/format.h"
+#include "message_store.h"
 
 namespace kfd {
 namespace {
@@ -42,6 +43,19 @@ constexpr std::size_t kTfProbe = 500;   // /tf messages searched for the odom fr
 // sample; further away its odometry is unknown.
 constexpr double kOdometryHoldSeconds = 1.0;
 
+// The bytes of a log: a file's size, or the sum of a folder's files (a rosbag2 folder).
+std::uint64_t logSize(const std::string& path) {
+    std::error_code ec;
+    if (!fs::is_directory(path, ec)) {
+        const auto n = fs::file_size(path, ec);
+        return ec ? 0 : n;
+    }
+    std::uint64_t n = 0;
+    for (const auto& f : fs::directory_iterator(path, ec))
+        if (f.is_regular_file(ec)) n += f.file_size(ec);
+    return n;
+}
+
 std::string stripSlash(const std::string& s) {
     const auto b = s.find_first_not_of('/');
     return b == std::string::npos ? std::string() : s.substr(b);
@@ -51,33 +65,10 @@ double yawOf(const geometry_msgs::Quaternion& q) {
     return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
 }
 
-struct TopicInfo {
-    std::string type;
-    std::size_t count = 0;
-    double first = 0.0, last = 0.0;
-};
-
-// The bag's topics, from its index only.
-std::map<std::string, TopicInfo> topicsOf(rosbag::Bag& bag) {
-    std::map<std::string, TopicInfo> topics;
-    rosbag::View all(bag);
-    for (const rosbag::ConnectionInfo* c : all.getConnections())
-        topics[c->topic].type = c->datatype;
-    for (auto& [name, info] : topics) {
-        rosbag::View v(bag, rosbag::TopicQuery(name));
-        info.count = v.size();
-        if (info.count) {
-            info.first = v.getBeginTime().toSec();
-            info.last = v.getEndTime().toSec();
-        }
-    }
-    return topics;
-}
-
 std::string listOf(const std::map<std::string, TopicInfo>& topics, const char* type) {
     std::string s;
     for (const auto& [name, info] : topics)
-        if (!type || info.type == type) s += (s.empty() ? "" : ", ") + name;
+        if (!type || isType(info.type, type)) s += (s.empty() ? "" : ", ") + name;
     return s.empty() ? "none" : s;
 }
 
@@ -94,7 +85,7 @@ std::string pickTopic(const std::map<std::string, TopicInfo>& topics, const std:
         if (it == topics.end())
             throw BagError(std::string(flag) + " " + named +
                            ": no such topic (topics: " + listOf(topics, nullptr) + ")");
-        if (it->second.type != type)
+        if (!isType(it->second.type, type))
             throw BagError(std::string(flag) + " " + named + ": the topic holds " +
                            it->second.type + ", not " + type);
         notes.push_back(std::string(what) + ": " + key + " (" + type + ", " + flag + ")");
@@ -102,7 +93,7 @@ std::string pickTopic(const std::map<std::string, TopicInfo>& topics, const std:
     }
     std::vector<std::string> found;
     for (const auto& [name, info] : topics)
-        if (info.type == type) found.push_back(name);
+        if (isType(info.type, type)) found.push_back(name);
     if (found.size() == 1) {
         notes.push_back(std::string(what) + ": " + found[0] + " (the only " + type + " topic)");
         return found[0];
@@ -140,19 +131,19 @@ boost::shared_ptr<T> instantiate(const NativeMessage& m) {
 
 // The first message of `topic` as a T, or null (none, or not a T).
 template <class T>
-boost::shared_ptr<T> firstMessage(BagReader& bag, const std::string& topic) {
-    auto v = bag.cursor(topic);
+boost::shared_ptr<T> firstMessage(MessageStore& bag, const std::string& topic) {
+    auto v = bag.cursor(topic, false);
     NativeMessage m;
-    if (v.next(m)) return instantiate<T>(m);
+    if (v->next(m)) return instantiate<T>(m);
     return nullptr;
 }
 
 // The first transform in /tf whose parent is `odom_frame` (its child is the base frame).
-std::string baseFrameFromTf(BagReader& bag, const std::string& tf_topic,
+std::string baseFrameFromTf(MessageStore& bag, const std::string& tf_topic,
                             const std::string& odom_frame) {
-    auto v = bag.cursor(tf_topic);
+    auto v = bag.cursor(tf_topic, false);
     std::size_t n = 0;
-    for (NativeMessage m; v.next(m);) {
+    for (NativeMessage m; v->next(m);) {
         if (++n > kTfProbe) break;
         if (const auto tf = instantiate<tf2_msgs::TFMessage>(m))
             for (const auto& t : tf->transforms)
@@ -188,15 +179,15 @@ std::string badTransform(const geometry_msgs::Transform& t) {
     return {};
 }
 
-void chooseMount(BagReader& bag, const std::map<std::string, TopicInfo>& topics, BagChoice& c) {
+void chooseMount(MessageStore& bag, const std::map<std::string, TopicInfo>& topics, BagChoice& c) {
     if (const auto s = firstMessage<sensor_msgs::LaserScan>(bag, c.scan_topic))
         c.laser_frame = stripSlash(s->header.frame_id);
     std::map<std::string, Edge> edges;  // child -> parent
     for (const char* topic : {"/tf_static", "tf_static"}) {
         const auto it = topics.find(topic);
-        if (it == topics.end() || it->second.type != kTfMessage) continue;
-        auto v = bag.cursor(topic);
-        for (NativeMessage m; v.next(m);)
+        if (it == topics.end() || !isType(it->second.type, kTfMessage)) continue;
+        auto v = bag.cursor(topic, false);
+        for (NativeMessage m; v->next(m);)
             if (const auto tf = instantiate<tf2_msgs::TFMessage>(m))
                 for (const auto& t : tf->transforms)
                     edges[stripSlash(t.child_frame_id)] =
@@ -238,7 +229,7 @@ void chooseMount(BagReader& bag, const std::map<std::string, TopicInfo>& topics,
     c.notes.push_back(buf);
 }
 
-BagChoice choose(BagReader& bag, const std::map<std::string, TopicInfo>& topics,
+BagChoice choose(MessageStore& bag, const std::map<std::string, TopicInfo>& topics,
                  const SourceOptions& o) {
     BagChoice c;
     c.scan_topic = pickTopic(topics, o.scan_topic, kLaserScan, {"/scan", "scan"}, "scans",
@@ -246,7 +237,7 @@ BagChoice choose(BagReader& bag, const std::map<std::string, TopicInfo>& topics,
     c.odom_frame = o.odom_frame.empty() ? "odom" : stripSlash(o.odom_frame);
     std::string tf_topic;
     for (const char* t : {"/tf", "tf"})
-        if (topics.count(t) && topics.at(t).type == kTfMessage) tf_topic = t;
+        if (topics.count(t) && isType(topics.at(t).type, kTfMessage)) tf_topic = t;
     const std::string mode = o.odom_topic;
     std::string tf_child;  // the child of the odom frame in /tf, once looked up
     if (mode == "none") {
@@ -291,31 +282,6 @@ BagChoice choose(BagReader& bag, const std::map<std::string, TopicInfo>& topics,
     return c;
 }
 
-// A bag open for reading: its structure checked by kfd (BagFile::check; its chunks' records
-// there when `check_chunks`, else as the reader loads them), its index read by rosbag_storage,
-// its messages read through a BagReader.
-struct OpenBag {
-    std::unique_ptr<BagFile> file;
-    rosbag::Bag bag;
-    std::unique_ptr<BagReader> reader;
-
-    OpenBag(const std::string& path, bool check_chunks) {
-        std::error_code ec;
-        if (!fs::is_regular_file(path, ec)) throw BagError(path + ": no such file", path);
-        file = std::make_unique<BagFile>(path);
-        file->check(check_chunks);
-        try {
-            bag.open(path, rosbag::bagmode::Read);
-        } catch (const std::exception& e) {
-            throw BagError(path + ": not a readable ROS 1 bag (" + e.what() +
-                               "; a bag cut short while recording has no index: `rosbag "
-                               "reindex` repairs it)",
-                           path);
-        }
-        reader = std::make_unique<BagReader>(*file, bag);
-    }
-};
-
 }  // namespace
 
 struct BagSource::Impl {
@@ -335,11 +301,11 @@ struct BagSource::Impl {
 
     std::string path;
     // Chunks are checked as they are loaded: each is decompressed once, when it is read.
-    OpenBag open;
+    std::unique_ptr<MessageStore> store;
     std::map<std::string, TopicInfo> topics;
     BagChoice choice;
     std::string label;  // the scans' sensor label: the scan topic without its leading '/'
-    std::optional<BagReader::Cursor> cursor;
+    std::unique_ptr<MessageStore::Cursor> cursor;
     bool at_end = false;
     std::uint64_t size = 0;
     std::size_t total_messages = 0, messages_read = 0, entries = 0;
@@ -350,12 +316,13 @@ struct BagSource::Impl {
     OdometryTracker tracker;
     SourceCounters counts;
 
-    Impl(const std::string& p, const SourceOptions& o) : path(p), open(p, false) {
+    Impl(const std::string& p, const SourceOptions& o)
+        : path(p), store(openMessageStore(p, false)) {
         try {
-            topics = topicsOf(open.bag);
-            choice = choose(*open.reader, topics, o);
+            topics = store->topics();
+            choice = choose(*store, topics, o);
             label = stripSlash(choice.scan_topic);
-            cursor.emplace(open.reader->cursor({}, true));
+            cursor = store->cursor({}, true);
             total_messages = cursor->size();
         } catch (const BagFileError&) {
             throw;
@@ -365,9 +332,7 @@ struct BagSource::Impl {
             throw BagError(
                 path + ": cannot read the bag's index or first messages (" + e.what() + ")", path);
         }
-        std::error_code ec;
-        size = fs::file_size(path, ec);
-        if (ec) size = 0;
+        size = logSize(path);
     }
 
     std::string where(const NativeMessage& m) const {
@@ -556,18 +521,19 @@ std::uint64_t BagSource::bytesRead() const {
 std::uint64_t BagSource::bytesTotal() const { return impl_->size; }
 const BagChoice& BagSource::choice() const { return impl_->choice; }
 SourceCounters BagSource::counters() const { return impl_->counts; }
-std::size_t BagSource::chunks() const { return impl_->open.reader->chunks(); }
-std::size_t BagSource::chunksLoaded() const { return impl_->open.reader->chunksLoaded(); }
-std::string BagSource::compression() const { return impl_->open.file->compression(); }
+std::size_t BagSource::chunks() const { return impl_->store->chunks(); }
+std::size_t BagSource::chunksLoaded() const { return impl_->store->chunksLoaded(); }
+std::string BagSource::compression() const { return impl_->store->compression(); }
+std::string BagSource::kind() const { return impl_->store->kind(); }
 
 SourceListing listBag(const std::string& path, const SourceOptions& options) {
-    OpenBag open(path, true);  // a listing checks every chunk
+    const auto store = openMessageStore(path, true);  // a listing checks every chunk
     SourceListing l;
     l.path = path;
-    l.format = LogFormat::Bag;
+    l.format = detectFormat(path);
     std::map<std::string, TopicInfo> topics;
     try {
-        topics = topicsOf(open.bag);
+        topics = store->topics();
     } catch (const std::exception& e) {
         throw BagError(path + ": cannot read the bag's index (" + e.what() + ")", path);
     }
@@ -576,9 +542,10 @@ SourceListing listBag(const std::string& path, const SourceOptions& options) {
         l.streams.push_back({name, info.type, info.count, info.first, info.last});
         total += info.count;
     }
-    l.detail = "ROS 1 bag, " + plural(topics.size(), "topic") + ", " + plural(total, "message");
+    l.detail =
+        store->kind() + ", " + plural(topics.size(), "topic") + ", " + plural(total, "message");
     try {
-        const BagChoice c = choose(*open.reader, topics, options);
+        const BagChoice c = choose(*store, topics, options);
         l.choices = c.notes;
     } catch (const BagError& e) {
         l.choices.push_back(std::string("cannot use as it is: ") + e.what());

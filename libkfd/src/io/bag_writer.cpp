@@ -29,7 +29,8 @@ BagWriterOptions::Compression parseBagCompression(const std::string& text) {
     if (text == "none") return C::None;
     if (text == "lz4") return C::Lz4;
     if (text == "bz2") return C::Bz2;
-    throw Error("'" + text + "' is not a bag compression (input, none, lz4 or bz2)");
+    if (text == "zstd") return C::Zstd;
+    throw Error("'" + text + "' is not a bag compression (input, none, lz4, bz2 or zstd)");
 }
 
 namespace {
@@ -94,6 +95,8 @@ BagWriter::BagWriter(const std::string& path, const BagWriterOptions& options,
                 case BagWriterOptions::Compression::Bz2:
                     bag.setCompression(rosbag::compression::BZ2);
                     break;
+                case BagWriterOptions::Compression::Zstd:
+                    throw BagError("a ROS 1 bag has no zstd chunks (none, lz4 or bz2)");
             }
         },
         "cannot create the bag");

@@ -17,7 +17,14 @@ bool laserAnglesMatch(const sensor_msgs::LaserScan& m) {
     if (n < 2) return true;
     const double lo = m.angle_min, hi = m.angle_max, inc = m.angle_increment;
     if (!std::isfinite(lo) || !std::isfinite(hi) || !std::isfinite(inc) || inc == 0.0) return false;
-    return std::fabs((hi - lo) / inc - static_cast<double>(n - 1)) <= 1.0;
+    return std::fabs((hi - lo) / inc - static_cast<double>(n - 1)) <= 1.0 || fullTurnSpan(m);
+}
+
+bool fullTurnSpan(const sensor_msgs::LaserScan& m) {
+    const std::size_t n = m.ranges.size();
+    const double span = double(m.angle_max) - double(m.angle_min), inc = m.angle_increment;
+    return n >= 2 && inc != 0.0 && std::isfinite(span / inc) &&
+           std::fabs(span / inc - static_cast<double>(n)) <= 1e-3;
 }
 
 mrpt::obs::CObservation2DRangeScan::Ptr laserScanToObservation(const sensor_msgs::LaserScan& m,
@@ -29,12 +36,16 @@ mrpt::obs::CObservation2DRangeScan::Ptr laserScanToObservation(const sensor_msgs
     obs->timestamp = mrpt::Clock::fromDouble(stamp);
     const std::size_t n = m.ranges.size();
     const bool angles_ok = laserAnglesMatch(m);
-    obs->aperture = angles_ok
-                        ? static_cast<float>(std::fabs(double(m.angle_max) - double(m.angle_min)))
-                        : std::numeric_limits<float>::quiet_NaN();
+    // The beams' span: angle_max - angle_min, or (n - 1) increments when angle_max is one
+    // increment past the last beam (fullTurnSpan).
+    const double last = fullTurnSpan(m)
+                            ? double(m.angle_min) + double(n - 1) * double(m.angle_increment)
+                            : double(m.angle_max);
+    obs->aperture = angles_ok ? static_cast<float>(std::fabs(last - double(m.angle_min)))
+                              : std::numeric_limits<float>::quiet_NaN();
     obs->rightToLeft = !angles_ok || m.angle_increment >= 0.0f;
     obs->maxRange = m.range_max;
-    const double mid = angles_ok ? 0.5 * (double(m.angle_min) + double(m.angle_max)) : 0.0;
+    const double mid = angles_ok ? 0.5 * (double(m.angle_min) + last) : 0.0;
     obs->sensorPose = mrpt::poses::CPose3D(mount.x, mount.y, 0.0, mount.phi + mid, 0.0, 0.0);
     obs->resizeScan(n);
     for (std::size_t i = 0; i < n; ++i) {

@@ -32,16 +32,23 @@ bool isCarmenKeyword(const std::string& w) {
 
 LogFormat detectFormat(const std::string& path) {
     std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+        if (std::filesystem::is_regular_file(std::filesystem::path(path) / "metadata.yaml", ec))
+            return LogFormat::Rosbag2;
+        throw SourceError(path + ": a folder without metadata.yaml (not a rosbag2 bag)", path);
+    }
     if (!std::filesystem::is_regular_file(path, ec))
         throw SourceError("input log not found: " + path, path);
     {
         std::FILE* f = std::fopen(path.c_str(), "rb");
         if (!f) throw SourceError("cannot open the input log " + path, path);
-        char head[13] = {};
+        char head[16] = {};
         const std::size_t n = std::fread(head, 1, sizeof(head), f);
         std::fclose(f);
+        if (n >= 8 && std::memcmp(head, "\x89MCAP0\r\n", 8) == 0) return LogFormat::Mcap;
+        if (n == 16 && std::memcmp(head, "SQLite format 3", 16) == 0) return LogFormat::Rosbag2;
         if (n >= 9 && std::memcmp(head, "#ROSBAG V", 9) == 0) {
-            if (n == 13 && std::memcmp(head, "#ROSBAG V2.0\n", 13) == 0) return LogFormat::Bag;
+            if (n >= 13 && std::memcmp(head, "#ROSBAG V2.0\n", 13) == 0) return LogFormat::Bag;
             throw SourceError(path + ": a ROS bag of format " +
                                   std::string(head + 9, head + std::min<std::size_t>(n, 12)) +
                                   " (only 2.0, the format of ROS 1 since 2010, is read)",
@@ -81,6 +88,8 @@ std::unique_ptr<Source> openSource(const std::string& path, LogFormat format,
                                    const SourceOptions& options) {
     switch (format) {
         case LogFormat::Bag:
+        case LogFormat::Rosbag2:
+        case LogFormat::Mcap:
             return std::make_unique<BagSource>(path, options);
         case LogFormat::Carmen:
             return std::make_unique<CarmenSource>(path);

@@ -26,6 +26,7 @@
 #include "kfd/io/carmen_writer.h"
 #include "kfd/io/gz_output.h"
 #include "kfd/io/open_source.h"
+#include "kfd/io/ros2_writer.h"
 #include "kfd/io/scan_csv.h"
 #include "kfd/stages/denoise_result.h"
 #include "kfd/stages/evidence_denoise_stage.h"
@@ -62,12 +63,18 @@ decltype(auto) asRawlogError(Fn&& fn, const std::string& field = {}) {
 }
 
 // The output's format by its name; a PathError naming the formats for any other name.
+bool isRos2(LogFormat f) { return f == LogFormat::Rosbag2 || f == LogFormat::Mcap; }
+bool isBagLike(LogFormat f) { return f == LogFormat::Bag || isRos2(f); }
+
 LogFormat outputFormat(const std::string& output) {
     if (hasExtension(output, ".bag")) return LogFormat::Bag;
+    LogFormat ros2;
+    if (ros2OutputFormat(output, ros2)) return ros2;
     if (isCarmenOutputName(output)) return LogFormat::Carmen;
     checkOutputName({"output", output}, {".rawlog"},
-                    "kfd-filter writes .rawlog (an MRPT rawlog), .bag (a ROS 1 bag, for a bag "
-                    "input), .clf or .log (a CARMEN log; .clf.gz, .log.gz: gzip)");
+                    "kfd-filter writes .rawlog (an MRPT rawlog), .bag (a ROS 1 bag, for a ROS 1 "
+                    "bag input), .db3 or .mcap (ROS 2, for any bag input), .clf or .log (a "
+                    "CARMEN log; .clf.gz, .log.gz: gzip)");
     return LogFormat::Rawlog;
 }
 
@@ -129,7 +136,7 @@ class Run {
     std::optional<TempOutputFile> tmp_, tmp_csv_;  // the outputs under temporary names
     ScanCsvWriter csv_;
     std::optional<GzOutputStream> gz_;       // a rawlog output
-    std::optional<BagWriter> bag_;           // a bag output (instead of gz_)
+    std::unique_ptr<MessageWriter> bag_;     // a bag output: ROS 1, .db3, .mcap (not gz_)
     std::optional<CarmenWriter> carmen_;     // a CARMEN output (instead of gz_)
     std::optional<Pose2D> carmen_odometry_;  // the odometry of the last line written
     std::vector<CObservation2DRangeScan::Ptr> carmen_unposed_;  // kept before any odometry
@@ -269,8 +276,8 @@ void Run::handleFrame(const std::shared_ptr<CSensoryFrame>& sf) {
 // The paths, the formats and the source; nothing is written yet.
 void Run::prepare() {
     std::error_code ec;
-    if (!fs::is_regular_file(opts_.input, ec))
-        throw RawlogError("input log not found: " + opts_.input);
+    if (!fs::is_regular_file(opts_.input, ec) && !fs::is_directory(opts_.input, ec))
+        throw RawlogError("input log not found: " + opts_.input);  // a folder: rosbag2
     if (opts_.output.empty()) throw RawlogError("no output file given");
     // Before anything is opened for writing: no output may be an input or the other output.
     try {
@@ -283,8 +290,16 @@ void Run::prepare() {
     sum_.output_format = asRawlogError([&] { return outputFormat(o); });
     sum_.input_format = asRawlogError([&] { return detectFormat(opts_.input); });
     if (sum_.output_format == LogFormat::Bag && sum_.input_format != LogFormat::Bag)
-        throw RawlogError("a bag output (" + o + ") needs a ROS bag input; " + opts_.input +
+        throw RawlogError("a bag output (" + o + ") needs a ROS 1 bag input; " + opts_.input +
                               " is read as: " + toString(sum_.input_format) +
+                              (isRos2(sum_.input_format) ? " (write a .db3 or .mcap instead)"
+                                                         : " (write a .rawlog instead)"),
+                          o);
+    if (isRos2(sum_.output_format) && !isBagLike(sum_.input_format))
+        throw RawlogError("a ROS 2 output (" + o +
+                              ") needs a bag input (ROS 1, rosbag2 or "
+                              "MCAP); " +
+                              opts_.input + " is read as: " + toString(sum_.input_format) +
                               " (write a .rawlog instead)",
                           o);
     source_ =
@@ -308,8 +323,23 @@ void Run::openOutputs() {
         if (bag.compression == BagWriterOptions::Compression::AsInput)
             if (const auto* in = dynamic_cast<const BagSource*>(source_.get()))
                 bag.compression = parseBagCompression(in->compression());
-        asRawlogError([&] { bag_.emplace(tmp_->path().string(), bag, opts_.output); },
-                      opts_.output);
+        asRawlogError(
+            [&] { bag_ = std::make_unique<BagWriter>(tmp_->path().string(), bag, opts_.output); },
+            opts_.output);
+    } else if (isRos2(sum_.output_format)) {
+        asRawlogError(
+            [&] {
+                BagWriterOptions bag = opts_.bag;  // AsInput: the input's none/lz4/zstd, or zstd
+                if (bag.compression == BagWriterOptions::Compression::AsInput) {
+                    const auto* in = dynamic_cast<const BagSource*>(source_.get());
+                    const std::string c = in ? in->compression() : "zstd";
+                    bag.compression = parseBagCompression(
+                        c == "none" || c == "lz4" || c == "zstd" ? c : std::string("zstd"));
+                }
+                bag_ = std::make_unique<Ros2Writer>(tmp_->path().string(), sum_.output_format, bag,
+                                                    opts_.output);
+            },
+            opts_.output);
     } else if (sum_.output_format == LogFormat::Carmen) {
         const bool gzip = hasExtension(opts_.output, ".gz");
         asRawlogError([&] {
@@ -422,7 +452,7 @@ void Run::handleCarmenEntry(const SourceEntry& e) {
                         "the first " +
                             std::to_string(kCarmenMaxUnposed) + " kept scans of " + opts_.input +
                             " have none (a laser-only log): write a .rawlog" +
-                            (sum_.input_format == LogFormat::Bag ? " or a .bag" : ""),
+                            (isBagLike(sum_.input_format) ? " or a bag" : ""),
                         opts_.output);
                 carmen_unposed_.push_back(scan);
             }
@@ -470,7 +500,7 @@ void Run::finish() {
     if (!carmen_unposed_.empty())
         throw RawlogError("a CARMEN output needs the robot's odometry (a FLASER line holds it): " +
                               opts_.input + " has none (a laser-only log): write a .rawlog" +
-                              (sum_.input_format == LogFormat::Bag ? " or a .bag" : ""),
+                              (isBagLike(sum_.input_format) ? " or a bag" : ""),
                           opts_.output);
     flushUnpairedAction(true);
     if (have_carry_) {  // the last frames were dropped: keep their motion as a final action
@@ -485,9 +515,13 @@ void Run::finish() {
     // Every output complete and checked (the gzip's trailer, the bag's index read back, sizes,
     // fsync) before anything is renamed into place.
     asRawlogError([&] {
-        if (bag_)
+        if (bag_) {
             bag_->close();
-        else if (carmen_)
+            if (const auto* r2 = dynamic_cast<const Ros2Writer*>(bag_.get())) {
+                sum_.messages_left_out = r2->messagesLeftOut();
+                sum_.objects_out -= sum_.messages_left_out;
+            }
+        } else if (carmen_)
             carmen_->close();
         else
             gz_->close();

@@ -46,6 +46,10 @@ const char* toString(LogFormat f) {
             return "ROS 1 bag";
         case LogFormat::Carmen:
             return "CARMEN log";
+        case LogFormat::Rosbag2:
+            return "rosbag2";
+        case LogFormat::Mcap:
+            return "MCAP";
     }
     return "?";
 }

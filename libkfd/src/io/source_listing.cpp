@@ -71,6 +71,8 @@ SourceListing listRawlog(const std::string& path) {
 SourceListing listSource(const std::string& path, const SourceOptions& options) {
     switch (detectFormat(path)) {
         case LogFormat::Bag:
+        case LogFormat::Rosbag2:
+        case LogFormat::Mcap:
             return listBag(path, options);
         case LogFormat::Carmen:
             return listCarmen(path);

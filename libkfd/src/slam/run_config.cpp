@@ -53,9 +53,12 @@ void resolvePaths(const IcpSlamOptions& opts, const mrpt::config::CConfigFile& c
         !opts.output_dir.empty() ? opts.output_dir : cfg.read_string(kSect, "logOutput_dir", "");
     std::error_code ec;
     if (sum.rawlog.empty()) throw SlamError("no rawlog given (option or rawlog_file)");
-    if (!fs::is_regular_file(sum.rawlog, ec)) throw SlamError("rawlog not found: " + sum.rawlog);
+    // A rosbag2 bag is a folder (metadata.yaml and its files): the source checks it.
+    const bool folder = fs::is_directory(sum.rawlog, ec);
+    if (!folder && !fs::is_regular_file(sum.rawlog, ec))
+        throw SlamError("rawlog not found: " + sum.rawlog);
     if (sum.output_dir.empty()) throw SlamError("no output folder given (option or logOutput_dir)");
-    checkReadable("rawlog", sum.rawlog);
+    if (!folder) checkReadable("rawlog", sum.rawlog);
     checkReadable("relations file", opts.relations);
     checkReadable("ground-truth trajectory", opts.ground_truth_tum);
     const std::vector<NamedPath> inputs = {{"configuration", opts.config_file},

@@ -123,6 +123,8 @@ class BagSource : public Source {
     /// The compression of the bag's chunks ("none", "bz2" or "lz4"; of most of them when they
     /// differ): what a bag output takes by default (BagWriterOptions::Compression::AsInput).
     std::string compression() const;
+    /// "ROS 1 bag", "rosbag2 (sqlite3)" or "MCAP".
+    std::string kind() const;
 
   private:
     struct Impl;

@@ -24,6 +24,12 @@ bool validRange(const sensor_msgs::LaserScan& m, float r);
 /// then matches the span's). Fewer than 2 beams: left to the door (no_beams).
 bool laserAnglesMatch(const sensor_msgs::LaserScan& m);
 
+/// True when angle_max is one increment past the last beam (angle_max - angle_min = n
+/// increments, within 1e-3 of one): the convention of 360-degree drivers such as rplidar_ros
+/// (0 to 2 pi in 360 beams). Such angles match the beam count too, and the beams' span is n - 1
+/// increments.
+bool fullTurnSpan(const sensor_msgs::LaserScan& m);
+
 /// The MRPT scan of `m` stamped `stamp` (s), labelled `label`, its laser mounted at `mount`
 /// (the laser frame in the robot's base frame). Angle fields that do not match the beam count
 /// (laserAnglesMatch) give an aperture of NaN: the door skips the scan (bad_aperture).

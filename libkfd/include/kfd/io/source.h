@@ -176,7 +176,13 @@ class Source {
 };
 
 /// The formats kfd reads.
-enum class LogFormat { Rawlog, Bag, Carmen };
+enum class LogFormat {
+    Rawlog,
+    Bag,  // ROS 1 bag
+    Carmen,
+    Rosbag2,  // ROS 2 rosbag2: a folder with metadata.yaml, or one sqlite3 .db3
+    Mcap,     // an MCAP file (ROS 2's default bag format from Iron on)
+};
 const char* toString(LogFormat f);
 
 /// What a source reads from a log whose streams are named (a bag's topics and frames). Empty
