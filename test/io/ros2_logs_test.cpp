@@ -47,9 +47,7 @@ std::size_t convert(const std::string& in, const std::string& out) {
     return writer.messagesWritten();
 }
 
-void write(const std::string& p, const std::string& b) {
-    std::ofstream(p, std::ios::binary) << b;
-}
+void write(const std::string& p, const std::string& b) { std::ofstream(p, std::ios::binary) << b; }
 
 struct ScanRow {
     double t;
@@ -414,4 +412,26 @@ TEST(Ros2Logs, BadFilesAreRefusedWithAClearMessage) {
                                content + std::string(1, '\x0F') + u64(4) + u32(0);
     write(d / "brotli.mcap", brotli);
     expectRefused(d / "brotli.mcap", "brotli");
+}
+
+namespace {
+std::size_t openDescriptors() {
+    return static_cast<std::size_t>(
+        std::distance(fs::directory_iterator("/proc/self/fd"), fs::directory_iterator()));
+}
+}  // namespace
+
+// A refused file leaves nothing open: each bad MCAP once kept its FILE (and descriptor).
+TEST(Ros2Logs, RefusedFilesLeaveNoDescriptorOpen) {
+    kfd::test::TempDir d("ros2_");
+    write(d / "bad.mcap", std::string("\x89MCAP0\r\n", 8) + "\x01" + std::string(7, '\xff'));
+    write(d / "bad.db3", std::string("SQLite format 3\0", 16) + std::string(100, 'x'));
+    const std::size_t before = openDescriptors();
+    for (int i = 0; i < 50; ++i)
+        for (const char* f : {"bad.mcap", "bad.db3"}) {
+            EXPECT_THROW(kfd::BagSource{d / f}, kfd::BagError);
+            EXPECT_THROW(kfd::Ros2Writer(d / "no/such/dir/out.mcap", kfd::LogFormat::Mcap),
+                         kfd::BagError);
+        }
+    EXPECT_EQ(openDescriptors(), before);
 }

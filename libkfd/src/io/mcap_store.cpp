@@ -7,9 +7,11 @@
 #include <zlib.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 
 #include "message_store.h"
 #include "ros2_store.h"
@@ -18,6 +20,10 @@ namespace kfd {
 namespace {
 
 namespace fs = std::filesystem;
+
+struct FileClose {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+};
 
 constexpr std::uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
 // A chunk that decompresses to more than this is refused (memory bounded whatever it claims).
@@ -84,37 +90,80 @@ class Fields {
     const char* record_;
 };
 
+// Room for more output: doubled, up to the announced size. A corrupt size field allocates
+// nothing: the output grows with what the data holds.
+void grow(std::vector<std::uint8_t>& out, std::size_t used, std::uint64_t size) {
+    if (used < out.size()) return;
+    const std::size_t next = std::max<std::size_t>(out.size() * 2, 64u << 10);
+    out.resize(static_cast<std::size_t>(std::min<std::uint64_t>(next, size)));
+}
+
+std::size_t unzstd(const std::uint8_t* p, std::size_t n, std::uint64_t size,
+                   std::vector<std::uint8_t>& out) {
+    ZSTD_DStream* z = ZSTD_createDStream();
+    if (!z) throw BagError("cannot start zstd");
+    ZSTD_inBuffer in{p, n, 0};
+    std::size_t used = 0, rc = 1;
+    while (rc != 0 && !ZSTD_isError(rc) && used < size) {
+        grow(out, used, size);
+        ZSTD_outBuffer o{out.data(), out.size(), used};
+        const std::size_t before_in = in.pos, before_out = used;
+        rc = ZSTD_decompressStream(z, &o, &in);
+        used = o.pos;
+        if (in.pos == before_in && used == before_out && used < out.size()) break;  // stuck
+    }
+    if (used == size && !ZSTD_isError(rc) && rc != 0) {  // all output: is the frame complete?
+        std::uint8_t extra = 0;
+        ZSTD_outBuffer o{&extra, 1, 0};
+        rc = ZSTD_decompressStream(z, &o, &in);
+        if (o.pos) used = size + 1;
+    }
+    ZSTD_freeDStream(z);
+    if (ZSTD_isError(rc) || rc != 0 || used != size)
+        throw BagError(std::string("a zstd chunk that does not decompress to its size (") +
+                       (ZSTD_isError(rc) ? ZSTD_getErrorName(rc) : "size differs") + ")");
+    return used;
+}
+
+std::size_t unlz4(const std::uint8_t* p, std::size_t n, std::uint64_t size,
+                  std::vector<std::uint8_t>& out) {
+    LZ4F_dctx* ctx = nullptr;
+    if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION)))
+        throw BagError("cannot start lz4");
+    std::size_t in_at = 0, used = 0, rc = 1;
+    while (rc != 0 && in_at < n) {
+        if (used == size) {  // output complete, input left: more than announced
+            used = size + 1;
+            break;
+        }
+        grow(out, used, size);
+        std::size_t src = n - in_at, dst = out.size() - used;
+        rc = LZ4F_decompress(ctx, out.data() + used, &dst, p + in_at, &src, nullptr);
+        if (LZ4F_isError(rc)) break;
+        in_at += src;
+        used += dst;
+        if (src == 0 && dst == 0) break;
+    }
+    LZ4F_freeDecompressionContext(ctx);
+    if (LZ4F_isError(rc) || rc != 0 || used != size)
+        throw BagError(std::string("an lz4 chunk that does not decompress to its size (") +
+                       (LZ4F_isError(rc) ? LZ4F_getErrorName(rc) : "size differs") + ")");
+    return used;
+}
+
 std::vector<std::uint8_t> decompress(const std::string& how, const std::uint8_t* p, std::size_t n,
                                      std::uint64_t size) {
     if (size > kMaxChunkBytes)
         throw BagError("a chunk of " + std::to_string(size) +
                        " bytes uncompressed (kfd reads chunks up to 512 MiB)");
-    std::vector<std::uint8_t> out(static_cast<std::size_t>(size));
+    std::vector<std::uint8_t> out;
     if (how.empty()) {
         if (n != size) throw BagError("an uncompressed chunk whose size does not match its data");
-        std::memcpy(out.data(), p, n);
+        out.assign(p, p + n);
     } else if (how == "zstd") {
-        const std::size_t got = ZSTD_decompress(out.data(), out.size(), p, n);
-        if (ZSTD_isError(got) || got != size)
-            throw BagError(std::string("a zstd chunk that does not decompress to its size (") +
-                           (ZSTD_isError(got) ? ZSTD_getErrorName(got) : "size differs") + ")");
+        out.resize(unzstd(p, n, size, out));
     } else if (how == "lz4") {
-        LZ4F_dctx* ctx = nullptr;
-        if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION)))
-            throw BagError("cannot start lz4");
-        std::size_t in_at = 0, out_at = 0, rc = 1;
-        while (rc != 0 && in_at < n && out_at <= out.size()) {
-            std::size_t src = n - in_at, dst = out.size() - out_at;
-            rc = LZ4F_decompress(ctx, out.data() + out_at, &dst, p + in_at, &src, nullptr);
-            if (LZ4F_isError(rc)) break;
-            in_at += src;
-            out_at += dst;
-            if (src == 0 && dst == 0) break;
-        }
-        LZ4F_freeDecompressionContext(ctx);
-        if (LZ4F_isError(rc) || rc != 0 || out_at != size)
-            throw BagError(std::string("an lz4 chunk that does not decompress to its size (") +
-                           (LZ4F_isError(rc) ? LZ4F_getErrorName(rc) : "size differs") + ")");
+        out.resize(unlz4(p, n, size, out));
     } else {
         throw BagError("a chunk compressed with '" + how + "' (MCAP readers know \"\", lz4, zstd)");
     }
@@ -127,16 +176,14 @@ class McapStore : public MessageStore {
         std::error_code ec;
         if (!fs::is_regular_file(path, ec)) throw BagError(path + ": no such file", path);
         size_ = fs::file_size(path, ec);
-        file_ = std::fopen(path.c_str(), "rb");
+        file_.reset(std::fopen(path.c_str(), "rb"));  // closed even when this throws
         if (!file_) throw BagError(path + ": cannot open it", path);
         std::uint8_t magic[8] = {};
-        if (size_ < 8 || std::fread(magic, 1, 8, file_) != 8 || std::memcmp(magic, kMagic, 8) != 0)
+        if (size_ < 8 || std::fread(magic, 1, 8, file_.get()) != 8 ||
+            std::memcmp(magic, kMagic, 8) != 0)
             throw BagError(path + ": not an MCAP file (no MCAP magic)", path);
         (void)check;  // the pass below walks every record and chunk
         scan();
-    }
-    ~McapStore() override {
-        if (file_) std::fclose(file_);
     }
 
     std::map<std::string, TopicInfo> topics() override { return topics_; }
@@ -290,7 +337,8 @@ class McapStore : public MessageStore {
     };
 
     void readAt(std::uint64_t at, std::uint8_t* p, std::size_t n) {
-        if (fseeko(file_, static_cast<off_t>(at), SEEK_SET) != 0 || std::fread(p, 1, n, file_) != n)
+        if (fseeko(file_.get(), static_cast<off_t>(at), SEEK_SET) != 0 ||
+            std::fread(p, 1, n, file_.get()) != n)
             fail(at, "cannot read it");
     }
     [[noreturn]] void fail(std::uint64_t at, const std::string& what) const {
@@ -346,7 +394,7 @@ class McapStore : public MessageStore {
 
     std::string path_;
     std::uint64_t size_ = 0;
-    std::FILE* file_ = nullptr;
+    std::unique_ptr<std::FILE, FileClose> file_;
     std::string compression_ = "none";
     std::map<std::uint16_t, Schema> schemas_;
     std::map<std::uint16_t, std::unique_ptr<Ros2Connection>> channels_;

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <vector>
 
 #include "bag_message.h"
@@ -21,6 +22,10 @@ namespace kfd {
 namespace {
 
 namespace fs = std::filesystem;
+
+struct FileClose {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+};
 
 bool endsWith(const std::string& s, const char* x) {
     const std::size_t n = std::strlen(x);
@@ -80,6 +85,16 @@ class DbSink : public Sink {
     DbSink(const std::string& path, const std::string& name) : name_(name) {
         std::error_code ec;
         fs::remove(path, ec);  // a temporary name: anything there is ours
+        try {
+            open(path);
+        } catch (...) {  // the destructor does not run for a constructor that throws
+            sqlite3_finalize(insert_);
+            sqlite3_close(db_);
+            throw;
+        }
+        file_ = fs::path(name).filename().string();
+    }
+    void open(const std::string& path) {
         if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
                             nullptr) != SQLITE_OK)
             fail("cannot create it");
@@ -98,7 +113,6 @@ class DbSink : public Sink {
                                "INSERT INTO messages(topic_id, timestamp, data) VALUES (?, ?, ?)",
                                -1, &insert_, nullptr) != SQLITE_OK)
             fail("cannot prepare it");
-        file_ = fs::path(name).filename().string();
     }
     ~DbSink() override {
         sqlite3_finalize(insert_);
@@ -209,13 +223,10 @@ class McapSink : public Sink {
   public:
     McapSink(const std::string& path, const std::string& name, std::string compression)
         : name_(name), compression_(std::move(compression)) {
-        f_ = std::fopen(path.c_str(), "wb");
+        f_.reset(std::fopen(path.c_str(), "wb"));  // closed even when this throws
         if (!f_) fail("cannot create it");
         put({0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'});
         put(Record(0x01).str("ros2").str("kfd").bytes());
-    }
-    ~McapSink() override {
-        if (f_) std::fclose(f_);
     }
     void topic(const Topic& t) override {
         const std::string enc = t.c.schema_encoding.empty() ? "ros2msg" : t.c.schema_encoding;
@@ -279,9 +290,8 @@ class McapSink : public Sink {
                 .num<std::uint32_t>(0)
                 .bytes());
         put({0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'});
-        if (std::fflush(f_) != 0) fail("failed writing it");
-        const int rc = std::fclose(f_);
-        f_ = nullptr;
+        if (std::fflush(f_.get()) != 0) fail("failed writing it");
+        const int rc = std::fclose(f_.release());
         if (rc != 0) fail("failed closing it");
     }
 
@@ -350,7 +360,7 @@ class McapSink : public Sink {
         chunk_count_ = 0;
     }
     void put(const std::vector<std::uint8_t>& b) {
-        if (!b.empty() && std::fwrite(b.data(), 1, b.size(), f_) != b.size())
+        if (!b.empty() && std::fwrite(b.data(), 1, b.size(), f_.get()) != b.size())
             fail("failed writing it");
         at_ += b.size();
     }
@@ -361,7 +371,7 @@ class McapSink : public Sink {
                        name_);
     }
     std::string name_, compression_;
-    std::FILE* f_ = nullptr;
+    std::unique_ptr<std::FILE, FileClose> f_;
     std::uint64_t at_ = 0;
     std::vector<std::vector<std::uint8_t>> schemas_, channels_, chunk_indexes_;
     std::vector<std::uint8_t> chunk_;
