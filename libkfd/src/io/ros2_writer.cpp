@@ -379,15 +379,16 @@ class McapSink : public Sink {
     std::uint64_t chunk_start_ = 0, chunk_end_ = 0, chunk_count_ = 0;
 };
 
-// A ROS 1 message of a type kfd reads, as CDR under its ROS 2 type; false for other types.
+// A ROS 1 message of a type kfd reads, as CDR under its ROS 2 type (its lengths checked first,
+// as for every message kfd deserializes: another topic's may be corrupt); false for other types.
 bool toCdr(const NativeMessage& m, std::string& type, std::vector<std::uint8_t>& out) {
-    if (const auto ls = m.instantiate<sensor_msgs::LaserScan>()) {
+    if (const auto ls = instantiateChecked<sensor_msgs::LaserScan>(m)) {
         type = "sensor_msgs/msg/LaserScan";
         out = encodeRos2(*ls);
-    } else if (const auto od = m.instantiate<nav_msgs::Odometry>()) {
+    } else if (const auto od = instantiateChecked<nav_msgs::Odometry>(m)) {
         type = "nav_msgs/msg/Odometry";
         out = encodeRos2(*od);
-    } else if (const auto tf = m.instantiate<tf2_msgs::TFMessage>()) {
+    } else if (const auto tf = instantiateChecked<tf2_msgs::TFMessage>(m)) {
         type = "tf2_msgs/msg/TFMessage";
         out = encodeRos2(*tf);
     } else {
