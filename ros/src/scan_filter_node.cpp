@@ -336,23 +336,15 @@ diagnostic_msgs::DiagnosticStatus ScanFilterNode::stats() const {
     char buf[160];
     std::snprintf(buf, sizeof(buf), "%zu of %zu scans kept", c.scans_kept, c.scans_in);
     s.message = buf;
-    const double dropped =
-        c.scans_in ? 100.0 * double(c.scans_in - c.scans_kept) / double(c.scans_in) : 0.0;
-    s.values = {kv("scans_in", double(c.scans_in)),
-                kv("scans_kept", double(c.scans_kept)),
-                kv("dropped_pct", dropped),
-                kv("points_removed", double(c.points_removed)),
-                kv("out_of_order", double(c.out_of_order)),
-                kv("odom_missing", double(c.odom_missing)),
-                kv("resets", double(c.resets)),
-                kv("geometry_resets", double(c.geometry_resets)),
-                kv("scans_skipped", double(c.scans_skipped)),
-                kv("latency_p50_us", latency_.percentile(50.0)),
-                kv("latency_p99_us", latency_.percentile(99.0)),
-                kv("latency_max_us", latency_.max()),
-                kv("work_p50_us", work_.percentile(50.0)),
-                kv("work_p99_us", work_.percentile(99.0)),
-                kv("work_max_us", work_.max())};
+    for (const auto& [key, value] : live::counterValues(c)) s.values.push_back(kv(key, value));
+    for (const auto& [key, value] :
+         {std::pair<const char*, double>{"latency_p50_us", latency_.percentile(50.0)},
+          {"latency_p99_us", latency_.percentile(99.0)},
+          {"latency_max_us", latency_.max()},
+          {"work_p50_us", work_.percentile(50.0)},
+          {"work_p99_us", work_.percentile(99.0)},
+          {"work_max_us", work_.max()}})
+        s.values.push_back(kv(key, value));
     return s;
 }
 

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "kfd/io/laser_scan.h"
+#include "kfd/io/ros2_message.h"
 #include "kfd/io/source.h"
-#include "ros2_message.h"
 
 namespace kfd {
 

@@ -10,7 +10,7 @@
 #include "bag_file.h"
 #include "bag_reader.h"
 #include "kfd/io/open_source.h"
-#include "ros2_message.h"
+#include "kfd/io/ros2_message.h"
 #include "ros2_store.h"
 
 namespace kfd {

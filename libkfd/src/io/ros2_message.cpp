@@ -1,4 +1,4 @@
-#include "ros2_message.h"
+#include "kfd/io/ros2_message.h"
 
 #include <map>
 
@@ -121,6 +121,25 @@ void decodeRos2(const std::uint8_t* data, std::size_t size, tf2_msgs::TFMessage&
     });
 }
 
+void decodeRos2(const std::uint8_t* data, std::size_t size, diagnostic_msgs::DiagnosticArray& m) {
+    decodeAs("diagnostic_msgs/msg/DiagnosticArray", data, size, [&](CdrReader& r) {
+        readHeader(r, m.header);
+        // A status is at least its level and three empty strings (1 + 3 + 3 x 5 bytes).
+        m.status.resize(r.readCount("status", 19));
+        for (auto& s : m.status) {
+            s.level = r.read<std::uint8_t>("status.level");
+            s.name = r.readString("status.name");
+            s.message = r.readString("status.message");
+            s.hardware_id = r.readString("status.hardware_id");
+            s.values.resize(r.readCount("status.values", 10));  // two empty strings
+            for (auto& kv : s.values) {
+                kv.key = r.readString("status.values.key");
+                kv.value = r.readString("status.values.value");
+            }
+        }
+    });
+}
+
 std::vector<std::uint8_t> encodeRos2(const sensor_msgs::LaserScan& m) {
     CdrWriter w;
     writeHeader(w, m.header);
@@ -156,6 +175,24 @@ std::vector<std::uint8_t> encodeRos2(const tf2_msgs::TFMessage& m) {
         const auto& p = t.transform.translation;
         for (double v : {p.x, p.y, p.z}) w.write(v);
         writeQuaternion(w, t.transform.rotation);
+    }
+    return std::move(w.bytes());
+}
+
+std::vector<std::uint8_t> encodeRos2(const diagnostic_msgs::DiagnosticArray& m) {
+    CdrWriter w;
+    writeHeader(w, m.header);
+    w.write<std::uint32_t>(static_cast<std::uint32_t>(m.status.size()));
+    for (const auto& s : m.status) {
+        w.write<std::uint8_t>(s.level);
+        w.writeString(s.name);
+        w.writeString(s.message);
+        w.writeString(s.hardware_id);
+        w.write<std::uint32_t>(static_cast<std::uint32_t>(s.values.size()));
+        for (const auto& kv : s.values) {
+            w.writeString(kv.key);
+            w.writeString(kv.value);
+        }
     }
     return std::move(w.bytes());
 }

@@ -16,7 +16,7 @@
 
 #include "bag_message.h"
 #include "kfd/io/laser_scan.h"
-#include "ros2_message.h"
+#include "kfd/io/ros2_message.h"
 
 namespace kfd {
 namespace {

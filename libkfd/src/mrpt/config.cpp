@@ -359,18 +359,21 @@ void applySection(Pipeline::Params& p, const ConfigValues::Section& section,
 std::string ConfigSyntax::sectionName(const std::string& stage) const {
     if (kind == Yaml) return "kfd: " + stage + ":";
     if (kind == RosParams) return "~" + stage + "/";
+    if (kind == Ros2Params) return stage + ".";
     return "[" + section + "." + stage + "]";
 }
 
 std::string ConfigSyntax::flatPlace() const {
     if (kind == Yaml) return "the kfd: map";
     if (kind == RosParams) return "the node's private parameters";
+    if (kind == Ros2Params) return "the node's parameters";
     return "[" + section + "]";
 }
 
 std::string ConfigSyntax::spell(const std::string& stage, const std::string& keys) const {
     if (kind == Yaml) return "kfd: " + stage + ": {" + keys + "}";
     if (kind == RosParams) return "~" + stage + "/{" + keys + "}";
+    if (kind == Ros2Params) return stage + ".{" + keys + "}";
     return sectionName(stage) + " " + keys;
 }
 

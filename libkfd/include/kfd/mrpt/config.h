@@ -76,11 +76,12 @@ struct ConfigValues {
 
 /// How the user wrote the configuration, for messages: the sections' and keys' spelling.
 struct ConfigSyntax {
-    enum Kind { Ini, Yaml, RosParams } kind = Ini;
+    // RosParams: the ROS 1 node's ~<stage>/<key>; Ros2Params: the ROS 2 node's <stage>.<key>.
+    enum Kind { Ini, Yaml, RosParams, Ros2Params } kind = Ini;
     std::string section = "KFD";  // the .ini section (Ini)
-    /// "[KFD.distance]", "kfd: distance:", "~distance/".
+    /// "[KFD.distance]", "kfd: distance:", "~distance/", "distance.".
     std::string sectionName(const std::string& stage) const;
-    /// "[KFD]", "the kfd: map", "the node's private parameters".
+    /// "[KFD]", "the kfd: map", "the node's private parameters", "the node's parameters".
     std::string flatPlace() const;
     /// "[KFD.distance] min_range, max_range" and the like.
     std::string spell(const std::string& stage, const std::string& keys) const;

@@ -22,12 +22,20 @@
 #include <string>
 #include <vector>
 
-#include "kfd/ros1/latency_stats.h"
-#include "kfd/ros1/live_filter.h"
+#include "kfd/live/latency_stats.h"
+#include "kfd/live/live_filter.h"
+#include "kfd/live/odometry_buffer.h"
 #include "kfd/ros1/node_config.h"
-#include "kfd/ros1/odometry_buffer.h"
 
 namespace kfd::ros1 {
+
+// The live front end both transports share (libkfd/include/kfd/live).
+using live::frameLabel;
+using live::LatencyStats;
+using live::LiveCounters;
+using live::LiveFilter;
+using live::LiveResult;
+using live::OdometryBuffer;
 
 class ScanFilterNode {
   public:

@@ -1,6 +1,6 @@
-// kfd::ros1::OdometryBuffer: the pose at a scan's stamp from an odometry topic, by the bag
+// kfd::live::OdometryBuffer: the pose at a scan's stamp from an odometry topic, by the bag
 // source's rule, in bounded memory.
-#include "kfd/ros1/odometry_buffer.h"
+#include "kfd/live/odometry_buffer.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 namespace {
 
 using kfd::Pose2D;
-using kfd::ros1::OdometryBuffer;
+using kfd::live::OdometryBuffer;
 
 TEST(OdometryBuffer, InterpolatesBetweenTheSamplesAroundTheStamp) {
     OdometryBuffer b;

@@ -1,4 +1,4 @@
-#include "kfd/ros1/live_filter.h"
+#include "kfd/live/live_filter.h"
 
 #include <boost/make_shared.hpp>
 
@@ -8,11 +8,25 @@
 #include "kfd/io/laser_scan.h"
 #include "kfd/mrpt/default_stages.h"
 
-namespace kfd::ros1 {
+namespace kfd::live {
 
 std::string frameLabel(const std::string& frame_id) {
     const auto b = frame_id.find_first_not_of('/');
     return b == std::string::npos ? std::string() : frame_id.substr(b);
+}
+
+std::vector<std::pair<std::string, double>> counterValues(const LiveCounters& c) {
+    const double dropped =
+        c.scans_in ? 100.0 * double(c.scans_in - c.scans_kept) / double(c.scans_in) : 0.0;
+    return {{"scans_in", double(c.scans_in)},
+            {"scans_kept", double(c.scans_kept)},
+            {"dropped_pct", dropped},
+            {"points_removed", double(c.points_removed)},
+            {"out_of_order", double(c.out_of_order)},
+            {"odom_missing", double(c.odom_missing)},
+            {"resets", double(c.resets)},
+            {"geometry_resets", double(c.geometry_resets)},
+            {"scans_skipped", double(c.scans_skipped)}};
 }
 
 LiveFilter::LiveFilter(const Params& p) : params_(p), door_(p.pipeline, {}, true) {}
@@ -90,4 +104,4 @@ LiveResult LiveFilter::process(sensor_msgs::LaserScan& m, double stamp,
     return r;
 }
 
-}  // namespace kfd::ros1
+}  // namespace kfd::live

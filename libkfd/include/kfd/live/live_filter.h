@@ -1,7 +1,8 @@
 // The live side of the one door: LaserScan messages as a robot or `rosbag play` delivers them,
 // each through kfd::StreamFilter::process, with the rules a live stream needs (time jumping
-// back, scans out of order, several lasers). No ROS communication: ScanFilterNode wires it to
-// topics; tests drive it with hand-made messages.
+// back, scans out of order, several lasers). No communication: the ROS 1 node
+// (kfd::ros1::ScanFilterNode) and the ROS 2 node (kfd::ros2::Ros2Node) wire it to their topics, so
+// both transports make the same decisions; tests drive it with hand-made messages.
 #pragma once
 
 #include <sensor_msgs/LaserScan.h>
@@ -11,13 +12,14 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "kfd/io/bag_writer.h"
 #include "kfd/mrpt/stream_filter.h"
 #include "kfd/pipeline/pipeline.h"
 
-namespace kfd::ros1 {
+namespace kfd::live {
 
 /// The node's counters (its ~stats and /diagnostics keys).
 struct LiveCounters {
@@ -113,7 +115,12 @@ class LiveFilter {
     LiveCounters counters_;
 };
 
+/// The counters as the nodes' diagnostics name them, in order: scans_in, scans_kept,
+/// dropped_pct (% of scans_in not kept), points_removed, out_of_order, odom_missing, resets,
+/// geometry_resets, scans_skipped.
+std::vector<std::pair<std::string, double>> counterValues(const LiveCounters& c);
+
 /// The sensor label of a frame_id: without its leading '/' (as the bag source labels a topic).
 std::string frameLabel(const std::string& frame_id);
 
-}  // namespace kfd::ros1
+}  // namespace kfd::live

@@ -1,7 +1,7 @@
-// kfd::ros1::LiveFilter: the live rules of the node (time jumping back, out-of-order scans,
+// kfd::live::LiveFilter: the live rules of the node (time jumping back, out-of-order scans,
 // several lasers, a geometry change, missing odometry) and the marking of removed beams. No ROS
 // master: hand-made LaserScan messages straight into the class.
-#include "kfd/ros1/live_filter.h"
+#include "kfd/live/live_filter.h"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +19,7 @@
 
 namespace {
 
-using kfd::ros1::LiveFilter;
+using kfd::live::LiveFilter;
 using kfd::test::roomScan;
 
 LiveFilter::Params defaults() {

@@ -1,11 +1,11 @@
-#include "kfd/ros1/odometry_buffer.h"
+#include "kfd/live/odometry_buffer.h"
 
 #include <cmath>
 
 #include "kfd/algorithms/pose.h"
 #include "kfd/io/source.h"
 
-namespace kfd::ros1 {
+namespace kfd::live {
 
 void OdometryBuffer::add(double stamp, const Pose2D& pose) {
     if (!std::isfinite(stamp) || !finitePose(pose.x, pose.y, pose.phi)) return;
@@ -35,4 +35,4 @@ std::optional<Pose2D> OdometryBuffer::at(double t) const {
                   wrapAngle(a.p.phi + w * wrapAngle(b.p.phi - a.p.phi))};
 }
 
-}  // namespace kfd::ros1
+}  // namespace kfd::live

@@ -9,7 +9,7 @@
 
 #include "kfd/pipeline/scan.h"
 
-namespace kfd::ros1 {
+namespace kfd::live {
 
 /// Bounded buffer of (stamp, pose) samples in arrival order.
 class OdometryBuffer {
@@ -48,4 +48,4 @@ class OdometryBuffer {
     std::deque<Sample> samples_;
 };
 
-}  // namespace kfd::ros1
+}  // namespace kfd::live

@@ -4,7 +4,7 @@
 #include <cstddef>
 #include <vector>
 
-namespace kfd::ros1 {
+namespace kfd::live {
 
 /// Percentiles over the last `window` samples, the maximum over all of them.
 class LatencyStats {
@@ -23,4 +23,4 @@ class LatencyStats {
     double max_ = 0.0;
 };
 
-}  // namespace kfd::ros1
+}  // namespace kfd::live

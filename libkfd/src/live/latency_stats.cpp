@@ -1,9 +1,9 @@
-#include "kfd/ros1/latency_stats.h"
+#include "kfd/live/latency_stats.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace kfd::ros1 {
+namespace kfd::live {
 
 void LatencyStats::add(double us) {
     if (ring_.size() < window_)
@@ -24,4 +24,4 @@ double LatencyStats::percentile(double p) const {
     return v[k];
 }
 
-}  // namespace kfd::ros1
+}  // namespace kfd::live
