@@ -96,6 +96,20 @@ struct CyclonePeer {
                          static_cast<uint32_t>(m.intensities.size()), m.intensities.data(), false};
         EXPECT_EQ(dds_write(writer, &s), DDS_RETCODE_OK);
     }
+    /// The USER_DATA of the writer the reader matched (kfd_ros2's scan_filtered), as text.
+    std::string matchedWriterUserData() const {
+        dds_instance_handle_t h[4];
+        if (dds_get_matched_publications(reader, h, 4) < 1) return "";
+        dds_builtintopic_endpoint_t* e = dds_get_matched_publication_data(reader, h[0]);
+        if (!e) return "";
+        void* v = nullptr;
+        std::size_t n = 0;
+        std::string text;
+        if (dds_qget_userdata(e->qos, &v, &n) && v) text.assign(static_cast<char*>(v), n);
+        dds_free(v);
+        dds_builtintopic_free_endpoint(e);
+        return text;
+    }
     // Everything the node has sent back so far, into `got` by stamp.
     void take(std::map<double, std::vector<float>>& got) {
         void* samples[32] = {nullptr};
@@ -131,6 +145,9 @@ TEST(Ros2Cyclone, CyclonePeerGetsWhatKfdFilterKeepsOffline) {
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
     ASSERT_TRUE(peer.matched()) << "Cyclone and kfd_ros2 never matched\n" << node.log();
     std::this_thread::sleep_for(std::chrono::seconds(1));  // the node's side of the discovery
+    // Jazzy reads the type hash from USER_DATA (and warns when it is missing).
+    EXPECT_EQ(peer.matchedWriterUserData(),
+              "typehash=RIHS01_64c191398013af96509d518dac71d5164f9382553fce5c1f8cca5be7924bd828;");
     std::map<double, std::vector<float>> got;
     rosbag::Bag bag(kBag);
     std::size_t sent = 0;

@@ -178,3 +178,29 @@ TEST(Ros2Node, TheLaserMountComesFromTfStaticAsOfflineAndOdometryFromTf) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Ros2Node, WithTheTrackStageEveryScanGetsATrackedPose) {
+    const Ros2Config c = config(Ros2Config::Odometry::None);  // kfd's defaults list `track`
+    ASSERT_TRUE(c.pipeline.lists("track"));
+    std::vector<nav_msgs::Odometry> poses;
+    Ros2Outputs o;
+    o.track = [&](const Bytes& b) {
+        nav_msgs::Odometry m;
+        kfd::decodeRos2(b.data(), b.size(), m);
+        poses.push_back(m);
+    };
+    Ros2Node node(c, o, [] { return 0.0; });
+    for (int i = 0; i < 10; ++i) {
+        const Bytes b = kfd::encodeRos2(roomScan(100.0 + 0.1 * i, "laser", 181, 0.02 * i));
+        node.onScan(b.data(), b.size());
+    }
+    ASSERT_EQ(poses.size(), 10u);
+    EXPECT_EQ(poses.back().header.frame_id, "odom");
+    EXPECT_EQ(poses.back().child_frame_id, "base_link");
+    // The robot moved 0.18 m along +x over the ten scans (laser only: the tracker found it).
+    EXPECT_NEAR(poses.back().pose.pose.position.x - poses.front().pose.pose.position.x, 0.18, 0.05);
+}
+
+}  // namespace
