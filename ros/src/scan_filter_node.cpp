@@ -13,18 +13,15 @@
 #include <thread>
 
 #include "kfd/algorithms/scan_tracker.h"
+#include "kfd/io/laser_scan.h"
 #include "kfd/stages/track_stage.h"
 
 namespace kfd::ros1 {
 
 namespace {
 
-double yawOf(const geometry_msgs::Quaternion& q) {
-    return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
-}
-
 Pose2D poseOf(const geometry_msgs::Transform& t) {
-    return Pose2D{t.translation.x, t.translation.y, yawOf(t.rotation)};
+    return Pose2D{t.translation.x, t.translation.y, quaternionYaw(t.rotation)};
 }
 
 diagnostic_msgs::KeyValue kv(const std::string& k, double v) {
@@ -119,7 +116,7 @@ LiveCounters ScanFilterNode::counters() const {
 void ScanFilterNode::onOdometry(const nav_msgs::Odometry::ConstPtr& m) {
     const double t = m->header.stamp.isZero() ? ros::Time::now().toSec() : m->header.stamp.toSec();
     const Pose2D p{m->pose.pose.position.x, m->pose.pose.position.y,
-                   yawOf(m->pose.pose.orientation)};
+                   quaternionYaw(m->pose.pose.orientation)};
     {
         std::lock_guard<std::mutex> lock(odom_mutex_);
         // Time jumped back (a bag looping): the older samples belong to another stream.

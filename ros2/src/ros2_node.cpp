@@ -6,6 +6,7 @@
 
 #include "kfd/algorithms/pose.h"
 #include "kfd/algorithms/scan_tracker.h"
+#include "kfd/io/laser_scan.h"
 #include "kfd/io/ros2_message.h"
 #include "kfd/pipeline/error.h"
 #include "kfd/stages/track_stage.h"
@@ -14,17 +15,6 @@ namespace kfd::ros2 {
 
 namespace {
 
-double yawOf(const geometry_msgs::Quaternion& q) {
-    return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
-}
-
-double seconds(const ros::Time& t) { return double(t.sec) + 1e-9 * double(t.nsec); }
-
-std::string strip(const std::string& frame) {
-    const auto b = frame.find_first_not_of('/');
-    return b == std::string::npos ? std::string() : frame.substr(b);
-}
-
 diagnostic_msgs::KeyValue kv(const std::string& k, double v) {
     diagnostic_msgs::KeyValue r;
     r.key = k;
@@ -32,13 +22,6 @@ diagnostic_msgs::KeyValue kv(const std::string& k, double v) {
     std::snprintf(buf, sizeof(buf), "%.10g", v);
     r.value = buf;
     return r;
-}
-
-ros::Time stampOf(double s) {
-    ros::Time t;
-    t.sec = static_cast<std::uint32_t>(std::floor(s));
-    t.nsec = static_cast<std::uint32_t>(std::lround((s - std::floor(s)) * 1e9) % 1000000000);
-    return t;
 }
 
 }  // namespace
@@ -72,7 +55,7 @@ bool Ros2Node::decoded(const std::uint8_t* data, std::size_t size, Message& m) {
 void Ros2Node::onScan(const std::uint8_t* data, std::size_t size) {
     Waiting w;
     if (!decoded(data, size, w.m)) return;
-    w.stamp = seconds(w.m.header.stamp);
+    w.stamp = w.m.header.stamp.toSec();
     if (w.stamp == 0.0)  // a driver without a clock: the receive time, as the ROS 1 node does
         w.stamp = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
                       .count();
@@ -95,7 +78,8 @@ void Ros2Node::onOdometry(const std::uint8_t* data, std::size_t size) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (config_.odometry != Ros2Config::Odometry::Topic) return;
     const auto& p = m.pose.pose;
-    addOdometry(seconds(m.header.stamp), Pose2D{p.position.x, p.position.y, yawOf(p.orientation)});
+    addOdometry(m.header.stamp.toSec(),
+                Pose2D{p.position.x, p.position.y, quaternionYaw(p.orientation)});
     drain(false);
 }
 
@@ -105,14 +89,15 @@ void Ros2Node::onTf(const std::uint8_t* data, std::size_t size, bool is_static) 
     std::lock_guard<std::mutex> lock(mutex_);
     for (const auto& t : m.transforms) {
         const auto& tr = t.transform;
-        const Pose2D p{tr.translation.x, tr.translation.y, yawOf(tr.rotation)};
+        const Pose2D p{tr.translation.x, tr.translation.y, quaternionYaw(tr.rotation)};
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.phi)) continue;
-        const std::string parent = strip(t.header.frame_id), child = strip(t.child_frame_id);
+        const std::string parent = live::frameLabel(t.header.frame_id),
+                          child = live::frameLabel(t.child_frame_id);
         if (is_static)
             static_tf_[child] = Edge{parent, p};
         else if (config_.odometry == Ros2Config::Odometry::Tf && parent == config_.odom_frame &&
                  child == config_.base_frame)
-            addOdometry(seconds(t.header.stamp), p);
+            addOdometry(t.header.stamp.toSec(), p);
     }
     if (!is_static) drain(false);
 }
@@ -120,7 +105,7 @@ void Ros2Node::onTf(const std::uint8_t* data, std::size_t size, bool is_static) 
 Pose2D Ros2Node::mountOf(const std::string& frame) const {
     // The chain base_frame -> ... -> laser in tf_static, as the bag source composes it.
     Pose2D mount{0.0, 0.0, 0.0};
-    std::string f = strip(frame);
+    std::string f = live::frameLabel(frame);
     for (std::size_t hops = 0; hops < 64 && f != config_.base_frame; ++hops) {
         const auto it = static_tf_.find(f);
         if (it == static_tf_.end()) return Pose2D{0.0, 0.0, 0.0};  // identity until it comes
@@ -187,7 +172,7 @@ void Ros2Node::filterOne(Waiting& w) {
     const TrackResult* t = r.stream.report.find<TrackResult>();
     if (t && out_.track && !config_.track_topic.empty()) {
         nav_msgs::Odometry m;
-        m.header.stamp = stampOf(w.stamp);
+        m.header.stamp = ros::Time().fromSec(w.stamp);
         m.header.frame_id = config_.odom_frame;
         m.child_frame_id = config_.base_frame;
         m.pose.pose.position.x = t->pose.x;
@@ -227,7 +212,7 @@ Bytes Ros2Node::publishDiagnostics(double stamp_s) {
           {"work_max_us", work_.max()}})
         s.values.push_back(kv(key, value));
     diagnostic_msgs::DiagnosticArray a;
-    a.header.stamp = stampOf(stamp_s);
+    a.header.stamp = ros::Time().fromSec(stamp_s);
     a.status.push_back(s);
     Bytes b = encodeRos2(a);
     if (out_.diagnostics) out_.diagnostics(b);

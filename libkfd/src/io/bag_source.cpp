@@ -56,15 +56,6 @@ std::uint64_t logSize(const std::string& path) {
     return n;
 }
 
-std::string stripSlash(const std::string& s) {
-    const auto b = s.find_first_not_of('/');
-    return b == std::string::npos ? std::string() : s.substr(b);
-}
-
-double yawOf(const geometry_msgs::Quaternion& q) {
-    return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
-}
-
 std::string listOf(const std::map<std::string, TopicInfo>& topics, const char* type) {
     std::string s;
     for (const auto& [name, info] : topics)
@@ -147,8 +138,8 @@ std::string baseFrameFromTf(MessageStore& bag, const std::string& tf_topic,
         if (++n > kTfProbe) break;
         if (const auto tf = instantiate<tf2_msgs::TFMessage>(m))
             for (const auto& t : tf->transforms)
-                if (stripSlash(t.header.frame_id) == odom_frame)
-                    return stripSlash(t.child_frame_id);
+                if (frameWithoutSlash(t.header.frame_id) == odom_frame)
+                    return frameWithoutSlash(t.child_frame_id);
     }
     return {};
 }
@@ -181,7 +172,7 @@ std::string badTransform(const geometry_msgs::Transform& t) {
 
 void chooseMount(MessageStore& bag, const std::map<std::string, TopicInfo>& topics, BagChoice& c) {
     if (const auto s = firstMessage<sensor_msgs::LaserScan>(bag, c.scan_topic))
-        c.laser_frame = stripSlash(s->header.frame_id);
+        c.laser_frame = frameWithoutSlash(s->header.frame_id);
     std::map<std::string, Edge> edges;  // child -> parent
     for (const char* topic : {"/tf_static", "tf_static"}) {
         const auto it = topics.find(topic);
@@ -190,10 +181,10 @@ void chooseMount(MessageStore& bag, const std::map<std::string, TopicInfo>& topi
         for (NativeMessage m; v->next(m);)
             if (const auto tf = instantiate<tf2_msgs::TFMessage>(m))
                 for (const auto& t : tf->transforms)
-                    edges[stripSlash(t.child_frame_id)] =
-                        Edge{stripSlash(t.header.frame_id),
+                    edges[frameWithoutSlash(t.child_frame_id)] =
+                        Edge{frameWithoutSlash(t.header.frame_id),
                              Pose2D{t.transform.translation.x, t.transform.translation.y,
-                                    yawOf(t.transform.rotation)},
+                                    quaternionYaw(t.transform.rotation)},
                              badTransform(t.transform)};
     }
     Pose2D mount{0.0, 0.0, 0.0};
@@ -234,7 +225,7 @@ BagChoice choose(MessageStore& bag, const std::map<std::string, TopicInfo>& topi
     BagChoice c;
     c.scan_topic = pickTopic(topics, o.scan_topic, kLaserScan, {"/scan", "scan"}, "scans",
                              "--scan-topic", c.notes, true);
-    c.odom_frame = o.odom_frame.empty() ? "odom" : stripSlash(o.odom_frame);
+    c.odom_frame = o.odom_frame.empty() ? "odom" : frameWithoutSlash(o.odom_frame);
     std::string tf_topic;
     for (const char* t : {"/tf", "tf"})
         if (topics.count(t) && isType(topics.at(t).type, kTfMessage)) tf_topic = t;
@@ -260,13 +251,13 @@ BagChoice choose(MessageStore& bag, const std::map<std::string, TopicInfo>& topi
         }
     }
     if (c.odometry == BagChoice::Odometry::Topic) {
-        c.base_frame = stripSlash(o.base_frame);
+        c.base_frame = frameWithoutSlash(o.base_frame);
         if (c.base_frame.empty())
             if (const auto od = firstMessage<nav_msgs::Odometry>(bag, c.odom_topic))
-                c.base_frame = stripSlash(od->child_frame_id);
+                c.base_frame = frameWithoutSlash(od->child_frame_id);
     } else if (c.odometry == BagChoice::Odometry::Tf) {
         c.odom_topic = tf_topic;
-        c.base_frame = stripSlash(o.base_frame);
+        c.base_frame = frameWithoutSlash(o.base_frame);
         if (c.base_frame.empty())
             c.base_frame =
                 !tf_child.empty() ? tf_child : baseFrameFromTf(bag, tf_topic, c.odom_frame);
@@ -321,7 +312,7 @@ struct BagSource::Impl {
         try {
             topics = store->topics();
             choice = choose(*store, topics, o);
-            label = stripSlash(choice.scan_topic);
+            label = frameWithoutSlash(choice.scan_topic);
             cursor = store->cursor({}, true);
             total_messages = cursor->size();
         } catch (const BagFileError&) {
@@ -434,15 +425,15 @@ struct BagSource::Impl {
                 if (const auto od = instantiateChecked<nav_msgs::Odometry>(m))
                     onSample(stampOf(od->header, item.record),
                              Pose2D{od->pose.pose.position.x, od->pose.pose.position.y,
-                                    yawOf(od->pose.pose.orientation)});
+                                    quaternionYaw(od->pose.pose.orientation)});
             } else if (choice.odometry == BagChoice::Odometry::Tf && topic == choice.odom_topic) {
                 if (const auto tf = instantiateChecked<tf2_msgs::TFMessage>(m))
                     for (const auto& t : tf->transforms)
-                        if (stripSlash(t.header.frame_id) == choice.odom_frame &&
-                            stripSlash(t.child_frame_id) == choice.base_frame)
+                        if (frameWithoutSlash(t.header.frame_id) == choice.odom_frame &&
+                            frameWithoutSlash(t.child_frame_id) == choice.base_frame)
                             onSample(stampOf(t.header, item.record),
                                      Pose2D{t.transform.translation.x, t.transform.translation.y,
-                                            yawOf(t.transform.rotation)});
+                                            quaternionYaw(t.transform.rotation)});
             }
             queued_bytes += native->bytes.size();
             queue.push_back(std::move(item));

@@ -8,6 +8,15 @@
 
 namespace kfd {
 
+std::string frameWithoutSlash(const std::string& frame_id) {
+    const auto b = frame_id.find_first_not_of('/');
+    return b == std::string::npos ? std::string() : frame_id.substr(b);
+}
+
+double quaternionYaw(const geometry_msgs::Quaternion& q) {
+    return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
+}
+
 bool validRange(const sensor_msgs::LaserScan& m, float r) {
     return std::isfinite(r) && r >= m.range_min && r < m.range_max;
 }

@@ -10,10 +10,7 @@
 
 namespace kfd::live {
 
-std::string frameLabel(const std::string& frame_id) {
-    const auto b = frame_id.find_first_not_of('/');
-    return b == std::string::npos ? std::string() : frame_id.substr(b);
-}
+std::string frameLabel(const std::string& frame_id) { return frameWithoutSlash(frame_id); }
 
 std::vector<std::pair<std::string, double>> counterValues(const LiveCounters& c) {
     const double dropped =

@@ -4,6 +4,7 @@
 // built with them: cmake/FindKfdRos1.cmake).
 #pragma once
 
+#include <geometry_msgs/Quaternion.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <sensor_msgs/LaserScan.h>
 
@@ -29,6 +30,13 @@ bool laserAnglesMatch(const sensor_msgs::LaserScan& m);
 /// (0 to 2 pi in 360 beams). Such angles match the beam count too, and the beams' span is n - 1
 /// increments.
 bool fullTurnSpan(const sensor_msgs::LaserScan& m);
+
+/// A tf frame's name without its leading '/'s ("/base_link" and "base_link" are one frame).
+std::string frameWithoutSlash(const std::string& frame_id);
+
+/// The yaw (rad) of a rotation given as a quaternion: how the bag source and both nodes read
+/// odometry and transforms, so that they agree.
+double quaternionYaw(const geometry_msgs::Quaternion& q);
 
 /// The MRPT scan of `m` stamped `stamp` (s), labelled `label`, its laser mounted at `mount`
 /// (the laser frame in the robot's base frame). Angle fields that do not match the beam count
