@@ -3,10 +3,12 @@
 # (or IN.rawlog) runs kfd-filter (its summary; the filtered rawlog opens in RawLogViewer) and
 # kfd-icp-slam with the kfd pre-filter, which writes report.md, map_figure.png and
 # summary.json; and renders one scan's clusters (kfd-render, when OSMesa is available).
-# Usage: bash scripts/demo.sh [IN.rawlog [FILTER_CONFIG [SLAM_CONFIG]]]
-#   defaults: rawlogs/office-mit-0.752.rawlog, share/kfd/kfd-40hz.ini,
-#   share/kfd-icp-slam/lidar-40hz.ini (for a 5 Hz log: share/kfd/default.ini and
-#   share/kfd-icp-slam/sick-180-5hz.ini). IN.gt.tum beside the log, when present, gives the ATE.
+# Usage: bash scripts/demo.sh [LOG [FILTER_CONFIG [SLAM_CONFIG]]]
+#   LOG: a rawlog, ROS 1 or ROS 2 bag or CARMEN log (default rawlogs/office-mit-0.752.rawlog);
+#   FILTER_CONFIG: default share/kfd/default.ini (one preset for every rate); SLAM_CONFIG:
+#   picked by the log's scan rate (kfd-filter --list), said on stderr: 20 Hz or more
+#   share/kfd-icp-slam/lidar-40hz.ini, else share/kfd-icp-slam/sick-180-5hz.ini.
+#   LOG's stem.gt.tum beside it, when present, gives the ATE.
 # Every file the last line names is checked; a missing one is an error (exit 1).
 # KFD_DEMO_APPS=DIR: the apps already built in DIR (the test suite's check on a clean copy of
 # the tree, test/scripts/demo_test.sh): no install, no build.
@@ -30,16 +32,29 @@ else
   cmake --build "$root/build" -j"$(nproc)" --target "${targets[@]}"
 fi
 in="${1:-$root/rawlogs/office-mit-0.752.rawlog}"
-cfg="${2:-$root/share/kfd/kfd-40hz.ini}"
-slam_cfg="${3:-$root/share/kfd-icp-slam/lidar-40hz.ini}"
-name="$(basename "$in" .rawlog)"
+cfg="${2:-$root/share/kfd/default.ini}"
+base="$(basename "$in")"
+name="${base%.gz}"
+name="${name%.*}"  # office-mit-0.752.rawlog -> office-mit-0.752; a rosbag2 folder keeps its name
+if [ -n "${3:-}" ]; then
+  slam_cfg="$3"
+else  # by the scan stream's rate, as kfd-filter --list gives it ("(15.0 s, 40.0 Hz)")
+  rate="$("$apps/kfd-filter" --list -i "$in" |
+    awk '/2D scan|LaserScan/ && !seen { for (i = 2; i <= NF; i++) if ($i == "Hz)") { print $(i-1); seen = 1 } }')"
+  slam_cfg="$root/share/kfd-icp-slam/sick-180-5hz.ini"
+  if awk -v r="${rate:-0}" 'BEGIN { exit !(r >= 20) }'; then
+    slam_cfg="$root/share/kfd-icp-slam/lidar-40hz.ini"
+  fi
+  echo "[kfd] $base: scans at ${rate:-an unknown rate} Hz: kfd-filter -c ${cfg#"$root"/}," \
+    "kfd-icp-slam ${slam_cfg#"$root"/} (give configs as arguments to choose)" >&2
+fi
 out="$root/out"
 mkdir -p "$out"
 start=$(date +%s)
 "$apps/kfd-filter" -q -c "$cfg" -i "$in" -o "$out/$name.kfd.rawlog" \
   --stats "$out/$name.kfd.csv"
 gt=()
-[ -f "${in%.rawlog}.gt.tum" ] && gt=(--gt "${in%.rawlog}.gt.tum")
+[ -f "$(dirname "$in")/$name.gt.tum" ] && gt=(--gt "$(dirname "$in")/$name.gt.tum")
 "$apps/kfd-icp-slam" -q "$slam_cfg" "$in" -o "$out/$name-slam" -m kfd "${gt[@]}"
 made=("$name.kfd.rawlog" "$name.kfd.csv" "$name-slam/report.md" "$name-slam/map_figure.png"
   "$name-slam/summary.json" "$name-slam/trajectory.tum")

@@ -47,9 +47,13 @@ inline void printListing(const std::string& path, const kfd::SourceOptions& o) {
     for (const auto& s : l.streams) {
         std::printf("  %-*s %-24s %8zu", static_cast<int>(w), s.name.c_str(), s.type.c_str(),
                     s.count);
-        if (s.last_stamp > 0.0)
-            std::printf("  %.3f .. %.3f s (%.1f s)", s.first_stamp, s.last_stamp,
-                        s.last_stamp - s.first_stamp);
+        if (s.last_stamp > 0.0) {
+            const double span = s.last_stamp - s.first_stamp;
+            std::printf("  %.3f .. %.3f s (%.1f s", s.first_stamp, s.last_stamp, span);
+            if (span > 0.0 && s.count > 1)  // messages per second over the span
+                std::printf(", %.1f Hz", static_cast<double>(s.count - 1) / span);
+            std::printf(")");
+        }
         std::printf("\n");
     }
     for (const auto& c : l.choices) std::printf("  %s\n", c.c_str());

@@ -65,14 +65,21 @@ void printScansAndPoints(const kfd::RawlogFilterSummary& s) {
     const double removed = static_cast<double>(s.points_removed_noise);
     std::printf("  scans    in %zu, kept %zu, dropped %zu (%.1f %%)\n", s.scans_in, s.scans_kept,
                 s.scans_dropped, s.droppedPercent());
-    std::printf("  points   in %zu; in kept scans removed: %zu out of range, %zu noise (%.2f %%)\n",
-                s.points_in, s.points_removed - s.points_removed_noise, s.points_removed_noise,
-                s.points_in ? 100.0 * removed / static_cast<double>(s.points_in) : 0.0);
+    std::printf(
+        "  points   in %zu; in kept scans removed: %zu not noise (range limits and filter stages, "
+        "below), %zu noise (%.2f %%)\n",
+        s.points_in, s.points_removed - s.points_removed_noise, s.points_removed_noise,
+        s.points_in ? 100.0 * removed / static_cast<double>(s.points_in) : 0.0);
     if (s.points_removed_noise)
         std::printf("  denoise  at most %.2f %% of a kept scan's returns removed\n",
                     100.0 * s.max_removed_noise_share);
     for (const std::string& line : kfd::stageCounterLines(s.stage_totals))
         std::printf("  %s\n", line.c_str());
+}
+
+// Why scans were kept or dropped, and the kept scans the denoisers cut most.
+void printReasons(const kfd::RawlogFilterSummary& s) {
+    for (const std::string& line : kfd::reasonLines(s)) std::printf("  %s\n", line.c_str());
 }
 
 // The line on the output's objects (CARMEN lines, bag messages or MRPT objects).
@@ -148,6 +155,7 @@ void printRepairs(const kfd::RawlogFilterSummary& s) {
 void printSummary(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSummary& s) {
     printInputAndSensor(o, s);
     printScansAndPoints(s);
+    printReasons(s);
     printObjects(o, s);
     printRepairs(s);
     std::printf("  time     wall %.2f s, filter %.3f s (%.1f us per scan)\n", s.wall_seconds,

@@ -4,10 +4,12 @@
 
 #include <cmath>
 #include <cstdio>
-#include <deque>
+#include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "common/cli.h"
 #include "common/config_cli.h"
@@ -27,20 +29,12 @@
 
 namespace {
 
-// The denoising stage the configuration's pipeline runs (selected by `variant`), kfd's
-// evidence_denoise when it lists none.
-std::string denoisingStage(const kfd::Pipeline::Params& p) {
-    const auto* listed = kfd::defaultStageRegistry().choice("variant")->listedIn(p.stages);
-    return listed ? listed->stage : "evidence_denoise";
-}
-
 struct Options {
     std::string in, out, cfg;
     long index = -1;
     double stamp = std::nan("");
     double extent = 0.0;
     int size = 800;
-    long history = 2;
     kfd::SourceOptions source;
     bool laser_only = false;
     bool list = false;
@@ -52,10 +46,6 @@ void addOptions(kfd::app::Cli& cli, Options& o) {
         ->required();
     cli.option("--index", o.index, "the N-th 2D scan (0-based)")->type_name("N");
     cli.option("--time", o.stamp, "the scan nearest to timestamp T (s)")->type_name("T");
-    cli.option("--history", o.history, "scans before it that the denoiser sees first")
-        ->type_name("K")
-        ->check(kfd::app::inRange(0, 100))
-        ->capture_default_str();
     cli.option("-c", o.cfg, "configuration (.ini [KFD] or .yaml); default: kfd's defaults")
         ->type_name("FILE");
     cli.option("-o", o.out, "output PNG")->type_name("FILE");
@@ -69,107 +59,141 @@ void addOptions(kfd::app::Cli& cli, Options& o) {
         ->type_name("M");
 }
 
-// A 2D scan of the log with its odometry and its 0-based number among the log's 2D scans.
-struct Seen {
-    mrpt::obs::CObservation2DRangeScan::Ptr scan;
-    std::optional<kfd::Pose2D> odometry;
-    long number = 0;
-};
-
-// The chosen scan and the `history` scans before it (the evidence denoiser's previous
-// keyframes), and the scan just after it (next_scan).
-struct Chosen {
-    std::deque<Seen> scans;  // the chosen one last
-    std::optional<Seen> after;
-};
-
-Chosen chooseScans(const Options& o) {
+// The number (0-based, among the log's 2D scans) of the scan --index or --time names: with
+// --time a first pass over the log finds the nearest stamp.
+long chosenNumber(const Options& o) {
     const auto source = kfd::openSource(o.in, o.source);
-    std::deque<Seen> recent;
-    Chosen c;
-    bool want_after = false;
-    double best = 1e300;
-    long n = 0;
     kfd::SourceEntry entry;
-    while (!(o.index >= 0 && !c.scans.empty() && !want_after) && source->next(entry)) {
+    long n = 0, best_n = -1;
+    double best = 1e300;
+    while ((o.index < 0 || n <= o.index) && source->next(entry)) {
         kfd::throwIfCancelled();
         entry.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
-            if (want_after) {
-                c.after = Seen{s, entry.odometry, n};
-                want_after = false;
-            }
-            recent.push_back({s, entry.odometry, n});
-            if (recent.size() > static_cast<std::size_t>(o.history) + 1) recent.pop_front();
             const double d = std::abs(kfd::stampOf(*s) - o.stamp);
             if ((o.index >= 0 && n == o.index) || (o.index < 0 && d < best)) {
                 best = d;
-                c.scans = recent;
-                c.after.reset();
-                want_after = true;
+                best_n = n;
             }
             ++n;
         });
     }
     if (n == 0) throw std::runtime_error("no laser scan in " + o.in);
-    if (c.scans.empty())
+    if (best_n < 0)
         throw std::runtime_error("no scan " + std::to_string(o.index) + " in " + o.in +
                                  ": it holds " + std::to_string(n) +
                                  " 2D scans (--index counts from 0)");
+    return best_n;
+}
+
+// The chosen scan as kfd-filter decided it.
+struct Decided {
+    mrpt::obs::CObservation2DRangeScan::Ptr scan;  // as the door left it
+    kfd::Scan before;                              // as it came in
+    kfd::StreamResult result;
+    long number = 0;
+};
+
+// The log from its first scan through the door with the configuration's whole pipeline, as
+// kfd-filter runs it, up to the chosen scan; with next_scan also the scan after it, which
+// finishes the chosen keyframe (the door then holds the later one, so its last clusters are
+// the chosen's). The chosen scan must be usable.
+Decided decide(const Options& o, long number, kfd::StreamFilter& door) {
+    const auto source = kfd::openSource(o.in, o.source);
+    kfd::SourceEntry entry;
+    Decided d;
+    d.number = number;
+    std::optional<kfd::StreamResult> finished;
+    // The scans the door holds (next_scan) stay alive until it hands them back finished: the
+    // source reuses its entry.
+    std::map<const void*, mrpt::obs::CObservation2DRangeScan::Ptr> held;
+    std::vector<const void*> done;
+    const auto keep = [&](kfd::StreamResult& f) {
+        if (d.scan && f.scan == d.scan.get()) finished = f;
+        done.push_back(f.scan);
+    };
+    long n = 0;
+    while (!finished && source->next(entry)) {
+        kfd::throwIfCancelled();
+        entry.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
+            if (finished) return;
+            if (n == number) {
+                d.scan = s;
+                kfd::toCore(*s, d.before);
+            }
+            held[s.get()] = s;
+            door.process(*s, entry.odometry, keep);
+            for (const void* p : done) held.erase(p);
+            done.clear();
+            ++n;
+        });
+    }
+    if (!finished) door.finish();
+    d.result = *finished;
+    if (d.result.skipped != kfd::ScanSkipReason::None) {
+        char t[64];
+        std::snprintf(t, sizeof(t), "%.6f", kfd::stampOf(*d.scan));
+        throw std::runtime_error("scan " + std::to_string(number) + " of " + o.in + " (t = " + t +
+                                 " s) cannot be drawn: it has " + kfd::describe(d.result.skipped) +
+                                 " (" + kfd::toString(d.result.skipped) + ")");
+    }
+    return d;
+}
+
+// What is drawn of a dropped scan: its valid returns as one cluster (the denoiser never ran).
+kfd::Clusters oneCluster(const kfd::Scan& scan) {
+    kfd::Clusters c;
+    c.label.assign(scan.size(), -1);
+    for (std::size_t i = 0; i < scan.size(); ++i)
+        if (scan.valid[i]) c.label[i] = 0;
+    c.size = {static_cast<std::uint32_t>(scan.countValid())};
+    c.mean_range = {0.0f};
+    c.noise = {0};
     return c;
 }
 
-// Through the one door, as every tool: the distance filter and the denoiser, every scan kept
-// (no keyframe stage), so the history scans are the denoiser's previous ones. The chosen
-// scan's result once the door finished it; with next_scan that takes the scan after it (the
-// log's last one without it), which the door then holds, so the door's last clusters are the
-// chosen's. A history scan the door skips is no previous keyframe; the chosen one must be
-// usable.
-kfd::StreamResult denoise(const Options& o, const Chosen& c, kfd::StreamFilter& door) {
-    const auto* drawn_scan = c.scans.back().scan.get();
-    std::optional<kfd::StreamResult> finished;
-    const auto keep = [&](kfd::StreamResult& f) {
-        if (f.scan == drawn_scan) finished = f;
-    };
-    for (const Seen& seen : c.scans) door.process(*seen.scan, seen.odometry, keep);
-    if (!finished && c.after) door.process(*c.after->scan, c.after->odometry, keep);
-    if (!finished) door.finish();
-    if (finished->skipped != kfd::ScanSkipReason::None) {
-        char t[64];
-        std::snprintf(t, sizeof(t), "%.6f", kfd::stampOf(*c.scans.back().scan));
-        throw std::runtime_error("scan " + std::to_string(c.scans.back().number) + " of " + o.in +
-                                 " (t = " + t + " s) cannot be drawn: it has " +
-                                 kfd::describe(finished->skipped) + " (" +
-                                 kfd::toString(finished->skipped) + ")");
-    }
-    return *finished;
+// "fr079.rawlog, scan 1200 (t = 1234.5 s): KEPT (view_change), 342 returns, 3 removed as noise
+// (0.88 %)": what kfd-filter's per-scan CSV says of the scan.
+std::string title(const Options& o, const Decided& d) {
+    const kfd::ScanRecord& r = d.result.record;
+    const std::string name = std::filesystem::path(o.in).filename().string();
+    return kfd::format(
+        "%s, scan %ld (t = %.3f s): %s (%s), %zu returns, %zu removed as noise "
+        "(%.2f %%)",
+        name.c_str(), d.number, kfd::stampOf(*d.scan), r.kept ? "KEPT" : "DROPPED", r.reason,
+        r.points_in, r.removed_noise,
+        r.points_in ? 100.0 * double(r.removed_noise) / double(r.points_in) : 0.0);
 }
 
-// Draws every clustered point of the scan (the denoiser's input; noise in red) and writes the
-// PNG under a temporary name, renamed when complete.
-void draw(const Options& o, const kfd::Pipeline::Params& p, const Chosen& c,
-          const kfd::StreamResult& r, const kfd::StreamFilter& door) {
-    const auto& last = *c.scans.back().scan;
-    const kfd::Clusters* clusters = door.lastClusters(last.sensorLabel);
-    if (!clusters) throw std::runtime_error("no clusters for the scan");
+// Draws the scan as it entered the denoiser (every clustered point; noise in red), or a dropped
+// scan's returns, and writes the PNG under a temporary name, renamed when complete.
+void draw(const Options& o, const kfd::Pipeline::Params& p, const Decided& d,
+          const kfd::StreamFilter& door) {
     kfd::Scan scan;
-    kfd::toCore(last, scan);
+    kfd::toCore(*d.scan, scan);
+    kfd::Clusters dropped;
+    const kfd::Clusters* clusters =
+        d.result.record.kept ? door.lastClusters(d.scan->sensorLabel) : nullptr;
+    if (!clusters) {  // dropped, or a pipeline without a denoiser: the returns as they came
+        scan = d.before;
+        dropped = oneCluster(scan);
+        clusters = &dropped;
+    }
     for (std::size_t i = 0; i < scan.size() && i < clusters->label.size(); ++i)
         if (clusters->label[i] >= 0) scan.valid[i] = 1;
-    const auto den = r.report.findOrDefault<kfd::DenoiseResult>();
+    const auto den = d.result.report.findOrDefault<kfd::DenoiseResult>();
     kfd::ClusterFigureOptions fo;
     fo.width = fo.height = o.size;
     fo.half_extent_m = o.extent;
     fo.ring_r_max = den.variant == kfd::DenoiseVariant::Reference ? den.r_max : 0.0;
     fo.rings = p.get<kfd::DenoiseStage>().clustering.rings.rings;
+    fo.title = title(o, d);
     kfd::ClusterFigure fig(fo);
     auto img = fig.render(scan, *clusters);
     kfd::TempOutputFile tmp(o.out);
     kfd::writePng(img, tmp.path(), o.out);  // every write checked (WriteError)
     kfd::throwIfCancelled();                // interrupted while drawing: nothing is moved
     tmp.commit();
-    std::printf("kfd-render: scan at %.6f, %s, %s -> %s\n", kfd::stampOf(last),
-                kfd::plural(den.clusters, "cluster").c_str(),
-                kfd::plural(den.points_removed, "noise point").c_str(), o.out.c_str());
+    std::printf("kfd-render: %s -> %s\n", fo.title.c_str(), o.out.c_str());
 }
 
 }  // namespace
@@ -177,12 +201,11 @@ void draw(const Options& o, const kfd::Pipeline::Params& p, const Chosen& c,
 int main(int argc, char** argv) {
     kfd::app::Cli cli(
         "kfd-render", "-i IN.{rawlog,bag,db3,mcap,clf} (--index N | --time T) -o OUT.png [options]",
-        "Runs the distance filter and the denoiser of CONFIG on one scan and draws its clusters\n"
-        "(each in its own colour), the removed noise points (red), the ring boundaries, the "
-        "sensor\n"
-        "and a 1 m grid and scale bar, top-down with +x right and +y up. No display needed.\n"
-        "The scans just before it go through the denoiser first (--history), as the previous\n"
-        "keyframes the evidence variant compares with.");
+        "Runs the log up to one scan through CONFIG's pipeline exactly as kfd-filter does and\n"
+        "draws that scan: its clusters (each in its own colour), the removed noise points (red),\n"
+        "the ring boundaries, the sensor and a 1 m grid and scale bar, top-down with +x right\n"
+        "and +y up, titled with kfd-filter's row for it (kept or dropped, why, returns,\n"
+        "removed). A dropped scan is drawn as it came in. No display needed.");
     Options o;
     addOptions(cli, o);
     cli.cancelOnSignal();  // outputs: stop cleanly on SIGINT/SIGTERM/SIGHUP
@@ -194,12 +217,10 @@ int main(int argc, char** argv) {
         kfd::app::checkOutputPaths({{"input log", o.in}, {"configuration", o.cfg}},
                                    {{"output image", o.out}});
         const kfd::Pipeline::Params p = kfd::app::loadConfig(o.cfg, "kfd-render");
-        const Chosen c = chooseScans(o);
-        kfd::Pipeline::Params drawn = p;
-        drawn.stages = {"distance", denoisingStage(p)};
-        kfd::StreamFilter door(drawn, {}, true);
+        const long number = chosenNumber(o);
+        kfd::StreamFilter door(p, {}, true);
         door.setLaserOnly(o.laser_only);
-        const kfd::StreamResult r = denoise(o, c, door);
-        draw(o, p, c, r, door);
+        const Decided d = decide(o, number, door);
+        draw(o, p, d, door);
     });
 }

@@ -297,6 +297,58 @@ def run_job(a):
     return run
 
 
+def what_is_judged(log, modes, baseline):
+    """One line per log, said before the runs: what its verdict rests on."""
+    if log["kind"] == "sim":
+        return "%s: simulated, ground-truth trajectory: judged on ATE" % log["name"]
+    if log.get("relations"):
+        return "%s: relations %s: judged on the local and long relations error" % (
+            log["name"], os.path.basename(log["relations"]))
+    if log.get("gt"):
+        return "%s: ground-truth trajectory %s: judged on ATE" % (
+            log["name"], os.path.basename(log["gt"]))
+    if baseline not in modes:
+        return ("%s: no ground truth and no %s runs: no verdict on accuracy (add mode %s), "
+                "only CPU, drop rate, ICP rejections and lost tracks" % (
+                    log["name"], baseline, baseline))
+    return ("%s: no ground truth (no .relations or .gt.tum beside it): accuracy is judged "
+            "against %s's own spread between repeats (trajectory ATE and drift per metre), "
+            "with ICP rejections, lost tracks and the CPU ratio; nothing says which is closer to "
+            "the truth" % (log["name"], baseline))
+
+
+def icp_configs(a):
+    """The configs of a run: --configs, or with --icp both each one and its twin with the other
+    ICP schedule (X.ini and X-every-scan.ini, e.g. sick-180-5hz.ini: ICP after 0.2 m / 5 deg of
+    odometry; sick-180-5hz-every-scan.ini: ICP on every scan)."""
+    if a.icp == "given":
+        return a.configs
+    out = []
+    for c in a.configs:
+        gated = c[:-len("-every-scan.ini")] + ".ini" if c.endswith("-every-scan.ini") else c
+        every = gated[:-len(".ini")] + "-every-scan.ini"
+        wanted = {"both": [gated, every], "every-scan": [every], "gated": [gated]}[a.icp]
+        for w in wanted:
+            if not os.path.isfile(w):
+                raise CompareError("--icp %s: no %s beside %s" % (a.icp, w, c))
+            if w not in out:
+                out.append(w)
+    return out
+
+
+def say_what_is_judged(a):
+    """Before any run: per log what its verdict rests on; per config its ICP schedule."""
+    if a.quiet:
+        return
+    for log in a.logs:
+        print("[kfd-compare] " + what_is_judged(resolve_log(log, a.datasets), a.modes,
+                                                a.baseline), file=sys.stderr)
+    for c in a.configs:
+        print("[kfd-compare] %s: %s (CPU ratios hold for this ICP config; --icp both runs "
+              "both schedules)" % (config_tag(c), kfd_report.icp_schedule(
+                  [{"command": ["", c]}])), file=sys.stderr)
+
+
 def plan(a):
     """Every job of a run command, as (log, config, mode, repeat), repeat by repeat: a run cut
     short still has every log, config and mode, with fewer repeats."""
@@ -309,6 +361,7 @@ def plan(a):
 def cmd_run(a):
     if a.repeats < 1:
         raise CompareError("--repeats must be >= 1")
+    a.configs = icp_configs(a)
     for c in a.configs:
         if not os.path.isfile(c):
             raise CompareError("config not found: " + c)
@@ -317,6 +370,7 @@ def cmd_run(a):
                            % a.exe)
     check_modes(a.exe, a.modes)
     jobs = plan(a)
+    say_what_is_judged(a)
     if a.emit_jobs:
         with open(a.emit_jobs, "w") as f:
             for j in jobs:
@@ -405,7 +459,7 @@ def collect(out, baseline="none", pairs=None, plots=True, quiet=False,
     runs = load_runs(out)
     groups, stats = kfd_report.analyse(runs, baseline,
                                        [tuple(x.split(":", 1)) for x in pairs or []],
-                                       failure_factor)
+                                       failure_factor, lambda r: run_trajectory(out, r))
     with open(os.path.join(out, "runs.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=RUN_COLUMNS, extrasaction="ignore")
         w.writeheader()
@@ -426,6 +480,12 @@ def collect(out, baseline="none", pairs=None, plots=True, quiet=False,
             len(runs), failed, os.path.join(out, "summary.md"), os.path.join(out, "report.md"),
             os.path.join(out, "runs.csv"), os.path.join(out, "runs.json")), file=sys.stderr)
     return stats
+
+
+def run_trajectory(out, r):
+    """A finished run's trajectory.tum as (t, x, y, yaw) poses, or None."""
+    path = os.path.join(out, kfd_report.run_folder(r), "trajectory.tum")
+    return kfd_diagnose.read_tum(path) if os.path.isfile(path) else None
 
 
 def plot(out, log, config, modes, baseline):
@@ -638,6 +698,10 @@ def build_parser():
                    help="pre-filter modes (kfd-icp-slam --mode; odometry@M: the odometry filter "
                    "at M's drop rate)")
     r.add_argument("--configs", nargs="+", default=[DEFAULT_CONFIG], help="kfd-icp-slam .ini files")
+    r.add_argument("--icp", choices=["given", "gated", "every-scan", "both"], default="given",
+                   help="which ICP schedule of each config: as given, its X.ini (ICP after "
+                   "0.2 m / 5 deg of odometry), its X-every-scan.ini (ICP on every scan: where "
+                   "a dropped scan saves an ICP run), or both")
     r.add_argument("--repeats", "-R", type=int, default=20,
                    help="runs per log, config and mode (repeat K starts K scans later)")
     r.add_argument("--out", "-o", required=True,

@@ -7,7 +7,9 @@ when that error is above F x the baseline mode's median on the same log and conf
 metrics judged are the local and long relations error, or ATE on a log without relations.
 Verdicts: see VERDICT_RULE. The statistics themselves are stats.py's."""
 import posixpath
+import re
 
+from . import agreement as kfd_agreement
 from . import stats as kfd_stats
 
 ALPHA = 0.05  # level of every "significant"
@@ -21,8 +23,10 @@ PAIR_METRICS = ["local", "long", "all", "ate", "cpu"]
 NAMED_PAIRS = [("kfd", "odometry@kfd"), ("kfd", "keyframe"), ("kfd+lo", "decimate@kfd+lo"),
                ("kfd", "decimate@kfd")]
 NAMES = {"local": "local error", "long": "long error", "all": "relations error", "ate": "ATE",
-         "drop": "drop rate", "cpu": "CPU time", "cpu_ms_per_scan": "CPU per scan"}
-DIGITS = {"drop": 1, "cpu": 2, "cpu_ms_per_scan": 2}
+         "drop": "drop rate", "cpu": "CPU time", "cpu_ms_per_scan": "CPU per scan",
+         "icp_rejected": "ICP rejection count", "lost_tracks": "lost-track count"}
+DIGITS = {"drop": 1, "cpu": 2, "cpu_ms_per_scan": 2, "icp_rejected": 1, "lost_tracks": 1}
+COUNTS = [("icp_rejected", "ICP rejected"), ("lost_tracks", "lost tracks")]  # per run, no GT needed
 SUPERSCRIPT = str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹")
 
 FAILURE_RULE = (
@@ -150,7 +154,7 @@ class Group:
     """The runs of one log and config (modes: mode -> {repeat: run}) and what is judged on them.
     Marks every run with failed, failure (its reasons) and folder."""
 
-    def __init__(self, log, config, modes, baseline, factor, extra_pairs=()):
+    def __init__(self, log, config, modes, baseline, factor, extra_pairs=(), trajectories=None):
         self.log, self.config, self.modes = log, config, modes
         self.baseline, self.factor = baseline, factor
         self.runs = [r for rs in modes.values() for r in rs.values()]
@@ -162,7 +166,10 @@ class Group:
             r["folder"] = run_folder(r)
         self.order = sorted(modes, key=lambda m: (m != baseline, m))
         self.summary = {mode: {m: kfd_stats.summary([r.get(m) for r in self.mode_runs(mode)])
-                               for m, _, _ in METRICS} for mode in self.order}
+                               for m in [x[0] for x in METRICS + COUNTS]}
+                        for mode in self.order}
+        self.icp = icp_schedule(self.runs)
+        self.agreement = self.agreements(trajectories) if trajectories else {}
         self.worst = {mode: self.worst_run(mode) for mode in self.order}
         self.pairs = self.wanted_pairs(extra_pairs)
         self.results = {p: {m: self.paired(p[0], p[1], m) for m in PAIR_METRICS}
@@ -171,6 +178,19 @@ class Group:
 
     def mode_runs(self, mode):
         return list(self.modes.get(mode, {}).values())
+
+    def agreements(self, trajectories):
+        """mode -> agreement.judge of its trajectories against the baseline's (None when
+        there is nothing to compare); trajectories(run) gives a finished run's poses."""
+        if self.baseline not in self.modes:
+            return {}
+
+        def of(mode):
+            runs = [r for r in self.mode_runs(mode) if finished(r)]
+            found = {r["repeat"]: t for r in runs for t in [trajectories(r)] if t}
+            return kfd_agreement.Trajectories(found, max_dt(runs))
+        base = of(self.baseline)
+        return {m: kfd_agreement.judge(of(m), base) for m in self.order if m != self.baseline}
 
     def failed(self, mode, repeats=None):
         return sum(1 for k, r in self.modes[mode].items()
@@ -261,7 +281,10 @@ class Group:
         fa, fb = self.failed(a, repeats), self.failed(b, repeats)
         worse = [m for m in self.judged if significant(res[m], +1)]
         better = [m for m in self.judged if significant(res[m], -1)]
-        if worse or (fa > fb and fb == 0):
+        spread = self.agreement.get(a) if b == self.baseline else None
+        if not self.judged:
+            word = spread_word(spread, b, fa > fb and fb == 0)
+        elif worse or (fa > fb and fb == 0):
             word = "WORSE"
         elif better and fa <= fb:
             word = "BETTER"
@@ -273,8 +296,9 @@ class Group:
              "repeats": len(repeats), "n": n, "smallest_p": kfd_stats.smallest_p(n),
              "cpu_ratio": cpu["median_ratio"] if cpu else None,
              "cpu_lo": cpu["ratio_lo"] if cpu else None,
-             "cpu_hi": cpu["ratio_hi"] if cpu else None}
-        v["small_n"] = v["smallest_p"] >= ALPHA
+             "cpu_hi": cpu["ratio_hi"] if cpu else None, "icp": self.icp,
+             "spread": spread}
+        v["small_n"] = v["smallest_p"] >= ALPHA and bool(self.judged)
         v["text"] = self.verdict_text(v, res)
         return v
 
@@ -288,8 +312,8 @@ class Group:
                                 NAMES[m], fmt3(x["median_a"]), fmt3(x["median_b"]),
                                 fmt_p(x["p_wilcoxon"])))
         if not self.judged:
-            evidence.append("no error to compare: %s; %s" % (self.absent("all"),
-                                                             self.absent("ate")))
+            evidence.append(self.spread_text(a, b, v["spread"]))
+        evidence.append(self.counts_text(a, b))
         evidence.append("%s vs %d" % (plural(v["failed_a"], "failed run"), v["failed_b"]))
         cpu = res["cpu"]
         if cpu and cpu["median_ratio"] == cpu["median_ratio"]:
@@ -298,11 +322,75 @@ class Group:
         else:
             at = "CPU ratio unknown (%s)" % (self.why_unpaired("cpu", a, b) if cpu is None
                                             else "%s's CPU time is 0 in every pair" % b)
-        text = "%s, %s: %s vs %s — %s (%s) %s" % (self.log, self.config, a, b, v["verdict"],
-                                                  "; ".join(evidence), at)
-        if v["small_n"]:
-            text += " — warning: " + small_n_warning(v["n"])
-        return text
+        return "%s, %s: %s vs %s — %s (%s) %s, %s" % (
+            self.log, self.config, a, b, v["verdict"], "; ".join(evidence), at, self.icp)
+
+    def spread_text(self, a, b, sp):
+        """The evidence of a verdict without ground truth (agreement.judge's result sp)."""
+        if sp is None:
+            return ("no ground truth (%s; %s) and no two finished %s runs with a trajectory to "
+                    "measure %s's own spread" % (self.absent("all"), self.absent("ate"), b, b))
+        ate, drift = sp["ate"], sp["drift"]
+
+        def pct(x):
+            return "–" if x is None else "%.2g %%/m" % (100 * x)
+        return ("no ground truth: %s's trajectory vs %s's of the same repeat: ATE %s m, drift %s "
+                "(medians over %d runs); %s's own repeats differ by %s m, %s (largest %s m, %s); "
+                "beyond %s's largest in %d of %d runs; rank-sum p = %s (ATE), %s (drift)" % (
+                    a, b, fmt3(ate["departure"]), pct(drift["departure"]), sp["n"], b,
+                    fmt3(ate["spread"]), pct(drift["spread"]), fmt3(ate["spread_max"]),
+                    pct(drift["spread_max"]), b, sp["beyond"], sp["n"], fmt_p(ate["p"]),
+                    fmt_p(drift["p"])))
+
+    def counts_text(self, a, b):
+        """ICP rejections and suspected lost tracks, medians per run (they need no ground
+        truth)."""
+        def med(mode, m):
+            s = self.summary[mode][m]
+            return "–" if s["n"] == 0 else "%g" % s["median"]
+        return "; ".join("%s %s vs %s" % (label, med(a, m), med(b, m)) for m, label in COUNTS) \
+            + " (medians)"
+
+
+def spread_word(sp, b, more_failures):
+    """The verdict word without ground truth, with how far A's departure is from b's spread
+    (the ratio of the medians, ATE)."""
+    if sp is None:
+        return "CANNOT JUDGE"
+    ratio = sp["ate"]["departure"] / sp["ate"]["spread"] if sp["ate"]["spread"] else None
+    times = " (%.2f× its median)" % ratio if ratio is not None else ""
+    if sp["departs"] or more_failures:
+        return "BEYOND %s'S SPREAD%s" % (b.upper(), times)
+    return "WITHIN %s'S SPREAD%s" % (b.upper(), times)
+
+
+def max_dt(runs):
+    """The stamp tolerance the runs' ground truth was matched with (--max-dt), else 1 ms."""
+    for r in runs:
+        c = r.get("command") or []
+        if "--max-dt" in c:
+            return float(c[c.index("--max-dt") + 1])
+    return 1e-3
+
+
+def icp_schedule(runs):
+    """Which ICP config the runs' CPU ratio holds for, read from their config file: 'ICP on
+    every scan' or 'ICP after L m / A deg of odometry' (icp-slam's localizationLinDistance and
+    localizationAngDistance)."""
+    path = next((r["command"][1] for r in runs if len(r.get("command") or []) > 1), None)
+    try:
+        with open(path) as f:
+            text = f.read()
+    except (OSError, TypeError):
+        return "ICP config unknown (its file is not readable)"
+    found = {k: float(v) for k, v in re.findall(
+        r"^\s*localization(Lin|Ang)Distance\s*=\s*([0-9.eE+-]+)", text, re.M)}
+    lin, ang = found.get("Lin"), found.get("Ang")
+    if lin is None or ang is None:
+        return "ICP config %s (no localizationLinDistance/AngDistance)" % posixpath.basename(path)
+    if lin == 0 and ang == 0:
+        return "ICP on every scan"
+    return "ICP after %g m / %g° of odometry" % (lin, ang)
 
 
 def significant(res, direction):
@@ -328,12 +416,13 @@ def small_n_warning(n):
 
 # --- all groups, runs.json --------------------------------------------------------------------
 
-def analyse(runs, baseline, extra_pairs=(), factor=FAILURE_FACTOR):
-    """The groups (log, config) of the runs, judged; and runs.json's content."""
+def analyse(runs, baseline, extra_pairs=(), factor=FAILURE_FACTOR, trajectories=None):
+    """The groups (log, config) of the runs, judged; and runs.json's content. trajectories(run)
+    gives a run's poses for the verdict without ground truth (agreement.py)."""
     by = {}
     for r in runs:
         by.setdefault((r["log"], r["config"]), {}).setdefault(r["mode"], {})[r["repeat"]] = r
-    groups = [Group(log, config, modes, baseline, factor, extra_pairs)
+    groups = [Group(log, config, modes, baseline, factor, extra_pairs, trajectories)
               for (log, config), modes in sorted(by.items())]
     stats = {"baseline": baseline, "failure_factor": factor, "alpha": ALPHA,
              "failure_rule": FAILURE_RULE % (factor, baseline),
@@ -397,9 +486,11 @@ def failed_cell(g, mode):
 
 def mode_table(g):
     dashes = Dashes()
-    cols = ["drop", "local", "long", "all", "ate", "cpu", "cpu_ms_per_scan"]
+    cols = ["drop", "local", "long", "all", "ate", "cpu", "cpu_ms_per_scan", "icp_rejected",
+            "lost_tracks"]
     lines = ["| mode | n | failed | dropped % | local (m) | long (m) | all (m) | ATE (m) | CPU (s) "
-             "| CPU/scan (ms) |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "| CPU/scan (ms) | ICP rejected | lost tracks |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for mode in g.order:
         lines.append("| %s | %d | %s | %s |" % (mode, len(g.modes[mode]), failed_cell(g, mode),
                                                 " | ".join(median_cell(g, mode, m, dashes)
@@ -451,11 +542,15 @@ def ratio_cell(res, b, dashes, digits=3):
                            fmt(res["ratio_hi"], digits))
 
 
-def small_n_notes(groups_pairs):
-    """One warning line per pair with too few runs for any p < ALPHA."""
-    return [""] + ["**Warning**, %s vs %s%s: %s." % (
-        a, b, "" if log is None else " on " + log, small_n_warning(v["n"]))
-        for log, (a, b), v in groups_pairs if v["small_n"]]
+def small_n_notes(verdicts):
+    """One warning per number of paired runs too small for any p < ALPHA, naming the verdicts
+    it concerns (said once, not under every verdict)."""
+    by_n = {}
+    for v in verdicts:
+        if v["small_n"]:
+            by_n.setdefault(v["n"], []).append("%s vs %s on %s" % (v["a"], v["b"], v["log"]))
+    return ["", *["**Warning** (%s): %s." % (", ".join(which), small_n_warning(n))
+                  for n, which in sorted(by_n.items())]] if by_n else []
 
 
 def pair_table(g):
@@ -472,13 +567,28 @@ def pair_table(g):
             lines.append("| %s vs %s | %s | %d | %d/%d/%d | %s | %s | %s |" % (
                 a, b, m, res["n"], res["wins"], res["losses"], res["ties"],
                 fmt_p(res["p_sign"]), fmt_p(res["p_wilcoxon"]), ratio_cell(res, b, dashes)))
-    notes = small_n_notes([(None, p, g.verdicts[p]) for p in g.pairs])
-    return lines + dashes.legend() + (notes if len(notes) > 1 else [])
+    return lines + dashes.legend()
 
 
 def verdict_lines(g):
     return ["- " + g.verdicts[p]["text"] for p in g.pairs] or [
         "No pair to judge (no `%s` runs and no named pair)." % g.baseline]
+
+
+def spread_line(g):
+    """For a log with ground truth, what the verdict without it would have said (the same
+    measure a user's log without ground truth gets)."""
+    found = [(a, sp) for a, sp in sorted(g.agreement.items()) if sp]
+    if not g.judged or not found:
+        return []
+    return ["Against %s's own spread (the verdict a log without ground truth gets): %s." % (
+        g.baseline, "; ".join("%s %s (ATE to %s %s m vs %s m between its repeats, drift %.2g vs "
+                              "%.2g %%/m, rank-sum p = %s / %s)" % (
+                                  a, "beyond" if sp["departs"] else "within", g.baseline,
+                                  fmt3(sp["ate"]["departure"]), fmt3(sp["ate"]["spread"]),
+                                  100 * (sp["drift"]["departure"] or 0),
+                                  100 * (sp["drift"]["spread"] or 0), fmt_p(sp["ate"]["p"]),
+                                  fmt_p(sp["drift"]["p"])) for a, sp in found)), ""]
 
 
 def report_md(groups, stats, out, plots):
@@ -494,7 +604,8 @@ def report_md(groups, stats, out, plots):
     lines += header(stats)
     for g in groups:
         lines += ["## %s, %s" % (g.log, g.config), "", threshold_line(g), ""]
-        lines += verdict_lines(g) + [""]
+        lines += verdict_lines(g) + small_n_notes(g.verdicts.values()) + [""]
+        lines += spread_line(g)
         lines += mode_table(g) + [""] + worst_table(g) + [""] + failed_list(g) + [""]
         lines += pair_table(g) + [""]
         if plots:
@@ -512,21 +623,23 @@ def summary_md(groups, stats):
     for config in sorted({g.config for g in groups}):
         gs = [g for g in groups if g.config == config]
         lines += ["## %s" % config, "", "Verdicts:", ""]
-        lines += [line for g in gs for line in verdict_lines(g)] + [""]
+        lines += [line for g in gs for line in verdict_lines(g)]
+        lines += small_n_notes([v for g in gs for v in g.verdicts.values()]) + [""]
         lines += summary_modes(gs) + [""] + summary_worst(gs) + [""] + summary_pairs(gs) + [""]
     return "\n".join(lines)
 
 
 def summary_modes(gs):
     dashes = Dashes()
-    lines = ["| log | mode | n | failed | dropped % | local (m) | long (m) | ATE (m) | CPU (s) |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    lines = ["| log | mode | n | failed | dropped % | local (m) | long (m) | ATE (m) | CPU (s) | "
+             "ICP rejected | lost tracks |", "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for g in gs:
         for mode in g.order:
             lines.append("| %s | %s | %d | %s | %s |" % (
                 g.log, mode, len(g.modes[mode]), failed_cell(g, mode), " | ".join(
                     median_cell(g, mode, m, dashes, iqr=False)
-                    for m in ("drop", "local", "long", "ate", "cpu"))))
+                    for m in ("drop", "local", "long", "ate", "cpu", "icp_rejected",
+                              "lost_tracks"))))
     return lines + dashes.legend()
 
 
@@ -564,5 +677,4 @@ def summary_pairs(gs):
             lines.append("| %s | %s vs %s | %d | %s | %s | %s | %s | %s |" % (
                 g.log, a, b, g.verdicts[(a, b)]["n"], wl("local"), wl("long"), wl("all"),
                 wl("ate"), cpu))
-    notes = small_n_notes([(g.log, p, g.verdicts[p]) for g in gs for p in g.pairs])
-    return lines + dashes.legend() + (notes if len(notes) > 1 else [])
+    return lines + dashes.legend()

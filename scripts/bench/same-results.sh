@@ -138,7 +138,7 @@ render() {  # name, log, index, options...
     >/dev/null 2>&1 || true
   verdict "kfd-render $name" same_file "$tmp/old-$name.png" "$tmp/new-$name.png"
 }
-RENDER_CFG=share/kfd/kfd-40hz.ini render office "$root/rawlogs/office-mit-0.752.rawlog" 300 \
+RENDER_CFG=share/kfd/default.ini render office "$root/rawlogs/office-mit-0.752.rawlog" 300 \
   --extent 8
 [ -f "$data/fr079/fr079.rawlog" ] && render fr079 "$data/fr079/fr079.rawlog" 1200
 

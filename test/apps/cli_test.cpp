@@ -284,7 +284,7 @@ TEST(CliApps, BadUsageExitsTwoAndSaysWhatIsWrong) {
         {"kfd-simulate", "-o x.rawlog --seed -1", "--seed: '-1' is not a non-negative integer"},
         {"kfd-chart", "in.csv -o out.png --size 640 wide", "--size: 'wide' is not an integer"},
         {"kfd-render", "-i a -o b.png --index 3rd", "--index: '3rd' is not an integer"},
-        {"kfd-render", "-i a -o b.png --index 3 --history 101", "--history: '101' is outside"},
+        {"kfd-render", "-i a -o b.png --index 3 --size big", "--size: 'big' is not an integer"},
         {"kfd-denoise-eval", "-i a -l b -c c --laser-only=maybe", "--laser-only"},
         // A missing required argument.
         {"kfd-filter", "-o out.rawlog", "no input log (-i)"},
@@ -373,7 +373,64 @@ TEST(CliApps, RenderDrawsAScanWithNextScanTheLogsLastToo) {
                                                     d / "r.png" + "' -c '" + d / "next.ini" + "'");
         EXPECT_EQ(r.status, 0) << pick << ": " << r.err;
         EXPECT_GT(fs::file_size(d / "r.png"), 1000u) << pick;
-        EXPECT_NE(r.out.find("noise point"), std::string::npos) << r.out;
+        EXPECT_NE(r.out.find("removed as noise"), std::string::npos) << r.out;
+    }
+}
+
+// One row of kfd-filter's per-scan CSV: index -> "KEPT (reason), P returns, R removed as
+// noise", as kfd-render titles the scan.
+std::vector<std::string> filterRows(const std::string& csv) {
+    std::ifstream in(csv);
+    std::string line;
+    std::getline(in, line);  // index,timestamp,sensor,kept,reason,points_in,removed_noise,...
+    std::vector<std::string> rows;
+    while (std::getline(in, line)) {
+        std::vector<std::string> c;
+        std::stringstream cells(line);
+        for (std::string cell; std::getline(cells, cell, ',');) c.push_back(cell);
+        rows.push_back(std::string(c.at(3) == "1" ? "KEPT" : "DROPPED") + " (" + c.at(4) + "), " +
+                       c.at(5) + " returns, " + c.at(6) + " removed as noise");
+    }
+    return rows;
+}
+
+// Issue 37: kfd-render draws exactly what kfd-filter did to a scan (the same history: the
+// whole log up to it through the same pipeline), kept or dropped, the most removed too.
+TEST(CliApps, RenderShowsKfdFiltersRowForTheSameScan) {
+    kfd::test::TempDir d("kfd_cli_");
+    std::vector<std::string> logs = {std::string(KFD_SOURCE_DIR) +
+                                     "/rawlogs/office-mit-0.752.rawlog"};
+    const std::string fr079 = std::string(KFD_DATASETS_DIR) + "/fr079/fr079.rawlog";
+    if (fs::exists(fr079)) logs.push_back(fr079);
+    for (const std::string& log : logs) {
+        const Result f = runApp(KFD_FILTER_EXE, "-q -i '" + log + "' -o '" + d / "o.rawlog" +
+                                                    "' --stats '" + d / "s.csv" + "'");
+        ASSERT_EQ(f.status, 0) << f.err;
+        const auto rows = filterRows(d / "s.csv");
+        ASSERT_GT(rows.size(), 100u);
+        std::vector<std::size_t> picks;  // the first kept and dropped after 50, the most removed
+        std::size_t most = 0, most_removed = 0;
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+            const std::size_t removed = std::stoul(rows[i].substr(rows[i].rfind(", ") + 2));
+            if (removed > most_removed) most = i, most_removed = removed;
+        }
+        for (const char* kind : {"KEPT", "DROPPED"})
+            for (std::size_t i = 50; i < rows.size(); ++i)
+                if (rows[i].rfind(kind, 0) == 0) {
+                    picks.push_back(i);
+                    break;
+                }
+        picks.push_back(most);
+        EXPECT_GT(most_removed, 0u) << log;
+        for (std::size_t i : picks) {
+            const Result r =
+                runApp(KFD_RENDER_EXE, "-i '" + log + "' --index " + std::to_string(i) + " -o '" +
+                                           d / "r.png" + "'");
+            ASSERT_EQ(r.status, 0) << r.err;
+            EXPECT_NE(r.out.find("): " + rows[i] + " ("), std::string::npos)
+                << log << " scan " << i << ": kfd-filter's row " << rows[i] << "\n"
+                << r.out;
+        }
     }
 }
 #endif

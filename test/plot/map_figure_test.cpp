@@ -159,7 +159,7 @@ TEST(MapFigure, DegenerateScansAreMarkedOrange) {
     const auto fig = kfd::renderMapFigure(in);
     auto orange = [&](double x) {
         const auto p = fig.frame.pixel(x, 1.0);
-        const auto c = rgbAt(fig.image, p.first, p.second - 2);  // beside the blue line
+        const auto c = rgbAt(fig.image, p.first, p.second - 3);  // beside the 3 px blue line
         return c[0] == 240 && c[1] == 130 && c[2] == 0;
     };
     EXPECT_TRUE(orange(1.0));
@@ -260,4 +260,49 @@ TEST(MapFigure, TheScaleBarGrowsWithCoarseCells) {
         EXPECT_LE(len, 60) << res;
         EXPECT_LT(fig.scale_bar_row, fig.frame.top);
     }
+}
+
+// Issue 37: where every trajectory coincides (an accurate estimate, odometry that needed no
+// correction) each one in the legend still shows in the map, with the keyframes, degenerate
+// scans and a lost track; the title is drawn in the band.
+TEST(MapFigure, EveryLegendEntryShowsWhereTheTrajectoriesCoincide) {
+    mrpt::maps::COccupancyGridMap2D grid(-5, 5, -5, 5, 0.05f);
+    kfd::MapFigureInput in;
+    in.grid = &grid;
+    for (int k = 0; k <= 60; ++k) in.estimate.push_back({double(k), {-3.0 + 0.1 * k, 0.5, 0.0}});
+    in.ground_truth = in.odometry = in.track = in.estimate;
+    for (std::size_t k = 0; k <= 60; k += 3) in.keyframes.push_back(k);  // dense keyframes
+    in.corridor = {10, 11, 12};
+    in.lost_tracks = {40};
+    in.title = "office.rawlog  mode kfd  dropped 66.7 %  ATE 0.000 m  1 suspected lost track";
+    const auto fig = kfd::renderMapFigure(in);
+    struct Want {
+        const char* name;
+        std::array<std::uint8_t, 3> rgb;
+    };
+    const std::vector<Want> colours = {
+        {"estimate", {30, 90, 220}},
+        {"keyframes", {10, 20, 90}},
+        {"ground truth, aligned to the estimate", {30, 160, 60}},
+        {"odometry from the estimate's start", {150, 150, 150}},
+        {"kfd's scan track from the estimate's start", {160, 40, 180}},
+        {"scans the corridor switch found degenerate", {240, 130, 0}},
+        {"suspected lost track begins", {220, 0, 0}}};
+    const auto& drawn = fig.layers;  // an empty grid: no occupancy map layer
+    ASSERT_EQ(drawn.size(), colours.size());
+    const int w = static_cast<int>(fig.image.getWidth());
+    for (std::size_t i = 0; i < colours.size(); ++i) {
+        EXPECT_EQ(drawn[i].name, colours[i].name);
+        std::size_t seen = 0;  // pixels of this colour in the map part (below the band)
+        for (int y = fig.frame.top; y < fig.frame.top + fig.frame.height; ++y)
+            for (int x = 0; x < w; ++x) seen += rgbAt(fig.image, x, y) == colours[i].rgb;
+        EXPECT_GT(seen, 0u) << colours[i].name << " is hidden";
+    }
+    std::size_t dark = 0;  // the title's text in its row of the band
+    for (int y = 8; y < 24; ++y)
+        for (int x = 8; x < 8 + 9 * 20; ++x) dark += rgbAt(fig.image, x, y)[0] < 100;
+    EXPECT_GT(dark, 50u);
+    in.title.clear();
+    const auto untitled = kfd::renderMapFigure(in);
+    EXPECT_LT(untitled.frame.top, fig.frame.top);  // the title row is gone
 }

@@ -168,7 +168,7 @@ class Scratch:
 
 PLACEHOLDERS = {
     "IN.rawlog": BUNDLED, "LOG": BUNDLED, "LOG.rawlog": BUNDLED, "REAL.rawlog": BUNDLED,
-    "my.rawlog": BUNDLED, "CONFIG": "share/kfd/kfd-40hz.ini", "GT.relations": "in/gt.relations",
+    "my.rawlog": BUNDLED, "CONFIG": "share/kfd/default.ini", "GT.relations": "in/gt.relations",
     "GT.tum": "rawlogs/office-mit-0.752.gt.tum", "N": "300", "DIR": "in",
 }
 

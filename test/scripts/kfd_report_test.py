@@ -4,7 +4,9 @@ verdicts (better, worse by significance, worse by failures, no difference), the 
 and the reasons of the "–" cells; and run_job's record of a failed kfd-icp-slam run."""
 import argparse
 import json
+import math
 import os
+import random
 import re
 import shutil
 import stat
@@ -12,6 +14,7 @@ import tempfile
 import unittest
 
 from kfd_tools import compare as kfd_compare
+from kfd_tools import report as kfd_report
 from kfd_tools import stats as kfd_stats
 
 CONFIG = "cfg"
@@ -210,25 +213,25 @@ class FewRuns(Base):
                       "0.06; long error 2.72 vs 1.30 m, Wilcoxon p = ", self.summary)
         self.assertIn("; 2 failed runs vs 0) at CPU ratio 1.00 [1.00–1.00]", self.summary)
 
-    def test_five_runs_warn_that_nothing_can_be_significant(self):
+    def test_five_runs_warn_once_that_nothing_can_be_significant(self):
         stats = self.collect()
         warning = "n = 5: the smallest possible p is %.2g; no difference can be significant" \
             % kfd_stats.smallest_p(5)
         self.assertIn("0.062", warning)
         v = self.verdict(stats, "aces", "kfd", "none")
         self.assertEqual((v["n"], v["small_n"]), (5, True))
-        self.assertTrue(v["text"].endswith(" — warning: " + warning))
+        self.assertNotIn("smallest possible p", v["text"])  # said once, below the verdicts
         aces = section(self.report, "aces, cfg")
         self.assertIn("- " + v["text"] + "\n", aces)
         self.assertIn("- " + v["text"] + "\n", self.summary)
         # keyframe's crashed and stopped runs leave 3 pairs
         v = self.verdict(stats, "aces", "keyframe", "none")
         self.assertEqual((v["n"], v["repeats"]), (3, 5))
-        self.assertTrue(v["text"].endswith("n = 3: the smallest possible p is 0.25; no "
-                                           "difference can be significant"))
-        pair_table = aces[aces.index("| A vs B |"):]
-        self.assertIn("**Warning**, kfd vs none: " + warning, pair_table)
-        self.assertIn("**Warning**, kfd vs none on aces: " + warning, self.summary)
+        for text in (aces, self.summary):
+            self.assertEqual(text.count(warning), 1, text)
+            self.assertEqual(text.count("n = 3: the smallest possible p is 0.25; no difference "
+                                        "can be significant"), 1)
+            self.assertIn("**Warning** (kfd vs none on aces): " + warning, text)
 
     def test_every_dash_has_its_reason(self):
         self.collect()
@@ -325,6 +328,112 @@ class DashReasons(Base):
                          "no relations file for this log")
         self.assertEqual(reason(self.summary, ["sim", "kfd vs none"], 3),
                          "no relations file for this log")
+
+
+def write_trajectory(out, log, mode, repeat, poses):
+    with open(os.path.join(run_path(out, log, mode, repeat), "trajectory.tum"), "w") as f:
+        f.write("# timestamp x y z qx qy qz qw\n")
+        for t, x, y, yaw in poses:
+            f.write("%.6f %.6f %.6f 0 0 0 %.9f %.9f\n" % (t, x, y, math.sin(yaw / 2),
+                                                         math.cos(yaw / 2)))
+
+
+def path(noise, seed, bend=0.0):
+    """A 30 m walk (0.1 m steps, a turn halfway), each pose moved by Gaussian noise of `noise`
+    m; bend (rad per step) turns every step a little more (a drifting estimate)."""
+    rng = random.Random(seed)
+    poses, x, y, yaw = [], 0.0, 0.0, 0.0
+    for i in range(300):
+        poses.append((0.2 * i, x + rng.gauss(0, noise), y + rng.gauss(0, noise), yaw))
+        yaw += (0.01 if 100 <= i < 200 else 0.0) + bend
+        x, y = x + 0.1 * math.cos(yaw), y + 0.1 * math.sin(yaw)
+    return poses
+
+
+class NoGroundTruth(Base):
+    """A log without relations or ground truth, 6 repeats: kfd's trajectories differ from none's
+    as much as none's differ from each other; keyframe's drift. The config runs ICP on every
+    scan."""
+
+    def setUp(self):
+        super().setUp()
+        config = os.path.join(self.tmp, CONFIG + ".ini")
+        with open(config, "w") as f:
+            f.write("[MappingApplication]\nlocalizationLinDistance = 0\n"
+                    "localizationAngDistance = 0 # every scan\n")
+        for k in range(6):
+            for i, (mode, noise, bend, cpu) in enumerate((
+                    ("none", 0.01, 0.0, 10.0), ("kfd", 0.01, 0.0, 5.0),
+                    ("keyframe", 0.01, 0.002, 4.0))):
+                write_run(self.out, "mine", mode, k, cpu=cpu + 0.1 * k, lost_tracks=0,
+                          command=["kfd-icp-slam", config, "mine.bag", "-m", mode])
+                write_trajectory(self.out, "mine", mode, k,
+                                 path(noise, 10 * k + i, bend)[k:])
+
+    def test_a_mode_is_judged_against_the_baselines_own_spread(self):
+        stats = self.collect()
+        within = self.verdict(stats, "mine", "kfd", "none")
+        self.assertTrue(within["verdict"].startswith("WITHIN NONE'S SPREAD ("), within["verdict"])
+        self.assertFalse(within["small_n"])  # the rank-sum test can be significant with 6 runs
+        beyond = self.verdict(stats, "mine", "keyframe", "none")
+        self.assertTrue(beyond["verdict"].startswith("BEYOND NONE'S SPREAD ("))
+        self.assertLess(beyond["spread"]["ate"]["p"], 0.05)
+        self.assertEqual(beyond["spread"]["beyond"], 6)
+        self.assertIn("mine, cfg: kfd vs none — WITHIN NONE'S SPREAD", self.summary)
+        self.assertIn("no ground truth: kfd's trajectory vs none's of the same repeat: ATE ",
+                      within["text"])
+        self.assertIn("ICP rejected 17.5 vs 17.5; lost tracks 0 vs 0 (medians)", within["text"])
+        self.assertTrue(within["text"].endswith(") at CPU ratio 0.51 [0.50–0.52], ICP on every "
+                                                "scan"), within["text"])
+        self.assertNotIn("smallest possible p", self.summary)
+
+    def test_without_trajectories_nothing_is_judged(self):
+        for k in range(6):
+            os.remove(os.path.join(run_path(self.out, "mine", "none", k), "trajectory.tum"))
+        stats = self.collect()
+        v = self.verdict(stats, "mine", "kfd", "none")
+        self.assertEqual(v["verdict"], "CANNOT JUDGE")
+        self.assertIn("no two finished none runs with a trajectory", v["text"])
+
+
+class BeforeRunning(unittest.TestCase):
+    SHARE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "share",
+                         "kfd-icp-slam")
+
+    def test_each_log_says_what_its_verdict_rests_on(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            bag = os.path.join(tmp, "mine.bag")
+            open(bag, "w").close()
+            log = kfd_compare.resolve_log(bag, tmp)
+            self.assertIn("mine: no ground truth (no .relations or .gt.tum beside it): accuracy "
+                          "is judged against none's own spread",
+                          kfd_compare.what_is_judged(log, ["none", "kfd"], "none"))
+            self.assertIn("no verdict on accuracy (add mode none)",
+                          kfd_compare.what_is_judged(log, ["kfd"], "none"))
+            open(os.path.join(tmp, "mine.relations"), "w").close()
+            self.assertIn("relations mine.relations: judged on the local and long relations error",
+                          kfd_compare.what_is_judged(kfd_compare.resolve_log(bag, tmp), ["kfd"],
+                                                     "none"))
+
+    def test_one_flag_runs_both_icp_schedules_and_each_is_named(self):
+        gated = os.path.join(self.SHARE, "sick-180-5hz.ini")
+        every = os.path.join(self.SHARE, "sick-180-5hz-every-scan.ini")
+        a = argparse.Namespace(configs=[gated], icp="both")
+        self.assertEqual(kfd_compare.icp_configs(a), [gated, every])
+        a.icp = "every-scan"
+        self.assertEqual(kfd_compare.icp_configs(a), [every])
+        a.configs, a.icp = [every], "gated"
+        self.assertEqual(kfd_compare.icp_configs(a), [gated])
+        self.assertEqual(kfd_report.icp_schedule([{"command": ["x", gated]}]),
+                         "ICP after 0.2 m / 5° of odometry")
+        self.assertEqual(kfd_report.icp_schedule([{"command": ["x", every]}]), "ICP on every scan")
+        with tempfile.TemporaryDirectory() as tmp:
+            lone = os.path.join(tmp, "lone.ini")
+            open(lone, "w").close()
+            a.configs, a.icp = [lone], "both"
+            with self.assertRaises(kfd_compare.CompareError) as e:
+                kfd_compare.icp_configs(a)
+            self.assertIn("--icp both: no %s-every-scan.ini beside" % lone[:-4], str(e.exception))
 
 
 FAIL = "#!/bin/sh\necho 'no usable scan in the log' >&2\nexit 1\n"

@@ -1,5 +1,7 @@
 """kfd_stats (kfd-compare's statistics) against values computed by hand."""
+import itertools
 import math
+import random
 import unittest
 
 from kfd_tools import stats as st
@@ -85,6 +87,28 @@ class Bootstrap(unittest.TestCase):
         r = st.bootstrap_median_ratio([1.0, 2.0], [0.0, 1.0])
         self.assertEqual(r, (2.0, 2.0, 2.0))
         self.assertTrue(math.isnan(st.bootstrap_median_ratio([1.0], [0.0])[0]))
+
+
+class RankSum(unittest.TestCase):
+    def brute(self, x, y):
+        """The plain definition: every way to give len(x) of the pooled values' ranks to x."""
+        pooled = list(x) + list(y)
+        r = st.ranks(pooled)
+        observed = sum(r[: len(x)])
+        sums = [sum(r[i] for i in c) for c in itertools.combinations(range(len(r)), len(x))]
+        return sum(1 for s in sums if s >= observed - 1e-9) / len(sums)
+
+    def test_exact_counting_equals_the_plain_definition_on_random_inputs(self):
+        rng = random.Random(7)
+        for _ in range(60):
+            x = [rng.choice([0.5, 1.0, 1.5, 2.0, rng.random()]) for _ in range(rng.randint(1, 6))]
+            y = [rng.choice([0.5, 1.0, 1.5, 2.0, rng.random()]) for _ in range(rng.randint(1, 6))]
+            self.assertAlmostEqual(st.rank_sum_greater(x, y), self.brute(x, y), 12, (x, y))
+
+    def test_five_larger_values_give_one_in_252(self):
+        self.assertAlmostEqual(st.rank_sum_greater([5, 6, 7, 8, 9], [0, 1, 2, 3, 4]), 1 / 252)
+        self.assertEqual(st.rank_sum_greater([0, 1, 2, 3, 4], [5, 6, 7, 8, 9]), 1.0)
+        self.assertEqual(st.rank_sum_greater([], [1.0]), 1.0)
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 LONGEST = os.path.join(ROOT, "scripts", "ci", "longest.py")
-ALGORITHM_FOLDERS = ("paper", "algorithms", "stages", "pipeline")
+ALGORITHM_FOLDERS = ("paper", "algorithms", "stages", "filters", "pipeline")
 PAPER_MAY_INCLUDE = re.compile(r'^(<[a-z_]+>|"kfd/paper/[a-z_]+\.h"|"kfd/pipeline/(scan|error)\.h")$')
 PAPER_STAGES = ("distance_stage", "keyframe_stage", "denoise_stage")
 PAPER_STAGE_MAY_INCLUDE = re.compile(

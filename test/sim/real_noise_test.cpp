@@ -199,7 +199,7 @@ TEST(NoisyLog, LabelsMatchTheInjectedBeamsAndScoreBackPerModel) {
     EXPECT_EQ(s.labels, dir / "noisy.labels.csv");
     EXPECT_GT(s.by_kind[1] + s.by_kind[2] + s.by_kind[3], 1000u);
     kfd::Pipeline::Params p =
-        kfd::loadConfigFile(std::string(KFD_SOURCE_DIR) + "/share/kfd/kfd-40hz.ini");
+        kfd::loadConfigFile(std::string(KFD_SOURCE_DIR) + "/share/kfd/default.ini");
     p.stages = {"distance", "denoise"};
     const auto q = kfd::evaluateDenoising(o.output, s.labels, p);
     EXPECT_EQ(q.scans, 600u);

@@ -3,7 +3,8 @@
 namespace kfd {
 
 const StageRegistry& defaultStageRegistry() {
-    static const StageRegistry r = makeStageRegistry({registerCoreStages, registerBaselineStages});
+    static const StageRegistry r =
+        makeStageRegistry({registerCoreStages, registerFilterStages, registerBaselineStages});
     return r;
 }
 

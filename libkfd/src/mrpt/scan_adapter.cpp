@@ -29,6 +29,12 @@ void toCore(const mrpt::obs::CObservation2DRangeScan& obs, Scan& out) {
     }
     std::uint8_t* valid = out.valid.data();
     for (std::size_t i = 0; i < n; ++i) valid[i] = obs.getScanRangeValidity(i) ? 1 : 0;
+    out.intensity.clear();
+    if (obs.hasIntensity() && n > 0) {
+        out.intensity.resize(n);
+        for (std::size_t i = 0; i < n; ++i)
+            out.intensity[i] = static_cast<float>(obs.getScanIntensity(i));
+    }
     out.timestamp = stampOf(obs);
     out.sensor_pose = Pose2D{obs.sensorPose.x(), obs.sensorPose.y(), obs.sensorPose.yaw()};
     out.max_range = obs.maxRange > 0.0f && std::isfinite(obs.maxRange)

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <utility>
 
+#include "kfd/algorithms/keyframe_guards.h"
 #include "kfd/algorithms/keyframe_selector.h"
 #include "kfd/io/source.h"
 #include "kfd/mrpt/default_stages.h"
@@ -224,6 +225,29 @@ void StreamFilter::record(StreamResult& res) {
     count(res);
 }
 
+namespace {
+
+void countReason(ScanCounters& c, const char* reason) {
+    for (auto& [name, n] : c.reasons)
+        if (name == reason) {
+            ++n;
+            return;
+        }
+    c.reasons.emplace_back(reason, 1);
+}
+
+// Keeps the kMostRemoved largest shares, largest first (ties: the earlier scan first).
+void keepMostRemoved(ScanCounters& c, const ScanCounters::Removal& r) {
+    auto& v = c.most_removed;
+    const auto at = std::find_if(
+        v.begin(), v.end(), [&](const ScanCounters::Removal& o) { return r.share() > o.share(); });
+    if (at == v.end() && v.size() >= ScanCounters::kMostRemoved) return;
+    v.insert(at, r);
+    if (v.size() > ScanCounters::kMostRemoved) v.pop_back();
+}
+
+}  // namespace
+
 // The counters of a recorded scan: the door's own, then the listed stages' declared ones.
 void StreamFilter::count(const StreamResult& res) {
     const ScanReport& rep = res.report;
@@ -234,6 +258,7 @@ void StreamFilter::count(const StreamResult& res) {
     c.points_in += rep.points_in;
     c.filter_seconds += rep.microseconds * 1e-6;
     outputs_.count(rep, c.stage_totals);
+    countReason(c, rec.reason);
     if (!res.keep) {
         ++c.scans_dropped;
         return;
@@ -247,6 +272,33 @@ void StreamFilter::count(const StreamResult& res) {
             std::max(c.max_removed_noise_share,
                      static_cast<double>(rec.removed_noise) / static_cast<double>(usable));
     c.points_removed += rep.points_in - rep.points_out;
+    if (rec.removed_noise > 0)
+        keepMostRemoved(c, {rec.index, rec.stamp, rec.removed_noise, usable});
+}
+
+std::vector<std::string> reasonLines(const ScanCounters& c) {
+    auto reasons = c.reasons;
+    std::stable_sort(reasons.begin(), reasons.end(),
+                     [](const auto& a, const auto& b) { return a.second > b.second; });
+    std::vector<std::string> lines;
+    for (const auto& [name, n] : reasons) {
+        const char* meaning = describeKeyframeReason(name);
+        const std::string why = meaning          ? meaning
+                                : name == "kept" ? "kept: no stage of the pipeline drops scans"
+                                : name.rfind("skipped:", 0) == 0
+                                    ? "skipped: a geometry kfd cannot use (see 'skipped')"
+                                    : "dropped by the " + name + " stage";
+        lines.push_back(format("%s %-14s %6zu  %s", lines.empty() ? "reasons " : "        ",
+                               name.c_str(), n, why.c_str()));
+    }
+    if (!c.most_removed.empty()) {
+        std::string m = "most removed (kfd-render --index N draws one):";
+        for (const auto& r : c.most_removed)
+            m += format(" scan %zu %.1f %% (%zu of %zu);", r.index, 100.0 * r.share(), r.removed,
+                        r.usable);
+        lines.push_back(m);
+    }
+    return lines;
 }
 
 std::string noUsableScan(const ScanCounters& c, const SourceCounters& source,

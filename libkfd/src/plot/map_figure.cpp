@@ -155,13 +155,14 @@ void alignToEstimate(const MapFigureInput& in, Trajectory& gt) {
 }
 
 const TColor kGrey(150, 150, 150), kGreen(30, 160, 60), kBlue(30, 90, 220), kNavy(10, 20, 90),
-    kBlack(0, 0, 0), kOrange(240, 130, 0), kPurple(160, 40, 180);
+    kBlack(0, 0, 0), kOrange(240, 130, 0), kPurple(160, 40, 180), kRed(220, 0, 0);
 
 // The layers drawn (in legend order) and their bounds, with the margin: nothing else sets the
 // figure's extent.
 Bounds layersAndBounds(const MapFigureInput& in, const Trajectory& gt, const Trajectory& odo,
                        const Trajectory& track, const std::vector<std::size_t>& keyframes,
-                       const std::vector<std::size_t>& corridor, std::vector<Layer>& layers) {
+                       const std::vector<std::size_t>& corridor,
+                       const std::vector<std::size_t>& lost, std::vector<Layer>& layers) {
     const auto& g = *in.grid;
     const double res = g.getResolution();
     Bounds b;
@@ -180,6 +181,8 @@ Bounds layersAndBounds(const MapFigureInput& in, const Trajectory& gt, const Tra
         layers.push_back({{"kfd's scan track from the estimate's start", "purple"}, kPurple});
     if (!corridor.empty())
         layers.push_back({{"scans the corridor switch found degenerate", "orange"}, kOrange, true});
+    if (!lost.empty())
+        layers.push_back({{"suspected lost track begins", "red crosses"}, kRed, true});
     if (draw_est || !keyframes.empty() || !corridor.empty()) addPath(b, in.estimate);
     if (draw_gt) addPath(b, gt);
     if (draw_odo) addPath(b, odo);
@@ -287,6 +290,34 @@ void drawBand(MapFigure& fig, const Band& band, const std::vector<Layer>& layers
     img.textOut(12 + kPadPx + fig.scale_bar_px, y, format("%g m", metres), kBlack);
 }
 
+// Squares of side 2 h + 1 px at the estimate's poses `at`.
+void squares(mrpt::img::CImage& img, const MapFigureFrame& f, const Trajectory& est,
+             const std::vector<std::size_t>& at, int h, const TColor& c) {
+    for (const auto k : at) {
+        const auto p = f.pixel(est[k].pose.x, est[k].pose.y);
+        img.filledRectangle(p.first - h, p.second - h, p.first + h, p.second + h, c);
+    }
+}
+
+// Every layer, from the bottom up, each narrower than the one below: where they coincide (an
+// accurate estimate on the ground truth, odometry that needed no correction) each still shows.
+void drawLayers(mrpt::img::CImage& img, const MapFigureFrame& f, const MapFigureInput& in,
+                const Trajectory& gt, const Trajectory& odo, const Trajectory& track,
+                const std::vector<std::size_t>& keyframes, const std::vector<std::size_t>& corridor,
+                const std::vector<std::size_t>& lost) {
+    path(img, f, gt, kGreen, 7);
+    path(img, f, track, kPurple, 5);
+    squares(img, f, in.estimate, corridor, 3, kOrange);
+    squares(img, f, in.estimate, keyframes, 2, kNavy);
+    path(img, f, in.estimate, kBlue, 3);
+    path(img, f, odo, kGrey, 1);
+    for (const auto k : lost) {  // a cross of 15 px, on top of everything
+        const auto p = f.pixel(in.estimate[k].pose.x, in.estimate[k].pose.y);
+        img.line(p.first - 7, p.second - 7, p.first + 7, p.second + 7, kRed, 3);
+        img.line(p.first - 7, p.second + 7, p.first + 7, p.second - 7, kRed, 3);
+    }
+}
+
 }  // namespace
 
 MapFigure renderMapFigure(const MapFigureInput& in) {
@@ -297,8 +328,9 @@ MapFigure renderMapFigure(const MapFigureInput& in) {
     const Trajectory track = fromEstimateStart(in, in.track);
     const auto keyframes = drawable(in.keyframes, in.estimate);
     const auto corridor = drawable(in.corridor, in.estimate);
+    const auto lost = drawable(in.lost_tracks, in.estimate);
     std::vector<Layer> layers;
-    const Bounds b = layersAndBounds(in, gt, odo, track, keyframes, corridor, layers);
+    const Bounds b = layersAndBounds(in, gt, odo, track, keyframes, corridor, lost, layers);
     const Band band = legendBand(in, layers);
     MapFigure fig;
     fig.frame = frameFor(in, b, band);
@@ -308,18 +340,7 @@ MapFigure renderMapFigure(const MapFigureInput& in) {
     img = mrpt::img::CImage(img_w, band.height + f.height, mrpt::img::CH_RGB);
     img.filledRectangle(0, 0, img_w - 1, band.height + f.height - 1, TColor(255, 255, 255));
     drawGrid(img, *in.grid, f);
-    path(img, f, odo, kGrey, 1);
-    path(img, f, track, kPurple, 1);
-    path(img, f, gt, kGreen, 5);  // wide: stays visible under an accurate estimate
-    path(img, f, in.estimate, kBlue, 2);
-    for (const auto k : corridor) {  // under the keyframe dots
-        const auto p = f.pixel(in.estimate[k].pose.x, in.estimate[k].pose.y);
-        img.filledRectangle(p.first - 2, p.second - 2, p.first + 2, p.second + 2, kOrange);
-    }
-    for (const auto k : keyframes) {
-        const auto p = f.pixel(in.estimate[k].pose.x, in.estimate[k].pose.y);
-        img.filledRectangle(p.first - 1, p.second - 1, p.first + 1, p.second + 1, kNavy);
-    }
+    drawLayers(img, f, in, gt, odo, track, keyframes, corridor, lost);
     drawBand(fig, band, layers);
     return fig;
 }

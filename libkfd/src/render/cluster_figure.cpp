@@ -65,18 +65,28 @@ std::array<std::uint8_t, 3> ClusterFigure::colourOf(std::int32_t label, bool noi
 std::pair<int, int> ClusterFigure::pixelOf(double x, double y) const {
     // Orthographic top view: the visible height is 2 * half_extent_ metres.
     const double s = 0.5 * opts_.height / half_extent_;
-    return {static_cast<int>(std::lround(0.5 * opts_.width + x * s)),
-            static_cast<int>(std::lround(0.5 * opts_.height - y * s))};
+    return {static_cast<int>(std::lround(0.5 * opts_.width + (x - centre_x_) * s)),
+            static_cast<int>(std::lround(0.5 * opts_.height - (y - centre_y_) * s))};
 }
 
 namespace {
 
+// The bounding box (m) of what a figure fitted to the scan shows: the returns and the sensor.
+struct Box {
+    double min_x = 0.0, max_x = 0.0, min_y = 0.0, max_y = 0.0;  // starts at the sensor
+    void add(double x, double y) {
+        min_x = std::min(min_x, x);
+        max_x = std::max(max_x, x);
+        min_y = std::min(min_y, y);
+        max_y = std::max(max_y, y);
+    }
+};
+
 // The clustered points (each cluster its colour) and the noise points (red, larger, above),
-// and how far they reach (m) when the figure fits the scan.
-double scanPoints(const Scan& scan, const Clusters& c, bool fit,
-                  mrpt::opengl::CPointCloudColoured& pts,
-                  mrpt::opengl::CPointCloudColoured& noise) {
-    double extent = 0.0;
+// and the box they span with the sensor.
+Box scanPoints(const Scan& scan, const Clusters& c, mrpt::opengl::CPointCloudColoured& pts,
+               mrpt::opengl::CPointCloudColoured& noise) {
+    Box box;
     for (std::size_t i = 0; i < scan.size() && i < c.label.size(); ++i) {
         if (!scan.valid[i] || c.label[i] < 0) continue;
         const double a = scan.geometry.angle(i), r = scan.range[i];
@@ -86,9 +96,9 @@ double scanPoints(const Scan& scan, const Clusters& c, bool fit,
         const auto col = ClusterFigure::colourOf(c.label[i], is_noise);
         (is_noise ? noise : pts)
             .insertPoint({x, y, is_noise ? 0.02f : 0.0f, col[0], col[1], col[2]});
-        if (fit) extent = std::max({extent, std::abs(double(x)), std::abs(double(y))});
+        box.add(x, y);
     }
-    return extent;
+    return box;
 }
 
 // Formulas 6-8's ring boundaries r_i = sqrt(i) r_max / sqrt(t), as circles of 180 segments.
@@ -106,30 +116,36 @@ mrpt::opengl::CSetOfLines::Ptr ringLines(std::size_t rings, double r_max) {
     return lines;
 }
 
-// The sensor at the origin (an arrow) and a 1 m scale bar at the bottom left.
-mrpt::opengl::CSetOfLines::Ptr markLines(double he, double half_extent) {
+// The sensor at the origin (an arrow) and a 1 m scale bar at the bottom left of the view
+// centred on (cx, cy).
+mrpt::opengl::CSetOfLines::Ptr markLines(double he, double half_extent, double cx, double cy) {
     auto marks = mrpt::opengl::CSetOfLines::Create();
     marks->setColor_u8(0, 0, 0);
     marks->setLineWidth(2.0f);
     marks->appendLine(-0.15, -0.1, 0.01, 0.25, 0.0, 0.01);
     marks->appendLine(0.25, 0.0, 0.01, -0.15, 0.1, 0.01);
     marks->appendLine(-0.15, 0.1, 0.01, -0.15, -0.1, 0.01);
-    const double bx = -he * 0.9, by = -half_extent * 0.9;
+    const double bx = cx - he * 0.9, by = cy - half_extent * 0.9;
     marks->appendLine(bx, by, 0.01, bx + 1.0, by, 0.01);
     marks->appendLine(bx, by - 0.05, 0.01, bx, by + 0.05, 0.01);
     marks->appendLine(bx + 1.0, by - 0.05, 0.01, bx + 1.0, by + 0.05, 0.01);
     return marks;
 }
 
-// The legend, in a bitmap font on the rendered image.
-void drawLegend(mrpt::img::CImage& img, bool rings) {
+// The title and the legend, in a bitmap font on the rendered image.
+void drawLegend(mrpt::img::CImage& img, const std::string& title, bool rings) {
     const mrpt::img::TColor black(0, 0, 0), red(230, 20, 20);
     img.selectTextFont("6x13");
-    img.textOut(8, 6, "clusters: one colour each", black);
-    img.filledRectangle(8, 24, 16, 32, red);
-    img.textOut(22, 22, "removed as noise", black);
-    img.textOut(8, 38, "1 m grid; bar (bottom left) = 1 m; sensor at centre", black);
-    if (rings) img.textOut(8, 54, "rings: equal-area boundaries", black);
+    int y = 6;
+    if (!title.empty()) {
+        img.textOut(8, y, title, black);
+        y += 16;
+    }
+    img.textOut(8, y, "clusters: one colour each", black);
+    img.filledRectangle(8, y + 18, 16, y + 26, red);
+    img.textOut(22, y + 16, "removed as noise", black);
+    img.textOut(8, y + 32, "1 m grid; bar (bottom left) = 1 m; arrow = sensor", black);
+    if (rings) img.textOut(8, y + 48, "rings: equal-area boundaries", black);
 }
 
 }  // namespace
@@ -144,19 +160,31 @@ mrpt::img::CImage ClusterFigure::render(const Scan& scan, const Clusters& c) {
     auto noise = CPointCloudColoured::Create();
     pts->setPointSize(opts_.point_size);
     noise->setPointSize(2.0f * opts_.point_size);
-    const bool fit = opts_.half_extent_m <= 0;
-    const double extent = std::max(opts_.half_extent_m, scanPoints(scan, c, fit, *pts, *noise));
-    half_extent_ = opts_.half_extent_m > 0 ? opts_.half_extent_m : std::max(1.0, 1.05 * extent);
-    const double he = half_extent_ * std::max(1.0, double(opts_.width) / opts_.height);
+    const Box box = scanPoints(scan, c, *pts, *noise);
+    const double aspect = double(opts_.width) / opts_.height;
+    if (opts_.half_extent_m > 0) {
+        half_extent_ = opts_.half_extent_m;
+        centre_x_ = centre_y_ = 0.0;
+    } else {  // the box with a 5 % margin, at least 1 m high, below the legend's rows
+        const int rows = 3 + (opts_.title.empty() ? 0 : 1) + (opts_.ring_r_max > 0 ? 1 : 0);
+        const double band = std::min(0.5, (16.0 * rows + 8.0) / opts_.height);
+        centre_x_ = 0.5 * (box.min_x + box.max_x);
+        half_extent_ = std::max(
+            {0.5, 0.525 * (box.max_y - box.min_y), 0.525 * (box.max_x - box.min_x) / aspect});
+        half_extent_ /= 1.0 - band;
+        centre_y_ = 0.5 * (box.min_y + box.max_y) + band * half_extent_;
+    }
+    const double he = half_extent_ * aspect;  // half the visible width
     auto grid =
-        CGridPlaneXY::Create(static_cast<float>(-std::ceil(he)), static_cast<float>(std::ceil(he)),
-                             static_cast<float>(-std::ceil(half_extent_)),
-                             static_cast<float>(std::ceil(half_extent_)), -0.01f, 1.0f);
+        CGridPlaneXY::Create(static_cast<float>(std::floor(centre_x_ - he)),
+                             static_cast<float>(std::ceil(centre_x_ + he)),
+                             static_cast<float>(std::floor(centre_y_ - half_extent_)),
+                             static_cast<float>(std::ceil(centre_y_ + half_extent_)), -0.01f, 1.0f);
     grid->setColor_u8(220, 220, 220);
     scene.insert(grid);
     if (opts_.ring_r_max > 0 && opts_.rings > 0)
         scene.insert(ringLines(opts_.rings, opts_.ring_r_max));
-    scene.insert(markLines(he, half_extent_));
+    scene.insert(markLines(he, half_extent_, centre_x_, centre_y_));
     scene.insert(pts);
     scene.insert(noise);
     scene.getViewport()->setCustomBackgroundColor({1.0f, 1.0f, 1.0f, 1.0f});
@@ -164,7 +192,7 @@ mrpt::img::CImage ClusterFigure::render(const Scan& scan, const Clusters& c) {
     cam.setOrthogonal(true);
     cam.setAzimuthDegrees(-90.0f);
     cam.setElevationDegrees(90.0f);
-    cam.setPointingAt(0.0f, 0.0f, 0.0f);
+    cam.setPointingAt(static_cast<float>(centre_x_), static_cast<float>(centre_y_), 0.0f);
     cam.setZoomDistance(static_cast<float>(4.0 * half_extent_));  // visible height = zoom / 2
     mrpt::img::CImage img;
     try {
@@ -172,7 +200,7 @@ mrpt::img::CImage ClusterFigure::render(const Scan& scan, const Clusters& c) {
     } catch (const std::exception& e) {
         throw RenderError(std::string("rendering failed: ") + e.what());
     }
-    drawLegend(img, opts_.ring_r_max > 0);
+    drawLegend(img, opts_.title, opts_.ring_r_max > 0);
     return img;
 }
 

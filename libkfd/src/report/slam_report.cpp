@@ -17,6 +17,7 @@
 #include "kfd/io/gz_output.h"
 #include "kfd/io/png_output.h"
 #include "kfd/mrpt/default_stages.h"
+#include "kfd/mrpt/stream_filter.h"
 #include "kfd/os/cancel.h"
 #include "kfd/os/output_paths.h"
 #include "kfd/pipeline/format.h"
@@ -154,6 +155,20 @@ Trajectory inFrame(const Trajectory& t, const MapFrame& f) {
     return out;
 }
 
+}  // namespace
+
+std::string mapTitle(const IcpSlamSummary& sum) {
+    std::string t = fs::path(sum.rawlog).filename().string() + "  mode " + toString(sum.mode) +
+                    format("  dropped %.1f %%", sum.dropped_pct);
+    if (sum.ate_rmse) t += format("  ATE %.3f m", *sum.ate_rmse);
+    t += sum.lost_track_stamps.empty()
+             ? std::string("  no lost track")
+             : "  " + plural(sum.lost_track_stamps.size(), "suspected lost track");
+    return t;
+}
+
+namespace {
+
 // Writes final_map.simplemap, map.png and map_figure.png; returns the figure's layers.
 std::vector<MapFigureLayer> writeMap(const IcpSlamResult& res, const StagedOutputFolder& out) {
     const auto& sum = res.summary;
@@ -192,7 +207,9 @@ std::vector<MapFigureLayer> writeMap(const IcpSlamResult& res, const StagedOutpu
     fig.track = res.track;                // put on the estimate's start by the figure
     fig.keyframes = res.keyframes;
     fig.corridor = res.corridor;
-    fig.title = fs::path(sum.rawlog).filename().string() + "  mode " + toString(sum.mode);
+    for (const double t : sum.lost_track_stamps)
+        if (const auto k = nearest(fig.estimate, t, 1.0)) fig.lost_tracks.push_back(*k);
+    fig.title = mapTitle(sum);
     if (frame.origin.x() != 0.0 || frame.origin.y() != 0.0)
         fig.title += format("  (origin at x %.0f, y %.0f m)", frame.origin.x(), frame.origin.y());
     const MapFigure drawn = renderMapFigure(fig);
@@ -242,6 +259,8 @@ void scansJson(Json& j, const IcpSlamSummary& s) {
     j["points_removed"] = s.points_removed;
     j["points_removed_noise"] = s.points_removed_noise;
     j["max_removed_noise_share"] = s.max_removed_noise_share;  // of a kept scan's valid returns
+    j["reasons"] = nlohmann::ordered_json::object();           // scans per keep/drop reason
+    for (const auto& [name, n] : s.reasons) j["reasons"][name] = n;
 }
 
 // ICP's corrections, their verdicts, re-matching and the guards under the SLAM's gate.
@@ -350,7 +369,7 @@ std::string gateText(const IcpSlamSummary& s) {
                           s.guard_rotation_deg_configured, s.guard_rotation_deg);
     if (lowered.empty()) return {};
     return "  guards     keyframe guards lowered to the SLAM's localisation gate: " + lowered +
-           "\n";
+           " (kfd-filter has no ICP gate: with the same [KFD] it keeps fewer scans)\n";
 }
 
 }  // namespace
@@ -358,11 +377,15 @@ std::string gateText(const IcpSlamSummary& s) {
 std::string summaryText(const IcpSlamSummary& s) {
     std::string t = format("kfd-icp-slam summary (mode %s)\n", toString(s.mode));
     t += format("  input      %s\n  output     %s\n", s.rawlog.c_str(), s.output_dir.c_str());
-    t += format("  scans      in %zu, kept %zu, dropped %.1f %%\n", s.scans_in, s.scans_kept,
-                s.dropped_pct);
+    t += format("  scans      in %zu, kept %zu, dropped %.1f %% (scans not passed on, of all read)",
+                s.scans_in, s.scans_kept, s.dropped_pct);
+    t += s.scans_kept_for_recovery
+             ? format("; %zu of the kept went to ICP for its recovery\n", s.scans_kept_for_recovery)
+             : std::string("\n");
     if (const std::string n = scansNotIn(s); !n.empty()) t += "             not in: " + n + "\n";
     t += format("  points     removed %zu of %zu\n", s.points_removed, s.points_in);
     t += gateText(s);
+    for (const std::string& line : reasonLines(s)) t += "  " + line + "\n";
     t += format(
         "  time       pre-filter %.1f us/scan, ICP-SLAM %.3f ms/scan, CPU %.2f s, wall %.2f s\n",
         s.prefilter_us_per_scan, s.icp_ms_per_scan, s.cpu_s_total, s.wall_s_total);

@@ -2,6 +2,8 @@
 // (beyond the paper; each 0 = off, all off in the paper presets). std only.
 #pragma once
 
+#include <string_view>
+
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -26,6 +28,9 @@ enum class KeyframeReason : std::uint8_t {
     TrackOdometry,  // view selector, tracker: the scans moved where the odometry does not
 };
 const char* toString(KeyframeReason r);
+/// What a reason means, in one phrase for summaries ("dropped: the last keyframe still covers
+/// the view ..."); `name` is toString()'s text; nullptr for a name that is no KeyframeReason.
+const char* describeKeyframeReason(std::string_view name);
 
 /// Outcome of one keyframe decision, with diagnostics (the keyframe and view_keyframe stages').
 struct KeyframeDecision {

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "kfd/algorithms/odometry_check.h"
@@ -65,6 +66,19 @@ struct ScanCounters {
     double filter_seconds = 0.0;           // time inside the pipeline's stages
     /// The listed stages' own counters (kfd/pipeline/stage_outputs.h), in pipeline order.
     std::vector<StageTotal> stage_totals;
+    /// Scans per ScanRecord::reason ("covered", "view_change", "motion", ...), first seen first.
+    std::vector<std::pair<std::string, std::size_t>> reasons;
+    /// The kept scans whose denoisers removed the largest shares of their returns, largest
+    /// first (at most kMostRemoved): where to look first (kfd-render --index).
+    struct Removal {
+        std::size_t index = 0;    // ScanRecord::index
+        double stamp = 0.0;       // s
+        std::size_t removed = 0;  // noise points removed
+        std::size_t usable = 0;   // returns the denoisers saw
+        double share() const { return usable ? double(removed) / double(usable) : 0.0; }
+    };
+    static constexpr std::size_t kMostRemoved = 5;
+    std::vector<Removal> most_removed;
     /// The stage counter called `name`, 0 when no listed stage declares it.
     double stageTotal(std::string_view name) const { return totalOf(stage_totals, name); }
 

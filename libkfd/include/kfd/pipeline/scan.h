@@ -139,6 +139,7 @@ struct Scan {
     ScanGeometry geometry;
     std::vector<float> range;         // m, one per beam
     std::vector<std::uint8_t> valid;  // 1 = usable, 0 = invalid or removed
+    std::vector<float> intensity;     // one per beam (the driver's units), or empty: none
     double timestamp = std::numeric_limits<double>::quiet_NaN();  // s (any epoch), NaN = unknown
     std::optional<Pose2D> odometry;  // absolute odometry at the scan, when known
     Pose2D sensor_pose;              // the sensor on the robot (MRPT's sensorPose), m and rad

@@ -143,17 +143,17 @@ class Stage {
     virtual const Clusters* clusters() const { return nullptr; }
 };
 
-/// A stage around a denoising algorithm `Algo` (Params, and Result filter(Scan&) with a
-/// points_removed field): never drops a scan, reports its removals as noise, and keeps the
+/// A stage around a beam filter `Algo` (Params, and Result filter(Scan&) with a points_removed
+/// field): never drops a scan, counts its removals (as noise when `noise`), and keeps the
 /// algorithm's Result as the diagnostics. A concrete stage adds kName, kHelp, keys() and name().
 template <class Algo>
-class DenoisingStage : public Stage {
+class BeamFilterStage : public Stage {
   public:
     using Params = typename Algo::Params;
-    explicit DenoisingStage(const Params& p) : algo_(p) {}
+    BeamFilterStage(const Params& p, bool noise) : algo_(p), noise_(noise) {}
     bool process(Scan& scan, StageReport& report, const ScanReport&) override {
         const auto r = algo_.filter(scan);
-        report.noise = true;
+        report.noise = noise_;
         report.points_removed = r.points_removed;
         report.setDiagnostics(r);
         return true;
@@ -165,6 +165,14 @@ class DenoisingStage : public Stage {
 
   private:
     Algo algo_;
+    bool noise_;
+};
+
+/// A denoiser's stage: its removals are noise (the denoising scores and bounds count them).
+template <class Algo>
+class DenoisingStage : public BeamFilterStage<Algo> {
+  public:
+    explicit DenoisingStage(const typename Algo::Params& p) : BeamFilterStage<Algo>(p, true) {}
 };
 
 /// A stage's parameters behind a type-erased handle, so that one Pipeline::Params can hold the

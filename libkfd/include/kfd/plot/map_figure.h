@@ -21,9 +21,10 @@ struct MapFigureInput {
     Trajectory ground_truth;  // any frame: aligned to the estimate (SE(2), least squares)
     Trajectory odometry;      // any frame: its first pose is put on the estimate's first pose
     Trajectory track;         // kfd's scan track (laser odometry): put on the estimate's start too
-    std::vector<std::size_t> keyframes;  // indices into `estimate` of scans that were kept
-    std::vector<std::size_t> corridor;   // indices into `estimate` of degenerate scans (orange)
-    std::string title;
+    std::vector<std::size_t> keyframes;    // indices into `estimate` of scans that were kept
+    std::vector<std::size_t> corridor;     // indices into `estimate` of degenerate scans (orange)
+    std::vector<std::size_t> lost_tracks;  // indices into `estimate` where a lost track began
+    std::string title;  // e.g. mapTitle(): the log, the mode, drop rate, ATE, lost tracks
     /// The pixel budget of the whole image (legend band included): its longest side and its
     /// area. The map is drawn at the grid's cell size unless that exceeds the budget; then each
     /// pixel covers a larger square (and shows the most occupied cell under it).
@@ -57,10 +58,12 @@ struct MapFigure {
     int scale_bar_px = 0, scale_bar_row = 0;
 };
 
-/// Draws with MRPT's 2D canvas (no OpenGL): the grid's known cells (+y up), the odometry
-/// (grey), kfd's scan track (purple), the ground truth (green), the estimate (blue) with keyframes
-/// as small dots and the scans the corridor switch found degenerate in orange. The map part spans
-/// what is drawn (the grid's known cells and the finite poses of the drawn trajectories, plus
+/// Draws with MRPT's 2D canvas (no OpenGL): the grid's known cells (+y up), then, from the
+/// bottom up and each narrower than the one below so that every one shows even where they
+/// coincide: the ground truth (green, 7 px), kfd's scan track (purple, 5 px), the scans the
+/// corridor switch found degenerate (orange squares), the keyframes (navy squares), the estimate
+/// (blue, 3 px), the odometry (grey, 1 px), and red crosses where a lost track began. The map part
+/// spans what is drawn (the grid's known cells and the finite poses of the drawn trajectories, plus
 /// margin_m; never the grid's empty extent or the origin for its own sake) at the grid's cell size,
 /// coarser when that exceeds the budget. Above it, a white band holds the title, the legend (one
 /// entry per drawn layer) and a scale bar (1, 2 or 5 times a power of ten metres, at least 20

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "kfd/paper/clusters.h"
@@ -23,7 +24,9 @@ class RenderError : public Error {
 
 struct ClusterFigureOptions {
     int width = 800, height = 800;  // px: 16 to 10 000 a side, at most 40 million pixels
-    double half_extent_m = 0.0;     // half the visible height (m); 0 = fit the scan
+    double half_extent_m = 0.0;     // half the visible height (m), centred on the sensor; 0 = fit
+                                    // the returns and the sensor, centred on them
+    std::string title;              // first line above the legend (e.g. log, scan, counts)
     double ring_r_max = 0.0;        // draw t faint equal-area ring boundaries up to this (m)
     std::size_t rings = 5;          // t
     float point_size = 4.0f;        // px
@@ -32,7 +35,9 @@ struct ClusterFigureOptions {
 /// Renders, top-down with +x right and +y up: each kept cluster in its own colour, removed
 /// points (invalid in `scan` but labelled in `clusters`, or flagged noise) in red and larger, the
 /// ring boundaries faintly, the sensor at the origin, a 1 m grid and a 1 m scale bar (bottom
-/// left). Needs no display: the OpenGL context is OSMesa's.
+/// left), the title and the legend. Without an extent the view is the smallest square (or the
+/// image's aspect) around the drawn returns and the sensor, with a 5 % margin. Needs no
+/// display: the OpenGL context is OSMesa's.
 class ClusterFigure {
   public:
     explicit ClusterFigure(const ClusterFigureOptions& opts = {});
@@ -56,6 +61,7 @@ class ClusterFigure {
     std::unique_ptr<Impl> impl_;
     ClusterFigureOptions opts_;
     double half_extent_ = 1.0;
+    double centre_x_ = 0.0, centre_y_ = 0.0;  // m: the view's centre in the last render
 };
 
 }  // namespace kfd

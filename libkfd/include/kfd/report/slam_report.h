@@ -21,6 +21,11 @@ std::string toJson(const IcpSlamSummary& s);
 /// target, one line each.
 std::string summaryText(const IcpSlamSummary& s);
 
+/// The map figure's title: the log's file name, the mode, the drop rate, the ATE when known and
+/// the suspected lost tracks ("fr079.rawlog  mode kfd  dropped 59.8 %  ATE 0.120 m  no lost
+/// track").
+std::string mapTitle(const IcpSlamSummary& s);
+
 /// report.md's text: every number summaryText() prints, with its unit (the local and long
 /// relations error with their counts, used and unmatched), and the map figure with a caption
 /// naming exactly `figure_layers` (what renderMapFigure drew; mapFigureCaption).

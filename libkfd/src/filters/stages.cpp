@@ -1,0 +1,11 @@
+#include "kfd/filters/stages.h"
+
+namespace kfd {
+
+void registerFilterStages(StageRegistry& registry) {
+    registry.add<AngleBoundsStage>();
+    registry.add<FootprintStage>();
+    registry.add<IntensityStage>();
+}
+
+}  // namespace kfd
