@@ -94,6 +94,11 @@ void printObjects(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
                     s.objects_in, s.objects_out, s.objects_dropped,
                     kfd::plural(s.points_marked, "removed point").c_str(),
                     kfd::toString(o.bag.removed));
+        std::printf(
+            "  compress %s%s (--bag-compression none|lz4|bz2|zstd; lz4 or none write fastest)\n",
+            s.output_compression.c_str(),
+            o.bag.compression == kfd::BagWriterOptions::Compression::AsInput ? ", as the input"
+                                                                             : "");
         if (s.messages_left_out)
             std::printf(
                 "  left out %zu ROS 1 messages of types kfd cannot write as ROS 2 (it "

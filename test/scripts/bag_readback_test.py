@@ -37,6 +37,11 @@ class BagReadback(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         kept = int(re.search(r"scans +in \d+, kept (\d+)", r.stdout).group(1))
         marked = int(re.search(r"(\d+) removed points written as nan", r.stdout).group(1))
+        # the summary says the output's chunk compression, as rosbag reads it (issue 37)
+        said = re.search(r"compress +(\w+), as the input", r.stdout).group(1)
+        with rosbag.Bag(src) as b, rosbag.Bag(out) as o:
+            self.assertEqual(said, o.get_compression_info().compression)
+            self.assertEqual(said, b.get_compression_info().compression)
 
         def others(path):
             with rosbag.Bag(path) as b:
