@@ -59,18 +59,18 @@ void addOptions(kfd::app::Cli& cli, Options& o) {
         ->type_name("M");
 }
 
-// The number (0-based, among the log's 2D scans) of the scan --index or --time names: with
-// --time a first pass over the log finds the nearest stamp.
-long chosenNumber(const Options& o) {
+// The number (0-based, among the log's 2D scans) of the scan nearest to --time: a first pass
+// over the log (--index needs none).
+long nearestNumber(const Options& o) {
     const auto source = kfd::openSource(o.in, o.source);
     kfd::SourceEntry entry;
     long n = 0, best_n = -1;
     double best = 1e300;
-    while ((o.index < 0 || n <= o.index) && source->next(entry)) {
+    while (source->next(entry)) {
         kfd::throwIfCancelled();
         entry.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
             const double d = std::abs(kfd::stampOf(*s) - o.stamp);
-            if ((o.index >= 0 && n == o.index) || (o.index < 0 && d < best)) {
+            if (d < best) {
                 best = d;
                 best_n = n;
             }
@@ -78,10 +78,6 @@ long chosenNumber(const Options& o) {
         });
     }
     if (n == 0) throw std::runtime_error("no laser scan in " + o.in);
-    if (best_n < 0)
-        throw std::runtime_error("no scan " + std::to_string(o.index) + " in " + o.in +
-                                 ": it holds " + std::to_string(n) +
-                                 " 2D scans (--index counts from 0)");
     return best_n;
 }
 
@@ -127,6 +123,11 @@ Decided decide(const Options& o, long number, kfd::StreamFilter& door) {
             ++n;
         });
     }
+    if (n == 0) throw std::runtime_error("no laser scan in " + o.in);
+    if (!d.scan)
+        throw std::runtime_error("no scan " + std::to_string(number) + " in " + o.in +
+                                 ": it holds " + std::to_string(n) +
+                                 " 2D scans (--index counts from 0)");
     if (!finished) door.finish();
     d.result = *finished;
     if (d.result.skipped != kfd::ScanSkipReason::None) {
@@ -217,7 +218,7 @@ int main(int argc, char** argv) {
         kfd::app::checkOutputPaths({{"input log", o.in}, {"configuration", o.cfg}},
                                    {{"output image", o.out}});
         const kfd::Pipeline::Params p = kfd::app::loadConfig(o.cfg, "kfd-render");
-        const long number = chosenNumber(o);
+        const long number = o.index >= 0 ? o.index : nearestNumber(o);
         kfd::StreamFilter door(p, {}, true);
         door.setLaserOnly(o.laser_only);
         const Decided d = decide(o, number, door);

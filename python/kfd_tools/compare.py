@@ -345,8 +345,7 @@ def say_what_is_judged(a):
                                                 a.baseline), file=sys.stderr)
     for c in a.configs:
         print("[kfd-compare] %s: %s (CPU ratios hold for this ICP config; --icp both runs "
-              "both schedules)" % (config_tag(c), kfd_report.icp_schedule(
-                  [{"command": ["", c]}])), file=sys.stderr)
+              "both schedules)" % (config_tag(c), kfd_report.icp_schedule_of(c)), file=sys.stderr)
 
 
 def plan(a):

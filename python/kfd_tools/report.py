@@ -374,10 +374,14 @@ def max_dt(runs):
 
 
 def icp_schedule(runs):
-    """Which ICP config the runs' CPU ratio holds for, read from their config file: 'ICP on
-    every scan' or 'ICP after L m / A deg of odometry' (icp-slam's localizationLinDistance and
-    localizationAngDistance)."""
-    path = next((r["command"][1] for r in runs if len(r.get("command") or []) > 1), None)
+    """Which ICP config the runs' CPU ratio holds for: icp_schedule_of their config file."""
+    return icp_schedule_of(next((r["command"][1] for r in runs
+                                 if len(r.get("command") or []) > 1), None))
+
+
+def icp_schedule_of(path):
+    """'ICP on every scan' or 'ICP after L m / A deg of odometry', read from a kfd-icp-slam
+    config (icp-slam's localizationLinDistance and localizationAngDistance)."""
     try:
         with open(path) as f:
             text = f.read()

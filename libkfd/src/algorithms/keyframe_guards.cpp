@@ -1,7 +1,6 @@
 #include "kfd/algorithms/keyframe_guards.h"
 
 #include <cmath>
-#include <utility>
 
 #include "kfd/algorithms/pose.h"
 #include "kfd/pipeline/error.h"
@@ -38,32 +37,50 @@ const char* toString(KeyframeReason r) {
     return "unknown";
 }
 
+namespace {
+
+const char* describe(KeyframeReason r) {
+    switch (r) {
+        case KeyframeReason::First:
+            return "kept: the sensor's first scan";
+        case KeyframeReason::Dissimilar:
+            return "kept by the paper's rule: its histogram correlates below P_pair^m with the "
+                   "last m keyframes (Formula 3)";
+        case KeyframeReason::Similar:
+            return "dropped by the paper's rule: its histogram correlates with the last m "
+                   "keyframes (Formula 3)";
+        case KeyframeReason::ViewChange:
+            return "kept: the view moved beyond the last keyframe's (max_view_change)";
+        case KeyframeReason::Covered:
+            return "dropped: the view has not moved beyond the last keyframe's, which still "
+                   "covers it (the view selector)";
+        case KeyframeReason::MaxDrops:
+            return "kept by a guard: max_consecutive_drops scans dropped in a row";
+        case KeyframeReason::MaxInterval:
+            return "kept by a guard: max_interval_s since the last keyframe";
+        case KeyframeReason::Translation:
+            return "kept by a guard: max_translation_m of odometry since the last keyframe";
+        case KeyframeReason::Rotation:
+            return "kept by a guard: max_rotation_deg of odometry since the last keyframe";
+        case KeyframeReason::Corridor:
+            return "kept: a degenerate view (corridor), where the selector switches to odometry "
+                   "or time";
+        case KeyframeReason::TrackPoor:
+            return "kept: the scan tracker could not align it to the last keyframe";
+        case KeyframeReason::TrackOdometry:
+            return "kept: its tracked motion and the odometry disagree (max_track_disagreement)";
+    }
+    return nullptr;
+}
+
+}  // namespace
+
 const char* describeKeyframeReason(std::string_view name) {
-    static const std::pair<const char*, const char*> kMeaning[] = {
-        {"first", "kept: the sensor's first scan"},
-        {"dissimilar",
-         "kept by the paper's rule: its histogram correlates below P_pair^m with the "
-         "last m keyframes (Formula 3)"},
-        {"similar",
-         "dropped by the paper's rule: its histogram correlates with the last m "
-         "keyframes (Formula 3)"},
-        {"view_change", "kept: the view moved beyond the last keyframe's (max_view_change)"},
-        {"covered",
-         "dropped: the view has not moved beyond the last keyframe's, which still "
-         "covers it (the view selector)"},
-        {"max_drops", "kept by a guard: max_consecutive_drops scans dropped in a row"},
-        {"max_interval", "kept by a guard: max_interval_s since the last keyframe"},
-        {"translation", "kept by a guard: max_translation_m of odometry since the last keyframe"},
-        {"rotation", "kept by a guard: max_rotation_deg of odometry since the last keyframe"},
-        {"corridor",
-         "kept: a degenerate view (corridor), where the selector switches to "
-         "odometry or time"},
-        {"track_poor", "kept: the scan tracker could not align it to the last keyframe"},
-        {"track_odometry",
-         "kept: its tracked motion and the odometry disagree "
-         "(max_track_disagreement)"}};
-    for (const auto& [n, meaning] : kMeaning)
-        if (name == n) return meaning;
+    // Every reason by its toString() name: one list of names, the enum's.
+    for (int i = 0; i <= static_cast<int>(KeyframeReason::TrackOdometry); ++i) {
+        const auto r = static_cast<KeyframeReason>(i);
+        if (name == toString(r)) return describe(r);
+    }
     return nullptr;
 }
 

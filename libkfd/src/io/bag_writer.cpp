@@ -33,6 +33,22 @@ BagWriterOptions::Compression parseBagCompression(const std::string& text) {
     throw Error("'" + text + "' is not a bag compression (input, none, lz4, bz2 or zstd)");
 }
 
+const char* toString(BagWriterOptions::Compression c) {
+    switch (c) {
+        case BagWriterOptions::Compression::AsInput:
+            return "input";
+        case BagWriterOptions::Compression::None:
+            return "none";
+        case BagWriterOptions::Compression::Lz4:
+            return "lz4";
+        case BagWriterOptions::Compression::Bz2:
+            return "bz2";
+        case BagWriterOptions::Compression::Zstd:
+            return "zstd";
+    }
+    return "none";
+}
+
 namespace {
 
 // A rosbag::Bag whose write failed cannot be destroyed: its destructor closes it, closing writes

@@ -314,30 +314,17 @@ void Run::prepare() {
     }
 }
 
-// "none", "lz4", "bz2", "zstd" (AsInput once resolved is one of them; "none" for AsInput).
-const char* compressionName(BagWriterOptions::Compression c) {
-    switch (c) {
-        case BagWriterOptions::Compression::Lz4:
-            return "lz4";
-        case BagWriterOptions::Compression::Bz2:
-            return "bz2";
-        case BagWriterOptions::Compression::Zstd:
-            return "zstd";
-        default:
-            return "none";
-    }
-}
-
 // Both outputs are written under temporary names beside them and renamed at the end; on any
 // failure or cancellation the destructors remove them.
 void Run::openOutputs() {
     asRawlogError([&] { tmp_.emplace(opts_.output); });
     if (sum_.output_format == LogFormat::Bag) {
-        BagWriterOptions bag = opts_.bag;  // AsInput: the input bag's compression
-        if (bag.compression == BagWriterOptions::Compression::AsInput)
-            if (const auto* in = dynamic_cast<const BagSource*>(source_.get()))
-                bag.compression = parseBagCompression(in->compression());
-        sum_.output_compression = compressionName(bag.compression);
+        BagWriterOptions bag = opts_.bag;  // AsInput: the input bag's compression, else none
+        if (bag.compression == BagWriterOptions::Compression::AsInput) {
+            const auto* in = dynamic_cast<const BagSource*>(source_.get());
+            bag.compression = parseBagCompression(in ? in->compression() : "none");
+        }
+        sum_.output_compression = toString(bag.compression);
         asRawlogError(
             [&] { bag_ = std::make_unique<BagWriter>(tmp_->path().string(), bag, opts_.output); },
             opts_.output);
@@ -351,9 +338,8 @@ void Run::openOutputs() {
                     bag.compression = parseBagCompression(
                         c == "none" || c == "lz4" || c == "zstd" ? c : std::string("zstd"));
                 }
-                sum_.output_compression = sum_.output_format == LogFormat::Mcap
-                                              ? compressionName(bag.compression)
-                                              : "none";
+                sum_.output_compression =
+                    sum_.output_format == LogFormat::Mcap ? toString(bag.compression) : "none";
                 bag_ = std::make_unique<Ros2Writer>(tmp_->path().string(), sum_.output_format, bag,
                                                     opts_.output);
             },

@@ -32,6 +32,8 @@ struct BagWriterOptions {
 /// "input", "none", "lz4", "bz2" or "zstd" (a bag's chunk compression, BagSource::compression());
 /// throws kfd::Error on anything else.
 BagWriterOptions::Compression parseBagCompression(const std::string& text);
+/// parseBagCompression's text: "input", "none", "lz4", "bz2" or "zstd".
+const char* toString(BagWriterOptions::Compression c);
 
 /// A bag output of kfd-filter, whatever its format (BagWriter: ROS 1; Ros2Writer: rosbag2's
 /// .db3 or MCAP, kfd/io/ros2_writer.h): the input's messages copied, the kept scans written.
