@@ -99,6 +99,11 @@ void printObjects(const kfd::RawlogFilterOptions& o, const kfd::RawlogFilterSumm
             s.output_compression.c_str(),
             o.bag.compression == kfd::BagWriterOptions::Compression::AsInput ? ", as the input"
                                                                              : "");
+        for (const std::string& t : s.unread_scans)
+            std::printf(
+                "  not filtered: %s, copied as it is (kfd reads sensor_msgs/LaserScan "
+                "only)\n",
+                t.c_str());
         if (s.messages_left_out)
             std::printf(
                 "  left out %zu ROS 1 messages of types kfd cannot write as ROS 2 (it "

@@ -1,5 +1,5 @@
-// The laser_filters-style stages (angle_bounds, footprint, intensity) through the door on real
-// logs: what each removes is exactly what it should, and nothing else.
+// The laser_filters-style stages (beam_count, angle_bounds, footprint, intensity) through the door
+// on real logs: what each removes is exactly what it should, and nothing else.
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -103,6 +103,55 @@ TEST(FilterStagesOnRealLogs, IntensityLeavesALogWithoutIntensitiesAsItIsAndCount
     EXPECT_EQ(scans, 360u);
     EXPECT_EQ(changed, 0u);
     EXPECT_EQ(kfd::totalOf(totals, "scans_without_intensity"), 360.0);
+}
+
+// The RPLIDAR rosbag2 with the count varying as an RPLIDAR driver's does (every other scan one
+// beam short, every third two beams long): with beam_count every scan leaves with the first
+// scan's 360 beams over the same aperture and the chain never restarts; without it, it
+// restarts at every change. Each output range is an input beam's or lies between two
+// neighbours'.
+TEST(FilterStagesOnRealLogs, BeamCountFixesAVaryingCountOnTheRplidarBag) {
+    const std::string log = dataset("mumble-rplidar-ros2/no_loop_room");
+    if (!std::filesystem::exists(log)) GTEST_SKIP() << "dataset missing: " << log;
+    const std::string chain = "distance, view_keyframe, evidence_denoise]\n";
+    for (const bool fixed : {true, false}) {
+        kfd::StreamFilter filter(
+            kfd::loadYamlText(std::string("pipeline: [") + (fixed ? "beam_count, " : "") + chain));
+        auto source = kfd::openSource(log);
+        kfd::SourceEntry e;
+        std::size_t scans = 0, resets = 0, wrong_count = 0, made_up = 0, kept = 0;
+        while (source->next(e))
+            e.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
+                const std::size_t n = s->getScanSize() - (scans % 2) + (scans % 3 == 2 ? 2 : 0);
+                s->resizeScan(n);  // MRPT keeps the aperture: the beams spread over it
+                kfd::Scan before;
+                kfd::toCore(*s, before);
+                const auto r = filter.process(*s, e.odometry);
+                resets += r.geometry_reset;
+                kept += r.keep;
+                ++scans;
+                if (!fixed) return;
+                wrong_count += s->getScanSize() != 360;
+                const double scale = double(n - 1) / 359.0;
+                for (std::size_t j = 0; j < s->getScanSize(); ++j) {
+                    if (!s->getScanRangeValidity(j)) continue;
+                    const auto i0 = static_cast<std::size_t>(std::min(j * scale, double(n - 1)));
+                    const std::size_t i1 = std::min(i0 + 1, n - 1);
+                    const float lo = std::min(before.range[i0], before.range[i1]);
+                    const float hi = std::max(before.range[i0], before.range[i1]);
+                    made_up += s->getScanRange(j) < lo - 1e-5f || s->getScanRange(j) > hi + 1e-5f;
+                }
+            });
+        EXPECT_EQ(scans, 508u);
+        if (fixed) {
+            EXPECT_EQ(resets, 0u);
+            EXPECT_EQ(wrong_count, 0u);
+            EXPECT_EQ(made_up, 0u);
+            EXPECT_LT(kept, scans / 2);  // the keyframe selector works on the fixed count
+        } else {
+            EXPECT_GT(resets, scans / 2);
+        }
+    }
 }
 
 }  // namespace

@@ -378,3 +378,64 @@ TEST(StreamFilter, WithoutNextScanEveryDoneRunsDuringItsOwnProcessCall) {
         EXPECT_EQ(calls, k + 1);
     }
 }
+
+namespace {
+
+// A "denoiser" that removes beams [first, last] of every scan as noise.
+struct WallEater : kfd::Stage {
+    std::size_t first, last;
+    WallEater(std::size_t f, std::size_t l) : first(f), last(l) {}
+    const char* name() const override { return "wall_eater"; }
+    bool process(kfd::Scan& scan, kfd::StageReport& report, const kfd::ScanReport&) override {
+        for (std::size_t i = first; i <= last; ++i) {
+            report.points_removed += scan.valid[i];
+            scan.valid[i] = 0;
+        }
+        report.noise = true;
+        return true;
+    }
+};
+
+}  // namespace
+
+// Issue 37: a denoiser's removal that looks like a surface (a straight run of >= 0.5 m) is
+// measured per scan (CSV surface_m), counted and listed in the summary's reasons; removing the
+// same beams for another reason (not noise) is not flagged.
+TEST(StreamFilter, ARemovedPieceOfWallIsFlaggedCountedAndListed) {
+    for (const bool noise : {true, false}) {
+        kfd::Pipeline::Params p;
+        p.stages = {};
+        struct NotNoise : WallEater {
+            using WallEater::WallEater;
+            bool process(kfd::Scan& s, kfd::StageReport& r, const kfd::ScanReport& c) override {
+                WallEater::process(s, r, c);
+                r.noise = false;
+                return true;
+            }
+        };
+        // Beams 170..200: -5 to +10 degrees of a wall 3 m ahead, 0.79 m of it.
+        kfd::StreamFilter f(p, [noise](kfd::Pipeline& pl) {
+            if (noise)
+                pl.add(std::make_unique<WallEater>(170, 200));
+            else
+                pl.add(std::make_unique<NotNoise>(170, 200));
+        });
+        auto s = roomScan(361, M_PI, 3.0);
+        const auto r = f.process(s);
+        ASSERT_TRUE(r.keep);
+        std::string lines;
+        for (const auto& l : kfd::reasonLines(f.counters())) lines += l + "\n";
+        if (noise) {
+            EXPECT_NEAR(r.record.surface_m, 3.0 * (std::tan(M_PI / 18) + std::tan(M_PI / 36)),
+                        0.01);
+            EXPECT_EQ(f.counters().scans_surface_removed, 1u);
+            EXPECT_NE(lines.find("looks like a surface: on 1 kept scans"), std::string::npos)
+                << lines;
+            EXPECT_NE(lines.find("scan 0 0.79 m;"), std::string::npos) << lines;
+        } else {
+            EXPECT_EQ(r.record.surface_m, 0.0);
+            EXPECT_EQ(f.counters().scans_surface_removed, 0u);
+            EXPECT_EQ(lines.find("looks like a surface"), std::string::npos) << lines;
+        }
+    }
+}

@@ -190,7 +190,7 @@ TEST(IcpSlamRunner, ScansCsvIsTheDoorsRecordWithThePose) {
     const std::size_t n = slam[0].size(), kept_col = col("kept"), goodness = col("icp_goodness"),
                       x = col("x");
     EXPECT_EQ(kept_col, 3u);
-    EXPECT_EQ(col("odometry_check"), 9u);  // the first stage's first column
+    EXPECT_EQ(col("odometry_check"), 10u);  // the first stage's first column
     EXPECT_EQ(x, n - 3);
     std::size_t kept = 0, corrected = 0, rejected = 0;
     for (std::size_t i = 1; i < slam.size(); ++i) {

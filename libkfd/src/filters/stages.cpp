@@ -3,6 +3,7 @@
 namespace kfd {
 
 void registerFilterStages(StageRegistry& registry) {
+    registry.add<BeamCountStage>();
     registry.add<AngleBoundsStage>();
     registry.add<FootprintStage>();
     registry.add<IntensityStage>();

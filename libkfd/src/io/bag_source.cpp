@@ -31,6 +31,7 @@ using mrpt::obs::CObservation2DRangeScan;
 using mrpt::obs::CObservationOdometry;
 
 constexpr const char* kLaserScan = "sensor_msgs/LaserScan";
+constexpr const char* kMultiEcho = "sensor_msgs/MultiEchoLaserScan";
 constexpr const char* kOdometry = "nav_msgs/Odometry";
 constexpr const char* kTfMessage = "tf2_msgs/TFMessage";
 constexpr double kLookaheadSeconds = 10.0;  // bag time searched for the odometry after a scan
@@ -220,11 +221,31 @@ void chooseMount(MessageStore& bag, const std::map<std::string, TopicInfo>& topi
     c.notes.push_back(buf);
 }
 
+// The scan topics kfd does not read (MultiEchoLaserScan), each said in the notes; when the bag
+// has no LaserScan to read, the error says what it holds instead.
+void chooseScans(const std::map<std::string, TopicInfo>& topics, const SourceOptions& o,
+                 BagChoice& c) {
+    for (const auto& [name, info] : topics)
+        if (isType(info.type, kMultiEcho))
+            c.unread_scans.push_back(name + " (" + kMultiEcho + ", " +
+                                     plural(info.count, "message") + ")");
+    try {
+        c.scan_topic = pickTopic(topics, o.scan_topic, kLaserScan, {"/scan", "scan"}, "scans",
+                                 "--scan-topic", c.notes, true);
+    } catch (const BagError& e) {
+        if (c.unread_scans.empty()) throw;
+        throw BagError(std::string(e.what()) + "; kfd reads " + kLaserScan + " only, not " +
+                       c.unread_scans.front() + " (convert one echo to a LaserScan topic first)");
+    }
+    for (const std::string& t : c.unread_scans)
+        c.notes.push_back("not read: " + t + ": kfd reads " + kLaserScan +
+                          " only; a bag output copies it unfiltered");
+}
+
 BagChoice choose(MessageStore& bag, const std::map<std::string, TopicInfo>& topics,
                  const SourceOptions& o) {
     BagChoice c;
-    c.scan_topic = pickTopic(topics, o.scan_topic, kLaserScan, {"/scan", "scan"}, "scans",
-                             "--scan-topic", c.notes, true);
+    chooseScans(topics, o, c);
     c.odom_frame = o.odom_frame.empty() ? "odom" : frameWithoutSlash(o.odom_frame);
     std::string tf_topic;
     for (const char* t : {"/tf", "tf"})
@@ -518,7 +539,9 @@ std::string BagSource::compression() const { return impl_->store->compression();
 std::string BagSource::kind() const { return impl_->store->kind(); }
 
 SourceListing listBag(const std::string& path, const SourceOptions& options) {
-    const auto store = openMessageStore(path, true);  // a listing checks every chunk
+    // The index only: the chunks are read (and checked) as the first messages need them
+    // (choose() reads a few), so a compressed bag is listed without decompressing it whole.
+    const auto store = openMessageStore(path, false);
     SourceListing l;
     l.path = path;
     l.format = detectFormat(path);

@@ -72,10 +72,43 @@ mrpt::obs::CObservation2DRangeScan::Ptr laserScanToObservation(const sensor_msgs
     return obs;
 }
 
+namespace {
+
+// `m` rewritten as `cleaned`, a scan the stages resampled (beam_count): its beams, increment,
+// angle_max and intensities; invalid beams hold `value`. Returns how many fewer valid beams
+// it has than `m` had.
+std::size_t writeResampled(sensor_msgs::LaserScan& m,
+                           const mrpt::obs::CObservation2DRangeScan& cleaned, float value) {
+    std::size_t valid_before = 0;
+    for (const float r : m.ranges) valid_before += validRange(m, r) ? 1 : 0;
+    const std::size_t n_before = m.ranges.size(), n = cleaned.getScanSize();
+    std::size_t valid_after = 0;
+    m.ranges.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const bool valid = cleaned.getScanRangeValidity(i);
+        m.ranges[i] = valid ? cleaned.getScanRange(i) : value;
+        valid_after += valid ? 1 : 0;
+    }
+    const double inc = n > 1 ? double(cleaned.aperture) / double(n - 1) : 0.0;
+    m.angle_increment = static_cast<float>(cleaned.rightToLeft ? inc : -inc);
+    m.angle_max =
+        static_cast<float>(double(m.angle_min) + double(m.angle_increment) * double(n - 1));
+    if (n_before > 1 && n > 1)
+        m.time_increment *= static_cast<float>(double(n_before - 1) / double(n - 1));
+    m.intensities.clear();
+    if (cleaned.hasIntensity())
+        for (std::size_t i = 0; i < n; ++i)
+            m.intensities.push_back(static_cast<float>(cleaned.getScanIntensity(i)));
+    return valid_before > valid_after ? valid_before - valid_after : 0;
+}
+
+}  // namespace
+
 std::size_t markRemovedBeams(sensor_msgs::LaserScan& m,
                              const mrpt::obs::CObservation2DRangeScan& cleaned, RemovedMark mark) {
     const float value = mark == RemovedMark::NaN ? std::numeric_limits<float>::quiet_NaN()
                                                  : std::numeric_limits<float>::infinity();
+    if (cleaned.getScanSize() != m.ranges.size()) return writeResampled(m, cleaned, value);
     std::size_t marked = 0;
     const std::size_t n = std::min(m.ranges.size(), cleaned.getScanSize());
     for (std::size_t i = 0; i < n; ++i) {

@@ -306,6 +306,7 @@ void Run::prepare() {
         asRawlogError([&] { return openSource(opts_.input, sum_.input_format, opts_.source); });
     if (const auto* bag = dynamic_cast<const BagSource*>(source_.get())) {
         const BagChoice& c = bag->choice();
+        sum_.unread_scans = c.unread_scans;
         sum_.layout = "scans " + c.scan_topic + ", odometry " +
                       (c.odometry == BagChoice::Odometry::None ? std::string("none")
                        : c.odometry == BagChoice::Odometry::Tf

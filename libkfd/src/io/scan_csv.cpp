@@ -32,7 +32,7 @@ void ScanCsvWriter::open(const std::string& path, const std::string& name,
     asScanCsvError([&] {
         out_.emplace(path, name);
         std::string header =
-            "index,timestamp,sensor,kept,reason,points_in,removed_noise,points_out,"
+            "index,timestamp,sensor,kept,reason,points_in,removed_noise,surface_m,points_out,"
             "microseconds";
         for (const std::string& c : stages_.columns()) header += "," + c;
         *out_ << header << ",icp_goodness,odom_x,odom_y,odom_phi,x,y,phi\n";
@@ -40,9 +40,10 @@ void ScanCsvWriter::open(const std::string& path, const std::string& name,
 }
 
 void ScanCsvWriter::write(const ScanRecord& r, const std::optional<Pose2D>& pose) {
-    std::string line = format("%zu,%.6f,%s,%d,%s,%zu,%zu,%zu,%.2f", r.index,
-                              stampForOutput(r.stamp), r.sensor.c_str(), r.kept ? 1 : 0, r.reason,
-                              r.points_in, r.removed_noise, r.points_out, r.microseconds);
+    std::string line =
+        format("%zu,%.6f,%s,%d,%s,%zu,%zu,%.2f,%zu,%.2f", r.index, stampForOutput(r.stamp),
+               r.sensor.c_str(), r.kept ? 1 : 0, r.reason, r.points_in, r.removed_noise,
+               r.surface_m, r.points_out, r.microseconds);
     line += stages_.cells(r.report);
     line += std::isnan(r.icp_goodness)
                 ? std::string(",")

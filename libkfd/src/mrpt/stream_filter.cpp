@@ -45,6 +45,33 @@ void writeBack(const std::uint8_t* valid, std::size_t n, mrpt::obs::CObservation
     }
 }
 
+// Writes a scan the stages resampled (beam_count: a beam count other than the observation's)
+// into `obs`: its beams, aperture, direction and intensities replaced by the scan's.
+void writeResampled(const Scan& scan, mrpt::obs::CObservation2DRangeScan& obs) {
+    const std::size_t n = scan.size();
+    obs.resizeScan(n);
+    obs.aperture = static_cast<float>(scan.geometry.aperture);
+    obs.rightToLeft = scan.geometry.right_to_left;
+    for (std::size_t i = 0; i < n; ++i) {
+        obs.setScanRange(i, scan.range[i]);
+        obs.setScanRangeValidity(i, scan.valid[i] != 0);
+    }
+    const bool has_intensity = scan.intensity.size() == n && n > 0;
+    obs.setScanHasIntensity(has_intensity);
+    if (has_intensity)
+        for (std::size_t i = 0; i < n; ++i)
+            obs.setScanIntensity(i, static_cast<int32_t>(std::lround(scan.intensity[i])));
+}
+
+// The stages' result written into `obs`: the removed beams marked invalid or, when a stage
+// resampled the scan, the whole scan replaced.
+void writeScan(const Scan& scan, mrpt::obs::CObservation2DRangeScan& obs) {
+    if (scan.size() == obs.getScanSize())
+        writeBack(scan.valid.data(), scan.size(), obs);
+    else
+        writeResampled(scan, obs);
+}
+
 }  // namespace
 
 StreamFilter::StreamFilter(const Pipeline::Params& params, StageFactory extra,
@@ -102,7 +129,9 @@ StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
 
     Sensor& s = sensorFor(obs.sensorLabel);
     std::swap(s.scan, spare_scan_);
-    const ScanGeometry g = s.scan.geometry;
+    // The geometry the stages see (after a beam_count stage's resampling): a driver whose
+    // count varies restarts nothing when the chain fixes the count.
+    const ScanGeometry g = s.pipeline->outputGeometry(s.scan.geometry);
     if (s.geometry.beams != 0 && g != s.geometry) {
         s.pipeline->reset();  // finishes a pending scan without its next
         collectFinished(s);
@@ -119,8 +148,9 @@ StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
     collectFinished(s);  // the sensor's scan before, when this one finished it
     res.keep = rec.kept = res.report.keep;
     // Written back: the beams the stages removed become invalid in the MRPT scan (ranges, beam
-    // count and angles kept; no beam made valid again). Only those beams are touched.
-    writeBack(s.scan.valid.data(), s.scan.size(), obs);
+    // count and angles kept; no beam made valid again; only those beams are touched), or the
+    // resampled scan replaces it (beam_count).
+    writeScan(s.scan, obs);
     if (res.report.pending) {  // recorded once finished
         res.pending = true;
         s.held = res;
@@ -141,7 +171,7 @@ void StreamFilter::collectFinished(Sensor& s) {
     res.report = report;
     res.keep = res.record.kept = report.keep;
     mrpt::obs::CObservation2DRangeScan& obs = *res.scan;
-    writeBack(done->valid.data(), std::min(done->size(), obs.getScanSize()), obs);
+    writeScan(*done, obs);
     record(res);
     for (InOrder& w : in_order_)  // a process(.., done) call waits for it
         if (w.held && w.scan == res.scan) {
@@ -219,6 +249,7 @@ void StreamFilter::record(StreamResult& res) {
     }
     rec.points_in = rep.points_in;
     rec.removed_noise = rep.noiseRemoved();
+    rec.surface_m = rep.surfaceRemoved();
     rec.points_out = rep.points_out;
     rec.microseconds = rep.microseconds;
     rec.report = rep;
@@ -241,6 +272,17 @@ void keepMostRemoved(ScanCounters& c, const ScanCounters::Removal& r) {
     auto& v = c.most_removed;
     const auto at = std::find_if(
         v.begin(), v.end(), [&](const ScanCounters::Removal& o) { return r.share() > o.share(); });
+    if (at == v.end() && v.size() >= ScanCounters::kMostRemoved) return;
+    v.insert(at, r);
+    if (v.size() > ScanCounters::kMostRemoved) v.pop_back();
+}
+
+// Keeps the kMostRemoved longest surface-like runs, longest first (ties: the earlier scan).
+void keepSurfaceRemoved(ScanCounters& c, const ScanCounters::SurfaceRemoval& r) {
+    ++c.scans_surface_removed;
+    auto& v = c.surface_removed;
+    const auto at =
+        std::find_if(v.begin(), v.end(), [&](const auto& o) { return r.length_m > o.length_m; });
     if (at == v.end() && v.size() >= ScanCounters::kMostRemoved) return;
     v.insert(at, r);
     if (v.size() > ScanCounters::kMostRemoved) v.pop_back();
@@ -274,6 +316,7 @@ void StreamFilter::count(const StreamResult& res) {
     c.points_removed += rep.points_in - rep.points_out;
     if (rec.removed_noise > 0)
         keepMostRemoved(c, {rec.index, rec.stamp, rec.removed_noise, usable});
+    if (rec.surface_m > 0.0) keepSurfaceRemoved(c, {rec.index, rec.stamp, rec.surface_m});
 }
 
 std::vector<std::string> reasonLines(const ScanCounters& c) {
@@ -296,6 +339,15 @@ std::vector<std::string> reasonLines(const ScanCounters& c) {
         for (const auto& r : c.most_removed)
             m += format(" scan %zu %.1f %% (%zu of %zu);", r.index, 100.0 * r.share(), r.removed,
                         r.usable);
+        lines.push_back(m);
+    }
+    if (c.scans_surface_removed > 0) {
+        std::string m = format(
+            "looks like a surface: on %zu kept scans the denoiser removed a straight run of "
+            ">= 0.5 m (a wall taken for noise?):",
+            c.scans_surface_removed);
+        for (const auto& r : c.surface_removed)
+            m += format(" scan %zu %.2f m;", r.index, r.length_m);
         lines.push_back(m);
     }
     return lines;

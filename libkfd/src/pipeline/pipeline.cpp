@@ -4,6 +4,8 @@
 #include <chrono>
 #include <string>
 
+#include "kfd/algorithms/surface_run.h"
+
 namespace kfd {
 
 PipelineParams::PipelineParams(const PipelineParams& o) : stages(o.stages) {
@@ -93,6 +95,22 @@ void Pipeline::add(std::unique_ptr<Stage> stage) {
 
 namespace {
 
+// Runs one stage on `scan` (its held scan's finish() when `next` is given), and, when it
+// removed returns as noise, measures the longest removed run that looks like a surface
+// (StageReport::surface_m) against its input flags, copied to `before`.
+bool runStage(Stage& stage, Scan& scan, StageReport& sr, const ScanReport& report,
+              std::vector<std::uint8_t>& before, bool finishing, const Scan* next) {
+    before.assign(scan.valid.begin(), scan.valid.end());  // no allocation once grown
+    const bool keep =
+        finishing ? stage.finish(scan, sr, report, next) : stage.process(scan, sr, report);
+    if (sr.noise && sr.points_removed > 0 && before.size() == scan.size()) {
+        const SurfaceRun run = longestRemovedSurface(scan, before.data());
+        sr.surface_beams = run.beams;
+        sr.surface_m = run.length_m;
+    }
+    return keep;
+}
+
 // A stage's end: its time since `t` (then `t` moves on) and, when it dropped the scan, the
 // report says so. Returns `keep`.
 bool endStage(const Stage& stage, bool keep, StageReport& sr, ScanReport& report,
@@ -142,7 +160,7 @@ ScanReport Pipeline::process(Scan& scan) {
             report.pending = true;
             break;
         }
-        const bool keep = stage.process(scan, sr, report);
+        const bool keep = runStage(stage, scan, sr, report, before_, false, nullptr);
         if (!keep) {  // the later stages see the dropped scan (Stage::observeDropped)
             for (std::size_t j = i + 1; j < stages_.size(); ++j) {
                 if (held_ && j == held_stage_) t += finishHeld(&scan);
@@ -177,8 +195,7 @@ std::chrono::steady_clock::duration Pipeline::finishHeld(const Scan* next) {
         Stage& stage = *stages_[i];
         StageReport& sr = report.stage_reports[report.stage_count++];
         sr.name = stage.name();
-        const bool keep = i == held_stage_ ? stage.finish(held_scan_, sr, report, next)
-                                           : stage.process(held_scan_, sr, report);
+        const bool keep = runStage(stage, held_scan_, sr, report, before_, i == held_stage_, next);
         if (!keep) {
             for (std::size_t j = i + 1; j < stages_.size(); ++j)
                 stages_[j]->observeDropped(held_scan_);
@@ -212,6 +229,12 @@ void Pipeline::reset() {
     finished_ = false;
     if (held_) finishHeld(nullptr);
     for (auto& s : stages_) s->reset();
+}
+
+ScanGeometry Pipeline::outputGeometry(const ScanGeometry& in) const {
+    ScanGeometry g = in;
+    for (const auto& s : stages_) g = s->outputGeometry(g);
+    return g;
 }
 
 const Clusters* Pipeline::lastClusters() const {

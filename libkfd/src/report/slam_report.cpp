@@ -259,6 +259,7 @@ void scansJson(Json& j, const IcpSlamSummary& s) {
     j["points_removed"] = s.points_removed;
     j["points_removed_noise"] = s.points_removed_noise;
     j["max_removed_noise_share"] = s.max_removed_noise_share;  // of a kept scan's valid returns
+    j["scans_surface_removed"] = s.scans_surface_removed;      // a straight run removed as noise
     j["reasons"] = nlohmann::ordered_json::object();           // scans per keep/drop reason
     for (const auto& [name, n] : s.reasons) j["reasons"][name] = n;
 }

@@ -23,8 +23,8 @@ class BagError : public SourceError {
 /// them, the index entries and the chunk index) and throws BagError naming the file, the byte
 /// offset and what is wrong: not a bag, truncated, no index, a chunk that does not decompress,
 /// a length or an offset outside its record or chunk. rosbag_storage trusts these, so
-/// listBag() runs this check first; BagSource runs it too, but checks each chunk's contents (its
-/// records, the index entries into it) when it first reads the chunk, so that each chunk is
+/// listBag() and BagSource run this check first (the index only), and check each chunk's contents
+/// (its records, the index entries into it) when it first reads the chunk, so that each chunk is
 /// decompressed once (a corrupt chunk is then a BagError from next(), naming its byte, as
 /// here). kfd reads the chunks itself; rosbag_storage only reads the index. A compressed
 /// chunk's output grows with what its data holds, up to its announced size: a corrupt size
@@ -44,6 +44,9 @@ struct BagChoice {
     double mount_x = 0.0, mount_y = 0.0, mount_yaw = 0.0;  // metres, radians
     /// How each choice was made, one line each ("scans: /scan (the only LaserScan topic)").
     std::vector<std::string> notes;
+    /// Topics of scans kfd does not read (sensor_msgs/MultiEchoLaserScan), as "TOPIC (TYPE,
+    /// N messages)": a bag output copies them as they are, unfiltered.
+    std::vector<std::string> unread_scans;
 };
 
 /// Reads a ROS 1 bag (format 2.0, any chunk compression) message by message in time order,

@@ -48,7 +48,10 @@ mrpt::obs::CObservation2DRangeScan::Ptr laserScanToObservation(const sensor_msgs
 
 /// Marks in `m` the beams that were valid in it (validRange) and that the door left invalid in
 /// `cleaned` (its MRPT scan after StreamFilter::process) with `mark` (NaN or +Inf, REP 117);
-/// every other field stays as received. Returns the beams marked.
+/// every other field stays as received. Returns the beams marked. When a beam_count stage
+/// resampled `cleaned` (another beam count), `m` takes its beams (invalid ones marked), the
+/// increment, angle_max, time_increment and intensities that go with them, and the result is
+/// how many fewer valid beams it has.
 std::size_t markRemovedBeams(sensor_msgs::LaserScan& m,
                              const mrpt::obs::CObservation2DRangeScan& cleaned, RemovedMark mark);
 

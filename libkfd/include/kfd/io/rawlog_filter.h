@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "kfd/io/bag_writer.h"
 #include "kfd/io/rawlog_source.h"
@@ -65,8 +66,11 @@ struct RawlogFilterSummary : ScanCounters {
                          // for a bag or CARMEN input, what was read from it
     LogFormat input_format = LogFormat::Rawlog;
     LogFormat output_format = LogFormat::Rawlog;
-    std::size_t points_marked = 0;      // bag output: removed points written as NaN / +Inf
-    std::string output_compression;     // bag output: "none", "lz4", "bz2" or "zstd" (chunks)
+    std::size_t points_marked = 0;   // bag output: removed points written as NaN / +Inf
+    std::string output_compression;  // bag output: "none", "lz4", "bz2" or "zstd" (chunks)
+    /// Bag input: scan topics kfd does not read (MultiEchoLaserScan), copied unfiltered to a
+    /// bag output ("TOPIC (TYPE, N messages)").
+    std::vector<std::string> unread_scans;
     std::size_t messages_left_out = 0;  // .db3/.mcap of a ROS 1 bag: messages of types kfd
                                         // cannot write as ROS 2 (not LaserScan, Odometry, tf)
     std::size_t objects_in = 0;         // top-level objects read (a CARMEN log: lines; a bag:

@@ -21,11 +21,13 @@ class ScanCsvError : public Error {
 
 /// Writes ScanRecords as CSV rows, one per scan, under this header:
 ///
-///     index,timestamp,sensor,kept,reason,points_in,removed_noise,points_out,microseconds,
+///     index,timestamp,sensor,kept,reason,points_in,removed_noise,surface_m,points_out,
+///     microseconds,
 ///     <the listed stages' columns>,icp_goodness,odom_x,odom_y,odom_phi,x,y,phi
 ///
 /// The door's columns: index, timestamp (s, 0 when unknown), sensor, kept (1/0) and reason as
 /// in ScanRecord; points_in, removed_noise (by the denoising stages), points_out: valid beams;
+/// surface_m: the longest run the denoisers removed that looks like a surface (m, 0: none);
 /// microseconds: the pipeline's time. Then each listed stage's own columns, in pipeline
 /// order, as the stage declares them (`kfd-filter --list-columns` prints them with their
 /// meaning; kfd/pipeline/stage_outputs.h): e.g. removed_range (distance), p_common,

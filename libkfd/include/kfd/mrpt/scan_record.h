@@ -31,8 +31,9 @@ struct ScanRecord {
                                 // or the stage that dropped it, or "skipped:<why>" (static text)
     std::size_t points_in = 0;  // valid beams entering the pipeline
     std::size_t removed_noise = 0;  // by the denoising stages (StageReport::noise)
-    std::size_t points_out = 0;     // valid beams leaving the pipeline
-    double microseconds = 0.0;      // time in the pipeline's stages
+    double surface_m = 0.0;      // the longest removed run that looks like a surface (m; 0: none)
+    std::size_t points_out = 0;  // valid beams leaving the pipeline
+    double microseconds = 0.0;   // time in the pipeline's stages
     /// The stages' reports (empty for a skipped scan): the listed stages' own columns are
     /// formatted from it when the row is written (kfd/pipeline/stage_outputs.h;
     /// StreamFilter::outputs().cell(record.report, "corridor") reads one by name).
@@ -79,6 +80,17 @@ struct ScanCounters {
     };
     static constexpr std::size_t kMostRemoved = 5;
     std::vector<Removal> most_removed;
+    /// Kept scans where a denoising stage removed a run of returns that looks like a surface
+    /// (a straight run, kfd/algorithms/surface_run.h), and the longest such runs, longest
+    /// first (at most kMostRemoved): a piece of wall removed as noise is found without
+    /// rendering every keyframe.
+    struct SurfaceRemoval {
+        std::size_t index = 0;  // ScanRecord::index
+        double stamp = 0.0;     // s
+        double length_m = 0.0;  // the run's length
+    };
+    std::size_t scans_surface_removed = 0;
+    std::vector<SurfaceRemoval> surface_removed;
     /// The stage counter called `name`, 0 when no listed stage declares it.
     double stageTotal(std::string_view name) const { return totalOf(stage_totals, name); }
 

@@ -48,7 +48,8 @@ struct StreamResult {
 ///     auto r = kfd.process(*scan, odometryPose);  // checks and cleans `scan` in place
 ///     if (r.keep) slam.processScan(scan);
 ///
-/// When a sensor's geometry (beam count, aperture or direction) changes, its state is reset
+/// When a sensor's geometry (beam count, aperture or direction, as its stages see it: after a
+/// beam_count stage's resampling) changes, its state is reset
 /// and the scan is treated as the first of a new stream (StreamResult::geometry_reset).
 ///
 /// One scan of latency (the denoise key next_scan = true): a kept scan may come back pending

@@ -135,6 +135,10 @@ class Pipeline {
     bool holding() const { return held_; }
     /// Forgets all stream state; a held scan is finished first (finished() returns it).
     void reset();
+    /// The geometry the stages after all resampling see for an input scan of geometry `in`
+    /// (Stage::outputGeometry through the chain): what a caller compares to decide that the
+    /// sensor's geometry changed and the chain must restart (reset()).
+    ScanGeometry outputGeometry(const ScanGeometry& in) const;
 
     const std::vector<std::unique_ptr<Stage>>& stages() const { return stages_; }
     /// The first stage of class S, or nullptr.
@@ -158,6 +162,7 @@ class Pipeline {
     bool held_ = false, finished_ = false;
     std::size_t held_stage_ = 0;
     Scan held_scan_, finished_scan_;
+    std::vector<std::uint8_t> before_;  // a stage's input valid flags (surface check)
     ScanReport held_report_, finished_report_;
 };
 

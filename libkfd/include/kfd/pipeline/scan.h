@@ -134,7 +134,8 @@ inline ScanSkipReason checkGeometry(const ScanGeometry& g) {
 inline bool isUsableRange(float r) { return r >= 0.0f && r <= kMaxScanRangeM; }
 
 /// One scan as the core sees it. `valid[i] != 0` means beam i holds a usable range.
-/// Stages never delete beams: removing a point clears its valid flag.
+/// Stages never delete beams: removing a point clears its valid flag. The one exception is
+/// beam_count (kfd/filters/beam_count.h), which resamples the whole scan to a fixed count.
 struct Scan {
     ScanGeometry geometry;
     std::vector<float> range;         // m, one per beam

@@ -31,6 +31,10 @@ class StageReport {
     bool noise = false;              // points_removed are noise (a denoising stage)
     std::size_t points_removed = 0;  // valid beams this stage invalidated
     double microseconds = 0.0;       // wall time spent in this stage
+    /// A denoising stage (noise): the longest straight run of returns it removed, when one
+    /// looks like a surface (kfd/algorithms/surface_run.h; the pipeline measures it), else 0.
+    std::size_t surface_beams = 0;
+    double surface_m = 0.0;  // m, that run's length
 
     /// Stores the stage's diagnostics (a trivially copyable struct), replacing any before.
     template <class T>
@@ -92,6 +96,13 @@ struct ScanReport {
         const T* d = find<T>();
         return d ? *d : T{};
     }
+    /// The longest run that looked like a surface among the denoising stages' removals (m; 0:
+    /// none did; StageReport::surface_m).
+    double surfaceRemoved() const {
+        double m = 0.0;
+        for (const auto& s : *this) m = s.surface_m > m ? s.surface_m : m;
+        return m;
+    }
     /// Points invalidated as noise by the denoising stages that ran (StageReport::noise); the
     /// distance stage's removals are not noise.
     std::size_t noiseRemoved() const {
@@ -125,6 +136,11 @@ class Stage {
     virtual void decided(const Scan& /*scan*/, bool /*kept*/) {}
     /// Forget all stream state (called when the sensor's geometry changes).
     virtual void reset() {}
+    /// The geometry of a scan of geometry `in` after this stage: `in` for every stage that
+    /// only marks beams invalid; a resampling stage (beam_count) changes the count. The
+    /// door restarts the chain only when the geometry the stages see changes
+    /// (Pipeline::outputGeometry).
+    virtual ScanGeometry outputGeometry(const ScanGeometry& in) const { return in; }
     /// True: a scan reaching this stage is finished only once the sensor's next scan reached it
     /// too (one scan of latency; the evidence denoiser's next_scan, issue 25). The pipeline
     /// then holds a copy of the scan instead of calling process(), and calls finish() with the
