@@ -14,13 +14,23 @@ Two trajectories are compared on the scans both have (stamps within max_dt):
   stretch's start, per metre travelled (median over the stretches).
 The spread is the differences between the baseline's repeats K and K + 1; the departures are
 A's repeat K against the baseline's repeat K. The verdict tests (one-sided exact rank sum) that
-the departures are larger than the spread, on ATE and on drift."""
+the departures are larger than the spread, on ATE and on drift.
+
+A stretch counts for drift only when its ends are at least half its path apart: on a sensor
+that stands still, ICP's jitter adds up to metres of "path" that is no motion at all.
+
+A sensor that stands still (issue 37: every position of the baseline's runs within STILL_M of
+their mean, its heading within STILL_DEG) has one true pose, so there the truth is known
+without ground truth: each run's scatter (RMS distance of its positions from their mean) is
+its error, and the verdict tests that the mode's scatter is larger than the baseline's."""
 import math
 
 from . import stats as kfd_stats
 
 SEGMENT_M = 2.0  # m of path per drift stretch
 ALPHA = 0.05
+STILL_M = 0.10  # m: a baseline whose positions all lie this close to their mean stands still
+STILL_DEG = 5.0  # deg: ... and whose heading stays within this of its mean
 
 
 def match(a, b, max_dt):
@@ -79,6 +89,8 @@ def drift_per_m(pairs, segment_m=SEGMENT_M):
         if j == len(pairs):
             break
         (a0, b0), (a1, b1) = pairs[i], pairs[j]
+        if math.hypot(b1[0] - b0[0], b1[1] - b0[1]) < 0.5 * (path[j] - path[i]):
+            continue  # jitter, not motion (a sensor standing still, or turning on the spot)
         ma, mb = local_motion(a0, a1), local_motion(b0, b1)
         values.append(math.hypot(ma[0] - mb[0], ma[1] - mb[1]) / (path[j] - path[i]))
     return kfd_stats.median(values) if values else None
@@ -109,9 +121,47 @@ class Trajectories(dict):
         self.max_dt = max_dt
 
 
+def scatter(trajectory):
+    """RMS distance (m) of a trajectory's positions from their mean, and its heading's largest
+    distance from its circular mean (deg); None for an empty trajectory."""
+    if not trajectory:
+        return None
+    n = float(len(trajectory))
+    mx = sum(p[1] for p in trajectory) / n
+    my = sum(p[2] for p in trajectory) / n
+    rms = math.sqrt(sum((p[1] - mx) ** 2 + (p[2] - my) ** 2 for p in trajectory) / n)
+    mean_yaw = math.atan2(sum(math.sin(p[3]) for p in trajectory),
+                          sum(math.cos(p[3]) for p in trajectory))
+    turn = max(abs(math.remainder(p[3] - mean_yaw, 2 * math.pi)) for p in trajectory)
+    reach = max(math.hypot(p[1] - mx, p[2] - my) for p in trajectory)
+    return {"rms": rms, "reach": reach, "turn_deg": math.degrees(turn)}
+
+
+def still(baseline):
+    """True when every run of the baseline stands still (STILL_M, STILL_DEG)."""
+    found = [scatter(t) for t in baseline.values() if t]
+    return bool(found) and all(f["reach"] <= STILL_M and f["turn_deg"] <= STILL_DEG
+                               for f in found)
+
+
+def judge_still(mode, baseline):
+    """The verdict on a sensor that stands still: each run's scatter is its error."""
+    x = [f["rms"] for f in (scatter(mode[k]) for k in sorted(mode)) if f]
+    y = [f["rms"] for f in (scatter(baseline[k]) for k in sorted(baseline)) if f]
+    if not x or not y:
+        return None
+    p = kfd_stats.rank_sum_greater(x, y)
+    return {"still": True, "n": len(x), "n_spread": len(y),
+            "scatter": {"mode": kfd_stats.median(x), "baseline": kfd_stats.median(y),
+                        "mode_max": max(x), "baseline_max": max(y), "p": p},
+            "beyond": sum(1 for v in x if v > max(y)), "departs": p < ALPHA}
+
+
 def judge(mode, baseline):
     """The departures of mode (Trajectories) from baseline of the same repeats, the baseline's
     spread, and the tests; None when there is nothing to compare."""
+    if still(baseline):
+        return judge_still(mode, baseline)
     sp = spread(baseline)
     dep = [d for k in sorted(set(mode) & set(baseline))
            for d in [difference(mode[k], baseline[k], baseline.max_dt)] if d]

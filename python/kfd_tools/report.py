@@ -330,6 +330,15 @@ class Group:
         if sp is None:
             return ("no ground truth (%s; %s) and no two finished %s runs with a trajectory to "
                     "measure %s's own spread" % (self.absent("all"), self.absent("ate"), b, b))
+        if sp.get("still"):
+            sc = sp["scatter"]
+            return ("no ground truth, but the sensor stands still (every %s run's positions "
+                    "within %g m of their mean, heading within %g°): its one true pose makes "
+                    "each run's scatter about its mean its error: %s %s m vs %s %s m (medians "
+                    "over %d and %d runs; largest %s vs %s m); rank-sum p = %s" % (
+                        b, kfd_agreement.STILL_M, kfd_agreement.STILL_DEG, a,
+                        fmt3(sc["mode"]), b, fmt3(sc["baseline"]), sp["n"], sp["n_spread"],
+                        fmt3(sc["mode_max"]), fmt3(sc["baseline_max"]), fmt_p(sc["p"])))
         ate, drift = sp["ate"], sp["drift"]
 
         def pct(x):
@@ -357,6 +366,13 @@ def spread_word(sp, b, more_failures):
     (the ratio of the medians, ATE)."""
     if sp is None:
         return "CANNOT JUDGE"
+    if sp.get("still"):  # a sensor standing still: each run's scatter is its error
+        sc = sp["scatter"]
+        ratio = sc["mode"] / sc["baseline"] if sc["baseline"] else None
+        times = " (%.2f× its scatter)" % ratio if ratio is not None else ""
+        if sp["departs"] or more_failures:
+            return "SCATTERS MORE THAN %s%s" % (b.upper(), times)
+        return "SCATTERS NO MORE THAN %s%s" % (b.upper(), times)
     ratio = sp["ate"]["departure"] / sp["ate"]["spread"] if sp["ate"]["spread"] else None
     times = " (%.2f× its median)" % ratio if ratio is not None else ""
     if sp["departs"] or more_failures:
@@ -582,7 +598,7 @@ def verdict_lines(g):
 def spread_line(g):
     """For a log with ground truth, what the verdict without it would have said (the same
     measure a user's log without ground truth gets)."""
-    found = [(a, sp) for a, sp in sorted(g.agreement.items()) if sp]
+    found = [(a, sp) for a, sp in sorted(g.agreement.items()) if sp and not sp.get("still")]
     if not g.judged or not found:
         return []
     return ["Against %s's own spread (the verdict a log without ground truth gets): %s." % (

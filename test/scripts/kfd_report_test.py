@@ -13,6 +13,7 @@ import stat
 import tempfile
 import unittest
 
+from kfd_tools import agreement as kfd_agreement
 from kfd_tools import compare as kfd_compare
 from kfd_tools import report as kfd_report
 from kfd_tools import stats as kfd_stats
@@ -394,6 +395,44 @@ class NoGroundTruth(Base):
         v = self.verdict(stats, "mine", "kfd", "none")
         self.assertEqual(v["verdict"], "CANNOT JUDGE")
         self.assertIn("no two finished none runs with a trajectory", v["text"])
+
+
+def standing(noise, seed, n=200):
+    """A sensor standing still at (3, -2), heading 0.5 rad: ICP's jitter of `noise` m."""
+    rng = random.Random(seed)
+    return [(0.2 * i, 3 + rng.gauss(0, noise), -2 + rng.gauss(0, noise), 0.5 + rng.gauss(0, 0.002))
+            for i in range(n)]
+
+
+class StillSensor(Base):
+    """A log without ground truth whose sensor stands still, 6 repeats: there the one true pose
+    makes each run's scatter its error. kfd scatters less than none, keyframe more; drift is
+    not measured on jitter."""
+
+    def setUp(self):
+        super().setUp()
+        for k in range(6):
+            for i, (mode, noise) in enumerate((("none", 0.006), ("kfd", 0.002),
+                                               ("keyframe", 0.02))):
+                write_run(self.out, "still", mode, k, cpu=5.0, lost_tracks=0,
+                          command=["kfd-icp-slam", CONFIG + ".ini", "still.bag", "-m", mode])
+                write_trajectory(self.out, "still", mode, k, standing(noise, 10 * k + i)[k:])
+
+    def test_each_runs_scatter_is_its_error(self):
+        stats = self.collect()
+        v = self.verdict(stats, "still", "kfd", "none")
+        self.assertTrue(v["verdict"].startswith("SCATTERS NO MORE THAN NONE ("), v["verdict"])
+        self.assertIn("the sensor stands still", v["text"])
+        self.assertLess(v["spread"]["scatter"]["mode"], v["spread"]["scatter"]["baseline"])
+        worse = self.verdict(stats, "still", "keyframe", "none")
+        self.assertTrue(worse["verdict"].startswith("SCATTERS MORE THAN NONE ("), worse["verdict"])
+        self.assertLess(worse["spread"]["scatter"]["p"], 0.05)
+
+    def test_jitter_is_no_path_for_drift(self):
+        pairs = kfd_agreement.match(standing(0.01, 1), standing(0.01, 2), 1e-3)
+        self.assertIsNone(kfd_agreement.drift_per_m(pairs))
+        moving = kfd_agreement.match(path(0.01, 1), path(0.01, 2), 1e-3)
+        self.assertIsNotNone(kfd_agreement.drift_per_m(moving))
 
 
 class BeforeRunning(unittest.TestCase):
