@@ -142,6 +142,11 @@ void printRepairs(const kfd::RawlogFilterSummary& s) {
             kfd::plural(s.stamps_backwards, "stamp").c_str());
     if (s.geometry_resets)
         std::printf("  resets   %zu (scan geometry changed)\n", s.geometry_resets);
+    if (s.sensors_evicted)
+        std::printf(
+            "  evicted  %zu sensors' state (more than %zu sensor labels: the least "
+            "recently seen forgotten, its held scan finished first)\n",
+            s.sensors_evicted, kfd::StreamFilter::kDefaultMaxSensors);
     const kfd::SourceCounters& src = s.source;  // what the bag or CARMEN source repaired
     if (src.lines_unparsable)
         std::printf("  unparsed %s not CARMEN text skipped (%s, the first at line %zu)\n",

@@ -35,6 +35,7 @@ to ICP-SLAM: kfd+lo, decimate@kfd+lo).
 import argparse
 import concurrent.futures
 import csv
+import hashlib
 import json
 import math
 import os
@@ -80,6 +81,8 @@ class CompareError(Exception):
 
 
 # --- logs, modes, jobs ----------------------------------------------------------------------
+MAX_REPEATS = 1000  # runs per log, config and mode
+MAX_JOBS = 4096     # runs at a time
 
 # The logs kfd-icp-slam reads (by content; these extensions mark a spec as a path).
 LOG_EXTENSIONS = (".rawlog", ".bag", ".clf", ".log", ".clf.gz", ".log.gz", ".db3", ".mcap")
@@ -167,13 +170,36 @@ def run_dir(out, log_name, config, mode, repeat):
 
 def job_args(a, log, config, mode, repeat):
     args = JOB_COMMAND + [
-        "job", "--out", os.path.abspath(a.out), "--log", log,
+        "job", "--out", os.path.abspath(a.out), "--log", absolute_log(log),
         "--datasets", os.path.abspath(a.datasets), "--config", os.path.abspath(config),
         "--mode", mode, "--repeat", str(repeat), "--exe", os.path.abspath(a.exe),
         "--sim-exe", os.path.abspath(a.sim_exe), "--split-seconds", repr(a.split_seconds)]
     if a.maps:
         args.append("--map")
     return args + source_args(a)
+
+
+def absolute_log(spec):
+    """A log spec that names a file or folder, made absolute (a job may run from anywhere);
+    dataset names and sim: specs as they are."""
+    return os.path.abspath(spec) if os.path.exists(spec) else spec
+
+
+def inputs_of(cmd):
+    """What a run's result depends on besides its command: size, mtime and, for the files a
+    user edits (configs), a hash of every existing file the command names (the executable,
+    the config, the log, its ground truth). A finished run is reused only when these match."""
+    out = {}
+    for c in cmd:
+        if not os.path.isfile(c):
+            continue
+        st = os.stat(c)
+        entry = {"size": st.st_size, "mtime_ns": st.st_mtime_ns}
+        if c.endswith((".ini", ".yaml", ".yml", ".cfg")):
+            with open(c, "rb") as f:
+                entry["sha256"] = hashlib.sha256(f.read()).hexdigest()
+        out[c] = entry
+    return out
 
 
 def source_args(a):
@@ -222,6 +248,25 @@ def run_failed(done, ident, error, command, **more):
         " ".join(shlex.quote(c) for c in command)))
 
 
+def reusable(done, cmd):
+    """The finished run recorded in `done` when it ran this command on the same inputs
+    (inputs_of), else None: a run of an edited config, another binary or another log of the
+    same name runs again (and says so)."""
+    if not os.path.exists(done):
+        return None
+    try:
+        previous = read_json(done)
+    except (OSError, ValueError):
+        return None  # an unreadable record: run again
+    if not previous.get("finished", True):
+        return None
+    if previous.get("command") == cmd and previous.get("inputs") == inputs_of(cmd):
+        return previous
+    print("[kfd-compare] %s: the recorded run's command or inputs (config, binary, log) "
+          "changed: running it again" % os.path.dirname(done), file=sys.stderr, flush=True)
+    return None
+
+
 def run_job(a):
     """One kfd-icp-slam run: writes run.json (the summary, kernel CPU times, the command) into
     its run folder; a folder that already holds the run.json of a finished run is kept
@@ -231,10 +276,6 @@ def run_job(a):
     mode, match, laser = parse_mode(a.mode)
     folder = run_dir(a.out, log["name"], a.config, a.mode, a.repeat)
     done = os.path.join(folder, "run.json")
-    if os.path.exists(done):
-        previous = read_json(done)
-        if previous.get("finished", True):
-            return previous
     rawlog, rel, gt = log.get("rawlog"), log.get("relations"), log.get("gt")
     ident = {"log": log["name"], "config": config_tag(a.config), "mode": a.mode,
              "repeat": a.repeat, "seed": a.repeat + 1 if log["kind"] == "sim" else None,
@@ -258,6 +299,9 @@ def run_job(a):
         cmd += ["--match-drop-of", match]
     if laser:
         cmd.append("--laser-only")
+    previous = reusable(done, cmd)
+    if previous:
+        return previous
     os.makedirs(os.path.dirname(folder), exist_ok=True)
     t0 = time.monotonic()
     with open(folder + ".stderr", "w") as err:
@@ -292,7 +336,7 @@ def run_job(a):
         "relations_long_used": (s.get("relations_long") or {}).get("used"),
         "target_drop_pct": s.get("target_drop_pct"), "laser_only": s.get("laser_only"),
         "icp_rejected": s.get("icp_rejected"), "lost_tracks": s.get("lost_tracks_suspected"),
-        "finished": True, "command": cmd})
+        "finished": True, "command": cmd, "inputs": inputs_of(cmd)})
     write_run(done, run)
     return run
 
@@ -357,9 +401,29 @@ def plan(a):
             for config in a.configs for mode in a.modes]
 
 
+def unique_tags(a):
+    """Each log and config gets its own folder under runs/: two configs (or logs) whose names
+    would share one are refused, naming them."""
+    tags = {}
+    for c in a.configs:
+        other = tags.setdefault(config_tag(c), c)
+        if os.path.abspath(other) != os.path.abspath(c):
+            raise CompareError("two configs share the name %s (%s, %s): their runs would share "
+                               "one folder; rename one" % (config_tag(c), other, c))
+    names = {}
+    for log in a.logs:
+        name = resolve_log(log, a.datasets)["name"]
+        other = names.setdefault(name, log)
+        if absolute_log(other) != absolute_log(log):
+            raise CompareError("two logs share the name %s (%s, %s): their runs would share "
+                               "one folder; rename one" % (name, other, log))
+
+
 def cmd_run(a):
-    if a.repeats < 1:
-        raise CompareError("--repeats must be >= 1")
+    if not 1 <= a.repeats <= MAX_REPEATS:
+        raise CompareError("--repeats must be in [1, %d], not %d" % (MAX_REPEATS, a.repeats))
+    if not 1 <= a.jobs <= MAX_JOBS:
+        raise CompareError("--jobs must be in [1, %d], not %d" % (MAX_JOBS, a.jobs))
     a.configs = icp_configs(a)
     for c in a.configs:
         if not os.path.isfile(c):
@@ -368,6 +432,7 @@ def cmd_run(a):
         raise CompareError("kfd-icp-slam not found: %s (build it: bash scripts/test.sh)"
                            % a.exe)
     check_modes(a.exe, a.modes)
+    unique_tags(a)
     jobs = plan(a)
     say_what_is_judged(a)
     if a.emit_jobs:
@@ -420,7 +485,7 @@ def load_runs(out):
         raise CompareError("no runs under %s (run kfd-compare run first)" % base)
     for dirpath, _, files in os.walk(base):
         if "run.json" in files:
-            runs.append(read_json(os.path.join(dirpath, "run.json")))
+            runs.append(read_run(base, dirpath, out))
         for name in files:
             if name.endswith(".stderr") and not os.path.exists(
                     os.path.join(dirpath, name[:-len(".stderr")], "run.json")):
@@ -429,6 +494,24 @@ def load_runs(out):
         raise CompareError("no finished run under " + base)
     runs.sort(key=lambda r: (r["log"], r["config"], r["mode"], r["repeat"]))
     return runs
+
+
+def read_run(base, dirpath, out):
+    """A run folder's run.json, or, when it cannot be read (empty, cut short, not JSON), a
+    record with finished: false saying so (counted as a failed run)."""
+    path = os.path.join(dirpath, "run.json")
+    try:
+        run = read_json(path)
+        if isinstance(run, dict) and all(k in run for k in ("log", "config", "mode", "repeat")):
+            return run
+        why = "not a run record"
+    except (OSError, ValueError) as e:
+        why = str(e) or type(e).__name__
+    log, config, mode, folder = os.path.relpath(dirpath, base).split(os.sep)[-4:]
+    repeat = int(folder[1:]) if folder[1:].isdigit() else -1
+    return {"log": log, "config": config, "mode": mode, "repeat": repeat, "skip_scans": repeat,
+            "finished": False, "error": "unreadable run.json (%s): %s" % (
+                why, os.path.relpath(path, out))}
 
 
 def unfinished_run(base, dirpath, name, out):

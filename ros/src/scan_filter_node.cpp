@@ -115,6 +115,7 @@ LiveCounters ScanFilterNode::counters() const {
 
 void ScanFilterNode::onOdometry(const nav_msgs::Odometry::ConstPtr& m) {
     const double t = m->header.stamp.isZero() ? ros::Time::now().toSec() : m->header.stamp.toSec();
+    if (!live::usableStamp(t)) return;  // a scan at such a stamp is dropped too
     const Pose2D p{m->pose.pose.position.x, m->pose.pose.position.y,
                    quaternionYaw(m->pose.pose.orientation)};
     {
@@ -174,7 +175,7 @@ std::optional<Pose2D> ScanFilterNode::tfAtTheEdges(const ros::Time& stamp) {
         const auto latest =
             tf_->lookupTransform(config_.odom_frame, config_.base_frame, ros::Time(0));
         if (latest.header.stamp < stamp)
-            return (stamp - latest.header.stamp).toSec() <= hold
+            return stamp.toSec() - latest.header.stamp.toSec() <= hold
                        ? std::optional<Pose2D>(poseOf(latest.transform))
                        : std::nullopt;
         // Before the first transform: tf2 has no query for the oldest one, so the earliest
@@ -252,12 +253,33 @@ Pose2D ScanFilterNode::mountOf(const std::string& frame_id) {
 }
 
 void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
-    const auto start = std::chrono::steady_clock::now();
+    // No message may take the node (or the nodelet manager, and a driver loaded there) down:
+    // a stamp kfd cannot compute with is dropped and counted before any ros::Time arithmetic,
+    // and anything else that throws drops this scan only (issue 38).
     std::lock_guard<std::mutex> lock(mutex_);
     const ros::Time now = ros::Time::now();
     const ros::Time stamp = in->header.stamp.isZero() ? now : in->header.stamp;
+    if (!filter_.acceptStamp(stamp.toSec())) {
+        ROS_WARN_THROTTLE(5.0,
+                          "kfd: scan of frame '%s' stamped %.3f s: a stamp kfd cannot compute "
+                          "with (within a day of the end of ROS time): dropped (stamps_unusable)",
+                          in->header.frame_id.c_str(), stamp.toSec());
+        return;
+    }
+    try {
+        handleScan(in, now, stamp);
+    } catch (const std::exception& e) {
+        filter_.countError(true);
+        ROS_ERROR_THROTTLE(5.0, "kfd: scan of frame '%s' at %.3f s dropped: %s",
+                           in->header.frame_id.c_str(), stamp.toSec(), e.what());
+    }
+}
+
+void ScanFilterNode::handleScan(const sensor_msgs::LaserScan::ConstPtr& in, const ros::Time& now,
+                                const ros::Time& stamp) {
+    const auto start = std::chrono::steady_clock::now();
     if (last_scan_stamp_ && stamp != *last_scan_stamp_) {  // the queue's pace, every laser
-        const double dt = std::abs((stamp - *last_scan_stamp_).toSec());
+        const double dt = std::abs(stamp.toSec() - last_scan_stamp_->toSec());  // never throws
         if (intervals_.size() < kIntervals)
             intervals_.push_back(dt);
         else
@@ -283,6 +305,13 @@ void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
         tf_timed_out_at_.reset();
         ROS_WARN("kfd: time jumped back on frame '%s' (scan at %.3f s): state reset",
                  in->header.frame_id.c_str(), stamp.toSec());
+    }
+    if (filter_.counters().sensors_evicted > evicted_seen_) {
+        evicted_seen_ = filter_.counters().sensors_evicted;
+        ROS_WARN_THROTTLE(5.0,
+                          "kfd: more than %zu frame ids: the state of the one heard from longest "
+                          "ago was dropped (%zu so far, sensors_evicted)",
+                          StreamFilter::kDefaultMaxSensors, evicted_seen_);
     }
     if (r.out_of_order)
         ROS_WARN_THROTTLE(5.0, "kfd: scan of frame '%s' at %.3f s is out of order: dropped",

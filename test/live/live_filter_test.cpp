@@ -322,3 +322,20 @@ TEST(LiveFilter, NextScanHeldKeyframeIsPublishedBeforeATimeJumpResets) {
 }
 
 }  // namespace
+
+// Issue 38: 5 000 distinct frame ids grew kfd_node's memory by ~28 KB each, forever. The door
+// keeps at most 64 frames' state; the counter says how many were dropped.
+TEST(LiveFilter, AFloodOfFrameIdsKeepsBoundedStateAndCountsIt) {
+    LiveFilter f(defaults());
+    for (int i = 0; i < 1000; ++i) {
+        auto m = roomScan(1.0 + 0.01 * i, "frame" + std::to_string(i));
+        f.process(m, 1.0 + 0.01 * i, std::nullopt, false);
+    }
+    EXPECT_LE(f.door().sensorCount(), kfd::StreamFilter::kDefaultMaxSensors);
+    EXPECT_EQ(f.counters().sensors_evicted, 1000u - kfd::StreamFilter::kDefaultMaxSensors);
+    EXPECT_EQ(f.counters().scans_kept, 1000u);
+    bool listed = false;
+    for (const auto& [key, value] : kfd::live::counterValues(f.counters()))
+        listed = listed || (key == "sensors_evicted" && value == 936.0);
+    EXPECT_TRUE(listed);
+}

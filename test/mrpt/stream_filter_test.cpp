@@ -4,6 +4,9 @@
 #include <cmath>
 
 #include <filesystem>
+#include <memory>
+
+#include <sys/resource.h>
 #include <string>
 
 #include "kfd/algorithms/evidence_filter.h"
@@ -438,4 +441,50 @@ TEST(StreamFilter, ARemovedPieceOfWallIsFlaggedCountedAndListed) {
             EXPECT_EQ(lines.find("looks like a surface"), std::string::npos) << lines;
         }
     }
+}
+
+// Issue 38: a stream of ever new sensor labels grew the door's memory forever (one pipeline
+// each) and, with next_scan, held every sensor's first keyframe until the end. Now at most
+// maxSensors() keep state; the least recently seen is evicted, its held scan finished first,
+// so every scan comes out and memory stays bounded.
+TEST(StreamFilter, EverNewSensorLabelsAreEvictedOldestFirstWithNothingHeldLost) {
+    kfd::StreamFilter f(nextScanParams(), {}, true);
+    std::size_t done = 0, kept = 0;
+    const std::size_t labels = 3000;
+    struct rusage before {};
+    getrusage(RUSAGE_SELF, &before);
+    for (std::size_t i = 0; i < labels; ++i) {
+        auto s = std::make_shared<mrpt::obs::CObservation2DRangeScan>(
+            roomScan(181, M_PI, 3.0, "LASER" + std::to_string(i)));
+        s->timestamp = mrpt::Clock::fromDouble(100.0 + 0.01 * double(i));
+        f.process(*s, std::nullopt, [&done, &kept, s](kfd::StreamResult& r) {
+            ++done;
+            kept += r.keep;
+        });
+        EXPECT_LE(f.sensorCount(), kfd::StreamFilter::kDefaultMaxSensors);
+    }
+    struct rusage after {};
+    getrusage(RUSAGE_SELF, &after);
+    EXPECT_EQ(f.counters().sensors_evicted, labels - kfd::StreamFilter::kDefaultMaxSensors);
+    // Every evicted sensor's held keyframe was finished: all but the last 64 are out now.
+    EXPECT_EQ(done, labels - kfd::StreamFilter::kDefaultMaxSensors);
+    f.finish();
+    EXPECT_EQ(done, labels);
+    EXPECT_EQ(kept, labels);  // each the first scan of its sensor: a keyframe
+    EXPECT_EQ(f.counters().scans_kept, labels);
+    // ~30-60 KB per sensor kept forever would be 90-180 MB here.
+    EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 40 * 1024) << "KiB";
+}
+
+TEST(StreamFilter, AnEvictedSensorStartsAgainAsANewOne) {
+    kfd::Pipeline::Params p;
+    kfd::StreamFilter f(p);
+    f.setMaxSensors(2);
+    for (const char* label : {"A", "B", "A", "C", "A", "B"}) {
+        auto s = roomScan(181, M_PI, 3.0, label);
+        f.process(s);
+    }
+    // A B A C (evicts B, seen least recently) A B (evicts C): 2 evicted, A kept throughout.
+    EXPECT_EQ(f.counters().sensors_evicted, 2u);
+    EXPECT_EQ(f.sensorCount(), 2u);
 }

@@ -169,6 +169,33 @@ TEST_F(ScanFilterNodeTest, MissingTfFallsBackToLaserOnlyForThatScan) {
     EXPECT_EQ(n->counters().odom_missing, 2u);
 }
 
+// Issue 38: a stamp near the end of ROS 1's 32-bit time aborted the node ("Time is out of
+// dual 32-bit range", with the default odom: tf), and a jump of more than 2^31 s did in every
+// odometry mode. Now such a scan is dropped and counted, and the node goes on.
+TEST_F(ScanFilterNodeTest, AStampAtTheEndOfRosTimeOrAHugeJumpNeverKillsTheNode) {
+    for (const std::string odom : {"tf", "none"}) {
+        const std::string name = "stampnode_" + odom;
+        ros::param::set("/" + name + "/odom", odom);
+        ros::param::set("/" + name + "/tf_wait", 0.01);
+        auto n = node(name);
+        EXPECT_NO_THROW(n->onScan(scanAt(4294967000.0)));  // 295 s before the end
+        EXPECT_EQ(n->counters().stamps_unusable, 1u) << odom;
+        EXPECT_EQ(n->counters().scans_in, 1u) << odom;
+        EXPECT_EQ(n->counters().scans_kept, 0u) << odom;
+        EXPECT_NO_THROW(n->onScan(scanAt(1.0)));
+        EXPECT_NO_THROW(n->onScan(scanAt(3.0e9)));  // a jump of more than 2^31 s
+        EXPECT_NO_THROW(n->onScan(scanAt(2.0)));    // and back
+        EXPECT_EQ(n->counters().scans_in, 4u) << odom;
+        EXPECT_EQ(n->counters().stamps_unusable, 1u) << odom;
+        EXPECT_EQ(n->counters().callback_errors, 0u) << odom;
+        EXPECT_GE(n->counters().scans_kept, 1u) << odom;
+        // The counters reach /diagnostics and ~stats.
+        bool listed = false;
+        for (const auto& kv : n->stats().values) listed = listed || kv.key == "stamps_unusable";
+        EXPECT_TRUE(listed);
+    }
+}
+
 // The node waits in ROS time after the scan's stamp (here the wall clock: no use_sim_time).
 double secondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

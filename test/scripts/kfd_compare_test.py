@@ -234,6 +234,80 @@ class KfdCompare(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertIn("--scan-topic /scan", open(jobs).read())
 
+    def test_a_run_is_reused_only_on_the_same_command_and_inputs(self):
+        """Issue 38: an edited config reruns (it kept the old result before); an unchanged one
+        is reused."""
+        config = os.path.join(self.tmp, "c.ini")
+        shutil.copy(os.path.join(ROOT, "share", "kfd-icp-slam", "sick-180-5hz.ini"), config)
+        out = os.path.join(self.tmp, "reuse")
+        args = ["run", "--logs", OFFICE, "--modes", "kfd", "--repeats", "1", "--out", out,
+                "--configs", config, "-q", "--no-plots"] + self.exe
+        r = compare(*args)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        run_json = os.path.join(out, "runs", "office-mit-0.752", "c", "kfd", "r00", "run.json")
+        first = json.load(open(run_json))
+        self.assertIn(config, first["inputs"])
+        r = compare(*args)  # unchanged: reused, not rerun
+        self.assertNotIn("running it again", r.stderr)
+        self.assertEqual(json.load(open(run_json))["wall_s"], first["wall_s"])
+        with open(config, "a") as f:
+            f.write("\n# an edit the run must see (any edit reruns)\n")
+        r = compare(*args)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("changed: running it again", r.stderr)
+        again = json.load(open(run_json))
+        self.assertNotEqual(again["inputs"][config]["sha256"], first["inputs"][config]["sha256"])
+
+    def test_runs_that_would_share_a_folder_or_exceed_bounds_are_refused(self):
+        out = os.path.join(self.tmp, "tags")
+        a, b = os.path.join(self.tmp, "a"), os.path.join(self.tmp, "b")
+        for d in (a, b):
+            os.makedirs(d)
+            shutil.copy(os.path.join(ROOT, "share", "kfd-icp-slam", "sick-180-5hz.ini"), d)
+        r = compare("run", "--logs", OFFICE, "--out", out, "--configs",
+                    os.path.join(a, "sick-180-5hz.ini"), os.path.join(b, "sick-180-5hz.ini"),
+                    *self.exe)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("two configs share the name sick-180-5hz", r.stderr)
+        copy = os.path.join(a, os.path.basename(OFFICE))
+        shutil.copy(OFFICE, copy)
+        r = compare("run", "--logs", OFFICE, copy, "--out", out, *self.exe)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("two logs share the name office-mit-0.752", r.stderr)
+        for flag, value, message in (("--jobs", "0", "--jobs must be in [1, 4096], not 0"),
+                                     ("--repeats", "10000000",
+                                      "--repeats must be in [1, 1000], not 10000000")):
+            r = compare("run", "--logs", OFFICE, "--out", out, flag, value, *self.exe)
+            self.assertEqual(r.returncode, 1)
+            self.assertIn(message, r.stderr)
+            self.assertNotIn("Traceback", r.stderr)
+        self.assertFalse(os.path.exists(out))
+
+    def test_an_unreadable_run_json_is_a_failed_run_not_a_traceback(self):
+        out = os.path.join(self.tmp, "cut")
+        self.fake_runs(out, "cfg", "none", [0.1, 0.2])
+        open(os.path.join(out, "runs", "L", "cfg", "none", "r01", "run.json"), "w").close()
+        r = compare("collect", out, "-q", "--no-plots")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        runs = json.load(open(os.path.join(out, "runs.json")))["runs"]
+        bad = [x for x in runs if x["repeat"] == 1]
+        self.assertEqual(len(bad), 1)
+        self.assertTrue(bad[0]["failed"])
+        self.assertIn("unreadable run.json", bad[0]["failure"])
+
+    def test_emitted_jobs_name_the_log_by_its_absolute_path(self):
+        here = os.getcwd()
+        try:
+            os.chdir(os.path.dirname(OFFICE))
+            jobs = os.path.join(self.tmp, "jobs.txt")
+            r = compare("run", "--logs", os.path.basename(OFFICE), "--modes", "none",
+                        "--repeats", "1", "--out", os.path.join(self.tmp, "emit"),
+                        "--emit-jobs", jobs, *self.exe)
+        finally:
+            os.chdir(here)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("--log " + OFFICE, open(jobs).read())
+
     def test_bad_input_is_a_clear_error(self):
         out = os.path.join(self.tmp, "bad")
         r = compare("run", "--logs", "no-such-log", "--out", out, "--repeats", "1", *self.exe)

@@ -3,6 +3,7 @@
 #include <boost/make_shared.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 
 #include "kfd/io/laser_scan.h"
@@ -23,7 +24,26 @@ std::vector<std::pair<std::string, double>> counterValues(const LiveCounters& c)
             {"odom_missing", double(c.odom_missing)},
             {"resets", double(c.resets)},
             {"geometry_resets", double(c.geometry_resets)},
-            {"scans_skipped", double(c.scans_skipped)}};
+            {"scans_skipped", double(c.scans_skipped)},
+            {"stamps_unusable", double(c.stamps_unusable)},
+            {"callback_errors", double(c.callback_errors)},
+            {"sensors_evicted", double(c.sensors_evicted)}};
+}
+
+bool usableStamp(double seconds) {
+    return std::isfinite(seconds) && seconds >= 0.0 && seconds <= 4294967295.0 - kStampMargin;
+}
+
+bool LiveFilter::acceptStamp(double stamp) {
+    if (usableStamp(stamp)) return true;
+    ++counters_.scans_in;
+    ++counters_.stamps_unusable;
+    return false;
+}
+
+void LiveFilter::countError(bool scan) {
+    if (scan) ++counters_.scans_in;
+    ++counters_.callback_errors;
 }
 
 LiveFilter::LiveFilter(const Params& p) : params_(p), door_(p.pipeline, {}, true) {}
@@ -76,6 +96,13 @@ LiveResult LiveFilter::process(sensor_msgs::LaserScan& m, double stamp,
         r.reset = true;
         ++counters_.resets;
     }
+    if (last == last_stamp_.end() && last_stamp_.size() >= door_.maxSensors()) {
+        // Bounded like the door's sensors: the frame heard from longest ago is forgotten.
+        auto oldest = last_stamp_.begin();
+        for (auto it = last_stamp_.begin(); it != last_stamp_.end(); ++it)
+            if (it->second < oldest->second) oldest = it;
+        last_stamp_.erase(oldest);
+    }
     last_stamp_[label] = stamp;
     if (odom_expected && !odometry) ++counters_.odom_missing;
     auto obs = laserScanToObservation(m, stamp, label, mount);
@@ -89,6 +116,7 @@ LiveResult LiveFilter::process(sensor_msgs::LaserScan& m, double stamp,
         }
     });
     if (r.stream.geometry_reset) ++counters_.geometry_resets;
+    counters_.sensors_evicted = door_.counters().sensors_evicted;
     if (r.stream.skipped != ScanSkipReason::None) ++counters_.scans_skipped;
     if (!r.stream.keep) return r;
     if (!d->finished) {  // published once finished: a copy as received

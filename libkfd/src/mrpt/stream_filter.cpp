@@ -94,8 +94,13 @@ StreamFilter::StreamFilter(const Pipeline::Params& params, StageFactory extra,
 
 StreamFilter::Sensor& StreamFilter::sensorFor(const std::string& label) {
     auto it = sensors_.find(label);
-    if (it != sensors_.end()) return it->second;
+    if (it != sensors_.end()) {
+        it->second.last_used = counters_.scans_in;
+        return it->second;
+    }
+    while (sensors_.size() >= max_sensors_) evictOldest();
     Sensor s;
+    s.last_used = counters_.scans_in;
     s.pipeline =
         spare_ ? std::move(spare_) : std::make_unique<Pipeline>(params_, defaultStageRegistry());
     if (extra_) extra_(*s.pipeline);
@@ -158,6 +163,18 @@ StreamResult StreamFilter::process(mrpt::obs::CObservation2DRangeScan& obs,
     }
     record(res);
     return res;
+}
+
+void StreamFilter::evictOldest() {
+    auto oldest = sensors_.begin();
+    for (auto it = sensors_.begin(); it != sensors_.end(); ++it)
+        if (it->second.last_used < oldest->second.last_used) oldest = it;
+    if (oldest == sensors_.end()) return;
+    Sensor& s = oldest->second;
+    if (s.pipeline->finish()) collectFinished(s);  // its held keyframe is not lost
+    sensors_.erase(oldest);
+    ++counters_.sensors_evicted;
+    drain();
 }
 
 void StreamFilter::collectFinished(Sensor& s) {

@@ -31,7 +31,21 @@ struct LiveCounters {
     std::size_t resets = 0;           // state forgotten: time jumped back
     std::size_t geometry_resets = 0;  // a frame's beam count or angles changed (the door's reset)
     std::size_t scans_skipped = 0;    // unusable geometry (the door's check): not published
+    /// Dropped before the door: a stamp kfd cannot compute with (not finite, negative, or
+    /// within kStampMargin of the end of ROS 1's 32-bit time), or a message whose handling
+    /// threw (the node catches it per message).
+    std::size_t stamps_unusable = 0;
+    std::size_t callback_errors = 0;
+    /// Frames whose state was dropped to keep at most StreamFilter::kDefaultMaxSensors (the
+    /// least recently heard first, a held keyframe published first): a flood of frame ids.
+    std::size_t sensors_evicted = 0;
 };
+
+/// s: stamps this close to the end of ROS 1's time (2^32 s) are unusable: the waits and
+/// windows added to a stamp (tf_wait, the odometry's hold) must stay inside it.
+constexpr double kStampMargin = 86400.0;
+/// A stamp (s) kfd computes with: finite, >= 0 and at most 2^32 - 1 - kStampMargin.
+bool usableStamp(double seconds);
 
 /// What LiveFilter::process decided for one message.
 struct LiveResult {
@@ -83,6 +97,13 @@ class LiveFilter {
     /// --clock`): a clock that went back (the bag looping or restarting, however short) resets
     /// every frame's state and counts a reset, before the scan's own rules. True when it did.
     bool onClock(double now);
+    /// A received scan whose stamp is not usableStamp(): counted (scans_in, stamps_unusable),
+    /// never reaches the door; false. True for a usable stamp (nothing counted: process()
+    /// counts the scan).
+    bool acceptStamp(double stamp);
+    /// A received message whose handling threw: counted (scans_in when `scan`,
+    /// callback_errors).
+    void countError(bool scan);
     /// Forgets every frame's state (the counters stay); what a time jump does. A held keyframe
     /// is finished first (takeReady()).
     void reset();

@@ -59,6 +59,9 @@ struct ScanCounters {
     std::size_t odometry_bad = 0;      // scans whose odometry was not finite (used as unknown)
     std::size_t stamps_backwards = 0;  // scans stamped before their sensor's previous scan
     std::size_t geometry_resets = 0;   // a sensor's geometry changed: its state was reset
+    /// Sensors whose state was dropped to keep at most StreamFilter::maxSensors() (the least
+    /// recently seen first; a held scan finished first): a stream of ever new sensor names.
+    std::size_t sensors_evicted = 0;
     /// The largest share of a kept scan's valid returns the denoising stages removed (0-1).
     double max_removed_noise_share = 0.0;
     std::size_t points_in = 0;             // valid beams of the scans that ran

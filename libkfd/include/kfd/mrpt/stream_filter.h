@@ -144,6 +144,13 @@ class StreamFilter {
         sensors_.clear();
     }
     std::size_t sensorCount() const { return sensors_.size(); }
+    /// At most this many sensors keep state (a pipeline each, ~30-60 KB): a scan of a new
+    /// sensor beyond it evicts the sensor seen least recently, its held scan finished first
+    /// (counted: ScanCounters::sensors_evicted). A stream of ever new sensor labels or frame
+    /// ids then holds bounded memory. kDefaultMaxSensors unless set; at least 1.
+    static constexpr std::size_t kDefaultMaxSensors = 64;
+    void setMaxSensors(std::size_t n) { max_sensors_ = n < 1 ? 1 : n; }
+    std::size_t maxSensors() const { return max_sensors_; }
     const Pipeline::Params& params() const { return params_; }
     /// The clusters of the last denoised scan of a sensor (nullptr if none).
     const Clusters* lastClusters(const std::string& sensor_label) const;
@@ -154,8 +161,11 @@ class StreamFilter {
         ScanGeometry geometry;
         Scan scan;  // reused buffer
         double last_stamp = std::numeric_limits<double>::quiet_NaN();
-        StreamResult held;  // the pending scan's result (held.scan: its observation)
+        StreamResult held;            // the pending scan's result (held.scan: its observation)
+        std::uint64_t last_used = 0;  // the door's scan count when it last had a scan
     };
+    // Evicts the sensor seen least recently (its held scan finished and recorded first).
+    void evictOldest();
     Sensor& sensorFor(const std::string& label);
     void record(StreamResult& r);
     void count(const StreamResult& r);
@@ -184,6 +194,7 @@ class StreamFilter {
     ScanCounters counters_;
     StageOutputs outputs_;  // of params_.stages
     bool laser_only_ = false;
+    std::size_t max_sensors_ = kDefaultMaxSensors;
 };
 
 /// Empty when a run through the door had a usable scan (one that reached the pipeline); else

@@ -75,6 +75,9 @@ class ScanFilterNode {
   private:
     std::size_t publishReady();  // LiveFilter::takeReady's messages on scan_filtered; mutex_ held
     // The track stage's pose of the scan `r` is about, on ~track_topic (and /tf with ~track_tf).
+    // onScan's work for a scan with a usable stamp (may throw: onScan catches it).
+    void handleScan(const sensor_msgs::LaserScan::ConstPtr& in, const ros::Time& now,
+                    const ros::Time& stamp);
     void publishTrack(const LiveResult& r, const ros::Time& stamp);
     std::optional<Pose2D> tfAtTheEdges(const ros::Time& stamp);
     bool newestTfAfter(const ros::Time& stamp) const;  // odom -> base known after stamp
@@ -94,7 +97,8 @@ class ScanFilterNode {
     ros::NodeHandle nh_, pnh_;
     mutable std::mutex mutex_;  // the filter, the mounts, the latencies
     LiveFilter filter_;
-    std::mutex odom_mutex_;  // the odometry samples (their own thread: see onOdometry)
+    std::size_t evicted_seen_ = 0;  // sensors_evicted already warned about
+    std::mutex odom_mutex_;         // the odometry samples (their own thread: see onOdometry)
     std::condition_variable odom_cv_;
     OdometryBuffer odom_buffer_;
     LatencyStats latency_;  // callback entry to publish return
