@@ -29,6 +29,7 @@
 #include <mrpt/io/CFileGZInputStream.h>
 
 #include "kfd/io/open_source.h"
+#include "sanitizer.h"
 #include "test_bags.h"
 #include "test_files.h"
 
@@ -53,17 +54,7 @@ struct Result {
 };
 
 // AddressSanitizer reserves terabytes of address space: no RLIMIT_AS under it.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAsan = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kAsan = true;
-#else
-constexpr bool kAsan = false;
-#endif
-#else
-constexpr bool kAsan = false;
-#endif
+using kfd::test::kAsan;
 
 // Starts `exe args...` with stdout and stderr into files under `dir`; returns the pid. A
 // non-zero `address_space` limits the app's address space to that many bytes (RLIMIT_AS; not

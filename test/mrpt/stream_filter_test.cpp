@@ -15,6 +15,7 @@
 #include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/stream_filter.h"
 #include "kfd/stages/core_stages.h"
+#include "sanitizer.h"
 
 namespace {
 
@@ -472,8 +473,12 @@ TEST(StreamFilter, EverNewSensorLabelsAreEvictedOldestFirstWithNothingHeldLost) 
     EXPECT_EQ(done, labels);
     EXPECT_EQ(kept, labels);  // each the first scan of its sensor: a keyframe
     EXPECT_EQ(f.counters().scans_kept, labels);
-    // ~30-60 KB per sensor kept forever would be 90-180 MB here.
-    EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 40 * 1024) << "KiB";
+    // ~30-60 KB per sensor kept forever would be 90-180 MB here. AddressSanitizer keeps freed
+    // memory in its quarantine (up to 256 MB), so the bound holds only without it; the counts
+    // above hold everywhere.
+    if (!kfd::test::kAsan) {
+        EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 40 * 1024) << "KiB";
+    }
 }
 
 TEST(StreamFilter, AnEvictedSensorStartsAgainAsANewOne) {
