@@ -284,22 +284,11 @@ void countReason(ScanCounters& c, const char* reason) {
     c.reasons.emplace_back(reason, 1);
 }
 
-// Keeps the kMostRemoved largest shares, largest first (ties: the earlier scan first).
-void keepMostRemoved(ScanCounters& c, const ScanCounters::Removal& r) {
-    auto& v = c.most_removed;
-    const auto at = std::find_if(
-        v.begin(), v.end(), [&](const ScanCounters::Removal& o) { return r.share() > o.share(); });
-    if (at == v.end() && v.size() >= ScanCounters::kMostRemoved) return;
-    v.insert(at, r);
-    if (v.size() > ScanCounters::kMostRemoved) v.pop_back();
-}
-
-// Keeps the kMostRemoved longest surface-like runs, longest first (ties: the earlier scan).
-void keepSurfaceRemoved(ScanCounters& c, const ScanCounters::SurfaceRemoval& r) {
-    ++c.scans_surface_removed;
-    auto& v = c.surface_removed;
-    const auto at =
-        std::find_if(v.begin(), v.end(), [&](const auto& o) { return r.length_m > o.length_m; });
+// Keeps in `v` the ScanCounters::kMostRemoved entries of largest key(r), largest first (ties:
+// the one given first): the most-cut scans, the longest surface-like runs.
+template <class T, class Key>
+void keepLargest(std::vector<T>& v, const T& r, Key key) {
+    const auto at = std::find_if(v.begin(), v.end(), [&](const T& o) { return key(r) > key(o); });
     if (at == v.end() && v.size() >= ScanCounters::kMostRemoved) return;
     v.insert(at, r);
     if (v.size() > ScanCounters::kMostRemoved) v.pop_back();
@@ -332,8 +321,13 @@ void StreamFilter::count(const StreamResult& res) {
                      static_cast<double>(rec.removed_noise) / static_cast<double>(usable));
     c.points_removed += rep.points_in - rep.points_out;
     if (rec.removed_noise > 0)
-        keepMostRemoved(c, {rec.index, rec.stamp, rec.removed_noise, usable});
-    if (rec.surface_m > 0.0) keepSurfaceRemoved(c, {rec.index, rec.stamp, rec.surface_m});
+        keepLargest(c.most_removed, {rec.index, rec.stamp, rec.removed_noise, usable},
+                    [](const ScanCounters::Removal& r) { return r.share(); });
+    if (rec.surface_m > 0.0) {
+        ++c.scans_surface_removed;
+        keepLargest(c.surface_removed, {rec.index, rec.stamp, rec.surface_m},
+                    [](const ScanCounters::SurfaceRemoval& r) { return r.length_m; });
+    }
 }
 
 std::vector<std::string> reasonLines(const ScanCounters& c) {
