@@ -36,13 +36,16 @@ import argparse
 import concurrent.futures
 import csv
 import hashlib
+import io
 import json
 import math
 import os
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
+import threading
 import time
 
 from . import diagnose as kfd_diagnose
@@ -86,6 +89,27 @@ MAX_JOBS = 4096     # runs at a time
 
 # The logs kfd-icp-slam reads (by content; these extensions mark a spec as a path).
 LOG_EXTENSIONS = (".rawlog", ".bag", ".clf", ".log", ".clf.gz", ".log.gz", ".db3", ".mcap")
+
+
+class Interrupted(Exception):
+    """A run stopped by Ctrl-C or SIGTERM (or not started for it): recorded as interrupted, not
+    failed; collect leaves it out of every verdict and a rerun completes it."""
+
+
+# Ctrl-C / SIGTERM: no new run starts, the running ones get SIGINT (kfd-icp-slam stops cleanly).
+_STOP = threading.Event()
+_RUNNING = set()
+_RUNNING_LOCK = threading.Lock()
+
+
+def interrupt_running():
+    _STOP.set()
+    with _RUNNING_LOCK:
+        for p in _RUNNING:
+            try:
+                p.send_signal(signal.SIGINT)
+            except OSError:
+                pass
 
 
 def log_stem(filename):
@@ -305,14 +329,35 @@ def run_job(a):
     os.makedirs(os.path.dirname(folder), exist_ok=True)
     t0 = time.monotonic()
     with open(folder + ".stderr", "w") as err:
-        p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err)
-        _, status, ru = os.wait4(p.pid, 0)
+        with _RUNNING_LOCK:
+            if _STOP.is_set():
+                raise Interrupted("not started")
+            # A session of its own: a Ctrl-C reaches kfd-compare, which stops its runs itself.
+            p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err,
+                                 start_new_session=True)
+            _RUNNING.add(p)
+        try:
+            _, status, ru = os.wait4(p.pid, 0)
+        finally:
+            with _RUNNING_LOCK:
+                _RUNNING.discard(p)
         p.returncode = os.waitstatus_to_exitcode(status)  # reaped here, not by Popen
     wall = time.monotonic() - t0
     code = p.returncode
+    if code != 0 and (_STOP.is_set() or code in (130, 143, -signal.SIGINT, -signal.SIGTERM)):
+        write_run(done, dict(ident, finished=False, interrupted=True, command=cmd,
+                             error="interrupted (exit %d)" % code))
+        raise Interrupted("%s %s r%d" % (ident["log"], ident["mode"], ident["repeat"]))
     if code != 0:
         with open(folder + ".stderr") as f:
             msg = f.read().strip().splitlines()
+        if code == 1 and msg and "skipped at its start" in msg[0]:
+            # Repeat K skips K scans: beyond the log's scans it is not a run at all (neither
+            # recorded nor failed), but a request to make smaller.
+            os.remove(folder + ".stderr")
+            raise CompareError("%s has no scan left after skipping %d: --repeats %d asks for "
+                               "more repeats than the log has scans (repeat K skips K scans)"
+                               % (ident["log"], a.repeat, a.repeat + 1))
         how = "exit %d" % code if code > 0 else "killed by signal %d" % -code
         run_failed(done, ident, "kfd-icp-slam failed (%s): %s" % (
             how, msg[0] if msg else "no message"), cmd, exit_code=code, wall_s=wall,
@@ -444,7 +489,7 @@ def cmd_run(a):
               file=sys.stderr)
         return 0
     t0 = time.monotonic()
-    failed = []
+    failed, interrupted = [], []
 
     def one(j):
         log, config, mode, k = j
@@ -454,12 +499,18 @@ def cmd_run(a):
                                 scan_topic=a.scan_topic, odom_topic=a.odom_topic)
         return run_job(ns)
 
-    with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
-        futures = {pool.submit(one, j): j for j in jobs}
+    def on_term(*_):
+        raise KeyboardInterrupt
+    old_term = signal.signal(signal.SIGTERM, on_term)
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs)
+    futures = {pool.submit(one, j): j for j in jobs}
+    try:
         for n, fut in enumerate(concurrent.futures.as_completed(futures), 1):
             j = futures[fut]
             try:
                 fut.result()
+            except Interrupted:
+                interrupted.append(j)
             except (CompareError, subprocess.CalledProcessError) as e:
                 failed.append((j, str(e)))
             if not a.quiet:
@@ -467,10 +518,39 @@ def cmd_run(a):
                 print("[kfd-compare] %d/%d %s %s %s r%02d  (%.0f s, eta %.0f s)" % (
                     n, len(jobs), j[0], config_tag(j[1]), j[2], j[3], el,
                     el / n * (len(jobs) - n)), file=sys.stderr, flush=True)
+    except KeyboardInterrupt:
+        return stop_runs(a, pool, futures)
+    finally:
+        signal.signal(signal.SIGTERM, old_term)
+    pool.shutdown()
     for j, e in failed:
         print("[kfd-compare] failed: %s" % e, file=sys.stderr)
     collect(a.out, a.baseline, a.pairs, a.plots, a.quiet, a.failure_factor)
     return 1 if failed else 0
+
+
+def stop_runs(a, pool, futures):
+    """Ctrl-C or SIGTERM during `run`: the queue stops, the running runs are stopped and
+    recorded as interrupted, the report is made of what finished. Exit status 130."""
+    print("[kfd-compare] interrupted: stopping the running runs (they are recorded as "
+          "interrupted, not failed; run the same command again to complete them)",
+          file=sys.stderr, flush=True)
+    for f in futures:
+        f.cancel()
+    interrupt_running()
+    pool.shutdown(wait=True)
+    stopped = sum(1 for f in futures if f.cancelled() or isinstance(f.exception(), Interrupted))
+    done = sum(1 for f in futures if not f.cancelled() and f.exception() is None)
+    bad = sum(1 for f in futures if not f.cancelled() and isinstance(
+        f.exception(), (CompareError, subprocess.CalledProcessError)))
+    print("[kfd-compare] %d runs finished, %d failed, %d interrupted or not started" % (
+        done, bad, stopped), file=sys.stderr, flush=True)
+    if done:
+        try:
+            collect(a.out, a.baseline, a.pairs, a.plots, a.quiet, a.failure_factor)
+        except CompareError as e:
+            print("[kfd-compare] %s" % e, file=sys.stderr)
+    return 130
 
 
 # --- collect ---------------------------------------------------------------------------------
@@ -539,29 +619,61 @@ def collect(out, baseline="none", pairs=None, plots=True, quiet=False,
     if not failure_factor > 0:
         raise CompareError("--failure-factor must be > 0 (got %g)" % failure_factor)
     runs = load_runs(out)
+    # Interrupted runs (Ctrl-C) are neither finished nor failed: left out of every verdict.
+    interrupted = [r for r in runs if r.get("interrupted")]
+    runs = [r for r in runs if not r.get("interrupted")]
+    if not runs:
+        raise CompareError("only interrupted runs under %s: run kfd-compare run again to "
+                           "complete them" % os.path.join(out, "runs"))
     groups, stats = kfd_report.analyse(runs, baseline,
                                        [tuple(x.split(":", 1)) for x in pairs or []],
                                        failure_factor, lambda r: run_trajectory(out, r))
-    with open(os.path.join(out, "runs.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=RUN_COLUMNS, extrasaction="ignore")
-        w.writeheader()
-        for r in runs:
-            w.writerow(r)
+    stats["interrupted"] = [{k: r.get(k) for k in ("log", "config", "mode", "repeat")}
+                            for r in interrupted]
+    table = io.StringIO(newline="")
+    w = csv.DictWriter(table, fieldnames=RUN_COLUMNS, extrasaction="ignore")
+    w.writeheader()
+    for r in runs:
+        w.writerow(r)
     if plots:
         for g in groups:
             plot(out, g.log, g.config, g.modes, baseline)
-    with open(os.path.join(out, "runs.json"), "w") as f:
-        json.dump(stats, f, indent=1)
-    with open(os.path.join(out, "summary.md"), "w") as f:
-        f.write(kfd_report.summary_md(groups, stats))
-    with open(os.path.join(out, "report.md"), "w") as f:
-        f.write(kfd_report.report_md(groups, stats, out, plots))
+    note = ("%d interrupted run(s) left out (kfd-compare run again completes them).\n\n" %
+            len(interrupted) if interrupted else "")
+    write_all({os.path.join(out, "runs.csv"): table.getvalue(),
+               os.path.join(out, "runs.json"): json.dumps(stats, indent=1),
+               os.path.join(out, "summary.md"): note + kfd_report.summary_md(groups, stats),
+               os.path.join(out, "report.md"): note + kfd_report.report_md(groups, stats, out,
+                                                                           plots)})
     if not quiet:
         failed = sum(1 for r in runs if r["failed"])
-        print("[kfd-compare] %d runs (%d failed): %s, %s, %s, %s" % (
-            len(runs), failed, os.path.join(out, "summary.md"), os.path.join(out, "report.md"),
+        print("[kfd-compare] %d runs (%d failed%s): %s, %s, %s, %s" % (
+            len(runs), failed, ", %d interrupted left out" % len(interrupted) if interrupted
+            else "", os.path.join(out, "summary.md"), os.path.join(out, "report.md"),
             os.path.join(out, "runs.csv"), os.path.join(out, "runs.json")), file=sys.stderr)
     return stats
+
+
+def write_all(files):
+    """Writes {path: text} complete or not at all: every file to PATH.tmp first, then each
+    renamed over its path; when one cannot be written (a full disk), the temporary files are
+    removed and the old files stay as they were, all of them (CompareError)."""
+    written = []
+    try:
+        for path, text in files.items():
+            written.append(path + ".tmp")
+            with open(path + ".tmp", "w", newline="") as f:
+                f.write(text)
+    except OSError as e:
+        for tmp in written:
+            try:
+                os.remove(tmp)
+            except OSError:
+                pass
+        raise CompareError("cannot write %s (%s): the reports in %s are left as they were" % (
+            written[-1][:-len(".tmp")], e.strerror or e, os.path.dirname(written[-1])))
+    for path in files:
+        os.replace(path + ".tmp", path)
 
 
 def run_trajectory(out, r):
@@ -593,7 +705,9 @@ def plot(out, log, config, modes, baseline):
     fig.suptitle("%s, %s: %d repeats per mode" % (log, config, n), fontsize=10)
     fig.tight_layout()
     os.makedirs(os.path.join(out, "plots"), exist_ok=True)
-    fig.savefig(os.path.join(out, "plots", "%s-%s.png" % (log, config)), dpi=110)
+    png = os.path.join(out, "plots", "%s-%s.png" % (log, config))
+    fig.savefig(png + ".tmp", dpi=110, format="png")  # complete or absent, as write_all
+    os.replace(png + ".tmp", png)
     plt.close(fig)
 
 

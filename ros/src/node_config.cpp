@@ -1,5 +1,6 @@
 #include "kfd/ros1/node_config.h"
 
+#include <cctype>
 #include <cmath>
 #include <sstream>
 
@@ -67,6 +68,32 @@ std::string stringParam(const std::string& key, XmlRpcValue v) {
     return std::string(v);
 }
 
+// A tf2 frame id: not empty, no leading '/' (tf2 refuses it in every lookup), no white space.
+std::string frameParam(const std::string& key, XmlRpcValue v) {
+    const std::string f = stringParam(key, v);
+    if (f.empty()) throw ConfigError(key, "is empty: a tf frame id is needed (e.g. odom)");
+    if (f[0] == '/')
+        throw ConfigError(key, "'" + f + "': tf2 frame ids do not start with '/' (use '" +
+                                   f.substr(f.find_first_not_of('/') == std::string::npos
+                                                ? f.size()
+                                                : f.find_first_not_of('/')) +
+                                   "')");
+    for (const char ch : f)
+        if (std::isspace(static_cast<unsigned char>(ch)) || ch == '\0')
+            throw ConfigError(key, "'" + f + "' holds white space: not a tf frame id");
+    return f;
+}
+
+int intParam(const std::string& key, XmlRpcValue v, int lo, int hi) {
+    if (v.getType() != XmlRpcValue::TypeInt)
+        throw ConfigError(key, std::string("is ") + typeName(v.getType()) + ", not an int");
+    const int n = int(v);
+    if (n < lo || n > hi)
+        throw ConfigError(key, std::to_string(n) + " is outside [" + std::to_string(lo) + ", " +
+                                   std::to_string(hi) + "]");
+    return n;
+}
+
 double secondsParam(const std::string& key, XmlRpcValue v, double lo, double hi) {
     double d = 0.0;
     if (v.getType() == XmlRpcValue::TypeDouble)
@@ -99,7 +126,7 @@ void checkTrackTf(const NodeConfig& c) {
 
 bool isNodeParameter(const std::string& name) {
     for (const char* n : {"config", "odom", "odom_frame", "base_frame", "tf_wait", "removed_as",
-                          "reset_jump", "queue_size", "track_topic", "track_tf"})
+                          "reset_jump", "queue_size", "max_sensors", "track_topic", "track_tf"})
         if (name == n) return true;
     return false;
 }
@@ -123,21 +150,17 @@ NodeConfig nodeConfig(const std::map<std::string, XmlRpc::XmlRpcValue>& params) 
             else
                 throw ConfigError(key, "'" + s + "' is not tf, topic or none");
         } else if (key == "odom_frame") {
-            c.odom_frame = stringParam(key, value);
+            c.odom_frame = frameParam(key, value);
         } else if (key == "base_frame") {
-            c.base_frame = stringParam(key, value);
+            c.base_frame = frameParam(key, value);
         } else if (key == "tf_wait") {
             c.tf_wait = secondsParam(key, value, 0.0, 10.0);
         } else if (key == "reset_jump") {
             c.reset_jump = secondsParam(key, value, 0.0, 1e9);
         } else if (key == "queue_size") {
-            if (value.getType() != XmlRpc::XmlRpcValue::TypeInt)
-                throw ConfigError(key,
-                                  std::string("is ") + typeName(value.getType()) + ", not an int");
-            const int q = int(XmlRpc::XmlRpcValue(value));
-            if (q < 1 || q > 1000)
-                throw ConfigError(key, std::to_string(q) + " is outside [1, 1000]");
-            c.queue_size = q;
+            c.queue_size = intParam(key, value, 1, 1000);
+        } else if (key == "max_sensors") {
+            c.max_sensors = intParam(key, value, 1, 100000);
         } else if (key == "track_topic") {
             c.track_topic = stringParam(key, value);
         } else if (key == "track_tf") {

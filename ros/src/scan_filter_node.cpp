@@ -14,6 +14,7 @@
 
 #include "kfd/algorithms/scan_tracker.h"
 #include "kfd/io/laser_scan.h"
+#include "kfd/ros1/graceful_stop.h"
 #include "kfd/stages/track_stage.h"
 
 namespace kfd::ros1 {
@@ -59,7 +60,8 @@ ScanFilterNode::ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh, const No
     : config_(config),
       nh_(nh),
       pnh_(pnh),
-      filter_(LiveFilter::Params{config.pipeline, config.removed, config.reset_jump}) {
+      filter_(LiveFilter::Params{config.pipeline, config.removed, config.reset_jump,
+                                 std::size_t(config.max_sensors)}) {
     for (const std::string& note : config_.notes) ROS_WARN("kfd: %s", note.c_str());
     tf_ = std::make_unique<tf2_ros::Buffer>();
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_, nh_, true);
@@ -83,6 +85,7 @@ ScanFilterNode::ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh, const No
         nh_.subscribe("scan", q, &ScanFilterNode::onScan, this, ros::TransportHints().tcpNoDelay());
     timer_ = nh_.createWallTimer(ros::WallDuration(1.0),
                                  [this](const ros::WallTimerEvent&) { publishStats(); });
+    stop_token_ = GracefulStop::add([this] { stop(); });
 }
 
 ScanFilterNode::~ScanFilterNode() {
@@ -90,10 +93,23 @@ ScanFilterNode::~ScanFilterNode() {
     if (odom_spinner_) odom_spinner_->stop();
     odom_sub_.shutdown();
     scan_sub_.shutdown();
-    if (ros::ok()) {
-        finish();
-        publishStats();
-    }
+    // Nodelet unload (ROS goes on, this filter goes): what is held goes out first, then the
+    // registration, whose removal passes on a stop asked for meanwhile (GracefulStop).
+    if (ros::ok() && finishOnce() > 0) ros::WallDuration(0.3).sleep();  // reaches subscribers
+    GracefulStop::remove(stop_token_);
+}
+
+void ScanFilterNode::stop() {
+    stopping_ = true;  // an onScan waiting for odometry gives up, later scans are dropped
+    finishOnce();
+}
+
+std::size_t ScanFilterNode::finishOnce() {
+    if (finished_.exchange(true)) return 0;  // a stop and an unload may race: one finishes
+    const std::size_t held = finish();
+    publishStats();
+    ROS_INFO("kfd: stopping (%zu held keyframe%s published)", held, held == 1 ? "" : "s");
+    return held;
 }
 
 std::size_t ScanFilterNode::finish() {
@@ -143,7 +159,12 @@ bool ScanFilterNode::newestTfAfter(const ros::Time& stamp) const {
 }
 
 double ScanFilterNode::waitBound() const {
-    if (intervals_.empty()) return config_.tf_wait;
+    // Before two scans have come, the scan's own scan_time says the pace (a laser-only bag's
+    // first scan must not wait ~tf_wait while the queue overflows).
+    if (intervals_.empty())
+        return scan_time_ > 0.0
+                   ? std::min(config_.tf_wait, double(config_.queue_size - 1) * scan_time_)
+                   : config_.tf_wait;
     std::array<double, kIntervals> v;  // a copy on the stack: no allocation per scan
     const auto end = std::copy(intervals_.begin(), intervals_.end(), v.begin());
     const auto mid = v.begin() + std::ptrdiff_t(intervals_.size() / 2);
@@ -159,7 +180,7 @@ bool ScanFilterNode::waitFor(const ros::Time& stamp, Ready ready) {
         std::chrono::steady_clock::now() + std::chrono::duration<double>(2.0 * bound);
     while (!ready()) {
         if (ros::Time::now() >= deadline || std::chrono::steady_clock::now() >= wall_deadline ||
-            !ros::ok())
+            !ros::ok() || stopping_)
             return false;
         std::this_thread::sleep_for(std::chrono::microseconds(500));
     }
@@ -256,6 +277,7 @@ void ScanFilterNode::onScan(const sensor_msgs::LaserScan::ConstPtr& in) {
     // No message may take the node (or the nodelet manager, and a driver loaded there) down:
     // a stamp kfd cannot compute with is dropped and counted before any ros::Time arithmetic,
     // and anything else that throws drops this scan only (issue 38).
+    if (stopping_) return;  // stopping: what is held is published, nothing new comes in
     std::lock_guard<std::mutex> lock(mutex_);
     const ros::Time now = ros::Time::now();
     const ros::Time stamp = in->header.stamp.isZero() ? now : in->header.stamp;
@@ -286,6 +308,9 @@ void ScanFilterNode::handleScan(const sensor_msgs::LaserScan::ConstPtr& in, cons
             intervals_[next_interval_++ % intervals_.size()] = dt;
     }
     last_scan_stamp_ = stamp;
+    if (std::isfinite(in->scan_time) && in->scan_time > 0.0f && in->scan_time < 10.0f)
+        scan_time_ = in->scan_time;
+    checkSequence(*in);
     if (ros::Time::isSimTime() && filter_.onClock(now.toSec())) {
         std::lock_guard<std::mutex> odom_lock(odom_mutex_);
         odom_buffer_.clear();
@@ -306,22 +331,62 @@ void ScanFilterNode::handleScan(const sensor_msgs::LaserScan::ConstPtr& in, cons
         ROS_WARN("kfd: time jumped back on frame '%s' (scan at %.3f s): state reset",
                  in->header.frame_id.c_str(), stamp.toSec());
     }
-    if (filter_.counters().sensors_evicted > evicted_seen_) {
-        evicted_seen_ = filter_.counters().sensors_evicted;
-        ROS_WARN_THROTTLE(5.0,
-                          "kfd: more than %zu frame ids: the state of the one heard from longest "
-                          "ago was dropped (%zu so far, sensors_evicted)",
-                          StreamFilter::kDefaultMaxSensors, evicted_seen_);
-    }
-    if (r.out_of_order)
-        ROS_WARN_THROTTLE(5.0, "kfd: scan of frame '%s' at %.3f s is out of order: dropped",
-                          in->header.frame_id.c_str(), stamp.toSec());
+    reportScan(*in, stamp, r, odom.has_value());
     publishReady();  // held keyframes (next_scan) finished by a reset or this scan, before it
     if (r.publish) scan_pub_.publish(out);
     publishTrack(r, stamp);
     const auto end = std::chrono::steady_clock::now();
     latency_.add(std::chrono::duration<double, std::micro>(end - start).count());
     work_.add(std::chrono::duration<double, std::micro>(end - ready).count());
+}
+
+void ScanFilterNode::checkSequence(const sensor_msgs::LaserScan& m) {
+    const std::string frame = frameLabel(m.header.frame_id);
+    const auto it = last_seq_.find(frame);
+    // A gap of up to 10 000: scans that never arrived; a larger jump or a step back is a
+    // publisher that restarted. A driver that leaves seq at 0 never counts.
+    if (it != last_seq_.end() && m.header.seq > it->second + 1 &&
+        m.header.seq - it->second <= 10000) {
+        filter_.countMissing(m.header.seq - it->second - 1);
+        if (!warned_missing_)
+            ROS_WARN(
+                "kfd: %u scan(s) of frame '%s' never arrived (header.seq %u after %u): "
+                "lost in the queue (~queue_size) or before kfd; counted in scans_missing",
+                m.header.seq - it->second - 1, m.header.frame_id.c_str(), m.header.seq, it->second);
+        warned_missing_ = true;
+    }
+    if (it == last_seq_.end() && last_seq_.size() >= StreamFilter::kDefaultMaxSensors)
+        last_seq_.clear();  // a flood of frame ids: bounded like the door's sensors
+    last_seq_[frame] = m.header.seq;
+}
+
+void ScanFilterNode::reportScan(const sensor_msgs::LaserScan& m, const ros::Time& stamp,
+                                const LiveResult& r, bool has_odometry) {
+    const char* frame = m.header.frame_id.c_str();
+    if (config_.odometry != NodeConfig::Odometry::None && !has_odometry && !warned_odom_) {
+        warned_odom_ = true;
+        const std::string source =
+            config_.odometry == NodeConfig::Odometry::Tf
+                ? "transform " + config_.odom_frame + " -> " + config_.base_frame
+                : "topic " + nh_.resolveName("odom");
+        ROS_WARN(
+            "kfd: no odometry for the scan of frame '%s' at %.3f s (%s): filtered laser "
+            "only, counted in odom_missing; set ~odom: none on a robot without odometry",
+            frame, stamp.toSec(), source.c_str());
+    }
+    if (r.stream.skipped != ScanSkipReason::None)
+        ROS_WARN_THROTTLE(5.0, "kfd: scan of frame '%s' at %.3f s has %s: dropped (scans_skipped)",
+                          frame, stamp.toSec(), describe(r.stream.skipped));
+    if (filter_.counters().sensors_evicted > evicted_seen_) {
+        evicted_seen_ = filter_.counters().sensors_evicted;
+        ROS_WARN_THROTTLE(5.0,
+                          "kfd: more than %d frame ids (~max_sensors): the state of the one heard "
+                          "from longest ago was dropped (%zu so far, sensors_evicted)",
+                          config_.max_sensors, evicted_seen_);
+    }
+    if (r.out_of_order)
+        ROS_WARN_THROTTLE(5.0, "kfd: scan of frame '%s' at %.3f s is out of order: dropped", frame,
+                          stamp.toSec());
 }
 
 void ScanFilterNode::publishTrack(const LiveResult& r, const ros::Time& stamp) {
@@ -358,10 +423,14 @@ diagnostic_msgs::DiagnosticStatus ScanFilterNode::stats() const {
     diagnostic_msgs::DiagnosticStatus s;
     s.name = ros::this_node::getName() + ": kfd scan filter";
     s.hardware_id = "kfd";
-    s.level = diagnostic_msgs::DiagnosticStatus::OK;
     char buf[160];
     std::snprintf(buf, sizeof(buf), "%zu of %zu scans kept", c.scans_kept, c.scans_in);
     s.message = buf;
+    // Anything lost or degraded raises the level and is named in the message.
+    const auto look = live::attention(c, config_.odometry != NodeConfig::Odometry::None);
+    s.level = look.empty() ? diagnostic_msgs::DiagnosticStatus::OK
+                           : diagnostic_msgs::DiagnosticStatus::WARN;
+    for (const std::string& what : look) s.message += "; " + what;
     for (const auto& [key, value] : live::counterValues(c)) s.values.push_back(kv(key, value));
     for (const auto& [key, value] :
          {std::pair<const char*, double>{"latency_p50_us", latency_.percentile(50.0)},

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs one libFuzzer target for N minutes: scripts/ci/fuzz.sh TARGET MINUTES
-#   TARGET: pipeline, ini, yaml, rawlog, carmen, bag, mcap, db3 or ros2_node (test/fuzz/fuzz_TARGET.cpp)
+#   TARGET: pipeline, ini, yaml, rawlog, carmen, bag, mcap, db3, ros2_node or ros1_node (test/fuzz/fuzz_TARGET.cpp)
 # Builds the fuzzers in build-fuzz/ (clang, KFD_BUILD_FUZZERS=ON) when needed, starts from
 # the committed corpus test/fuzz/corpus/TARGET/ (new inputs go to build-fuzz/corpus/TARGET/,
 # the committed one is never written), runs with -max_total_time and a 2 s timeout per input,
@@ -9,7 +9,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 if [ $# -ne 2 ]; then
-  echo "usage: $0 TARGET MINUTES   (TARGET: pipeline, ini, yaml, rawlog, carmen, bag, mcap, db3, ros2_node)" >&2
+  echo "usage: $0 TARGET MINUTES   (TARGET: pipeline, ini, yaml, rawlog, carmen, bag, mcap, db3, ros2_node, ros1_node)" >&2
   exit 2
 fi
 target="$1"

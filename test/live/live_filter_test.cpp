@@ -339,3 +339,17 @@ TEST(LiveFilter, AFloodOfFrameIdsKeepsBoundedStateAndCountsIt) {
         listed = listed || (key == "sensors_evicted" && value == 936.0);
     EXPECT_TRUE(listed);
 }
+
+// ~max_sensors: the bound is the user's (a robot with many lasers raises it, a small one lowers
+// it); the frame heard from longest ago goes first.
+TEST(LiveFilter, TheFrameBoundIsAParameter) {
+    LiveFilter::Params p = defaults();
+    p.max_sensors = 2;
+    LiveFilter f(p);
+    for (const char* frame : {"a", "b", "a", "c", "a"}) {
+        auto m = roomScan(f.counters().scans_in + 1.0, frame);
+        f.process(m, f.counters().scans_in + 1.0, std::nullopt, false);
+    }
+    EXPECT_EQ(f.door().sensorCount(), 2u);
+    EXPECT_EQ(f.counters().sensors_evicted, 1u);  // b, when c came; a was heard since
+}

@@ -620,6 +620,54 @@ TEST(ConfigYamlCheck, SubsetRules) {
     EXPECT_EQ(yamlError("pipeline: [distance, keyframe]\nwindow: \"3\"\n"), "<no error>");
 }
 
+// Issue 38's low items: what MRPT's readers took silently or reported without its cause.
+TEST(ConfigBadInput, HexNumbersNulBytesUndefinedVariablesAndKeysBesideKfdAreRefused) {
+    // strtod read "0x10" as 16.
+    EXPECT_EQ(errorKey("[KFD]\n[KFD.view_keyframe]\nmax_consecutive_drops = 0x10\n"),
+              "max_consecutive_drops");
+    EXPECT_EQ(errorKey("[KFD]\n[KFD.view_keyframe]\nmax_view_change = 0x1p-1\n"),
+              "max_view_change");
+    EXPECT_EQ(errorKey("[KFD]\n[KFD.view_keyframe]\nmax_consecutive_drops = 16\n"), "<no error>");
+    kfd::test::TempDir dir("kfd_config_");
+    // The C string ended at the NUL: "3<NUL>junk" was 3.
+    const std::string nul = writeFile(
+        dir, "nul.ini",
+        std::string("[KFD]\n[KFD.view_keyframe]\nmax_consecutive_drops = 3") + '\0' + "junk\n");
+    const std::string nul_yaml =
+        writeFile(dir, "nul.yaml",
+                  std::string("view_keyframe:\n  max_consecutive_drops: 3") + '\0' + "junk\n");
+    for (const std::string& path : {nul, nul_yaml}) {
+        try {
+            kfd::loadConfigFile(path);
+            ADD_FAILURE() << path << " accepted";
+        } catch (const kfd::ConfigError& e) {
+            EXPECT_NE(std::string(e.what()).find(" holds a NUL byte: not a text file"),
+                      std::string::npos)
+                << e.what();
+        }
+    }
+    // "==== MRPT exception ====" lost the cause.
+    const std::string undefined = writeFile(
+        dir, "var.ini", "[KFD]\n[KFD.view_keyframe]\nmax_consecutive_drops = ${KFD_NOPE}\n");
+    try {
+        kfd::loadConfigFile(undefined);
+        ADD_FAILURE() << "an undefined ${VAR} accepted";
+    } catch (const kfd::ConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("var.ini line 3: ${KFD_NOPE} is not defined"),
+                  std::string::npos)
+            << e.what();
+    }
+    const std::string defined = writeFile(
+        dir, "def.ini",
+        "@define DROPS 7\n[KFD]\n[KFD.view_keyframe]\nmax_consecutive_drops = ${DROPS}\n");
+    EXPECT_NE(kfd::toIni(kfd::loadConfigFile(defined)).find("max_consecutive_drops = 7"),
+              std::string::npos);
+    // A key beside the kfd: map was silently ignored.
+    EXPECT_EQ(yamlErrorKey("kfd:\n  view_keyframe:\n    max_consecutive_drops: 3\n"
+                           "view_keyframe:\n  max_consecutive_drops: 5\n"),
+              "view_keyframe");
+}
+
 TEST(ConfigFuzzFindings, MalformedMrptExpansionIsAConfigError) {
     // fuzz_ini: MRPT's CConfigFile throws its own exception for an unclosed $eval{ (and the
     // other expansions); it reached the tools as a non-kfd exception.

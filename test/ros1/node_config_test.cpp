@@ -111,7 +111,15 @@ TEST(NodeConfig, NodeParametersAreChecked) {
     Params s;
     s["queue_size"] = 0;
     EXPECT_EQ(refusedKey(s), "queue_size");
+    for (const int n : {0, 100001}) {
+        Params m;
+        m["max_sensors"] = n;
+        EXPECT_EQ(refusedKey(m), "max_sensors");
+    }
     Params ok;
+    ok["max_sensors"] = 4;
+    EXPECT_EQ(nodeConfig(ok).max_sensors, 4);
+    ok.erase("max_sensors");
     ok["odom"] = "topic";
     ok["removed_as"] = "inf";
     ok["tf_wait"] = 0;  // an int is a number of seconds too
@@ -119,6 +127,30 @@ TEST(NodeConfig, NodeParametersAreChecked) {
     EXPECT_EQ(c.odometry, NodeConfig::Odometry::Topic);
     EXPECT_EQ(c.removed, kfd::RemovedMark::PlusInf);
     EXPECT_DOUBLE_EQ(c.tf_wait, 0.0);
+}
+
+// Issue 38: a frame id tf2 refuses in every lookup is refused at start, not warned per scan.
+TEST(NodeConfig, FrameIdsTf2WouldRefuseAreRefusedAtStart) {
+    for (const char* key : {"base_frame", "odom_frame"}) {
+        for (const char* bad : {"/base_link", "", "base link", "//odom"}) {
+            Params p;
+            p[key] = bad;
+            std::string message;
+            try {
+                nodeConfig(p);
+            } catch (const kfd::ConfigError& e) {
+                EXPECT_EQ(e.key(), key) << bad;
+                message = e.what();
+            }
+            EXPECT_FALSE(message.empty()) << key << " = '" << bad << "' accepted";
+            if (bad[0] == '/') {
+                EXPECT_NE(message.find("do not start with '/'"), std::string::npos) << message;
+            }
+        }
+    }
+    Params ok;
+    ok["base_frame"] = "robot1/base_link";  // a tf prefix inside is fine
+    EXPECT_EQ(nodeConfig(ok).base_frame, "robot1/base_link");
 }
 
 TEST(NodeConfig, BadConfigFileIsRefused) {

@@ -196,6 +196,44 @@ TEST_F(ScanFilterNodeTest, AStampAtTheEndOfRosTimeOrAHugeJumpNeverKillsTheNode) 
     }
 }
 
+// Issue 38: scans lost in the queue or before the node (a gap in header.seq), scans of unusable
+// geometry and scans without the odometry the node was told to use are counted and raise the
+// diagnostics to WARN, naming what happened; a healthy stream stays OK.
+TEST_F(ScanFilterNodeTest, LostScansAndMissingOdometryRaiseTheDiagnostics) {
+    ros::param::set("/healthy/odom", std::string("none"));
+    auto ok = node("healthy");
+    for (std::uint32_t seq : {7u, 8u, 9u}) {
+        auto m = boost::make_shared<sensor_msgs::LaserScan>(roomScan(10.0 + 0.1 * seq));
+        m->header.seq = seq;
+        ok->onScan(m);
+    }
+    EXPECT_EQ(ok->counters().scans_missing, 0u);
+    EXPECT_EQ(ok->stats().level, diagnostic_msgs::DiagnosticStatus::OK) << ok->stats().message;
+
+    ros::param::set("/lossy/odom", std::string("none"));
+    auto n = node("lossy");
+    for (std::uint32_t seq : {1u, 2u, 5u, 6u, 20000u}) {  // 2 missing; 20000: a restart
+        auto m = boost::make_shared<sensor_msgs::LaserScan>(roomScan(10.0 + 0.1 * seq));
+        m->header.seq = seq;
+        n->onScan(m);
+    }
+    EXPECT_EQ(n->counters().scans_missing, 2u);
+    auto bad = boost::make_shared<sensor_msgs::LaserScan>(roomScan(3000.0));
+    bad->angle_increment = 0.0f;  // unusable geometry
+    n->onScan(bad);
+    EXPECT_EQ(n->counters().scans_skipped, 1u);
+    const auto s = n->stats();
+    EXPECT_EQ(s.level, diagnostic_msgs::DiagnosticStatus::WARN);
+    EXPECT_NE(s.message.find("2 scans missing"), std::string::npos) << s.message;
+    EXPECT_NE(s.message.find("1 scans of unusable geometry"), std::string::npos) << s.message;
+
+    ros::param::set("/noodom/tf_wait", 0.01);  // odom: tf (the default), no transform ever
+    auto t = node("noodom");
+    t->onScan(scanAt(50.0));
+    EXPECT_EQ(t->stats().level, diagnostic_msgs::DiagnosticStatus::WARN);
+    EXPECT_NE(t->stats().message.find("without odometry"), std::string::npos);
+}
+
 // The node waits in ROS time after the scan's stamp (here the wall clock: no use_sim_time).
 double secondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -251,6 +289,21 @@ TEST_F(ScanFilterNodeTest, TheWaitIsCappedByWhatTheScanQueueAbsorbs) {
     n->onScan(scanAt(t0));  // waits (3 - 1) x 0.1 s = 0.2 s, not 3 s
     EXPECT_GE(secondsSince(start), 0.15);
     EXPECT_LT(secondsSince(start), 1.5);
+}
+
+// Issue 38: before two scans have come, the pace is the scan's own scan_time: the first scan of
+// a laser-only stream waits (queue_size - 1) x scan_time, not ~tf_wait, while scans queue up.
+TEST_F(ScanFilterNodeTest, TheFirstScansWaitIsCappedByItsOwnScanTime) {
+    ros::param::set("/firstnode/tf_wait", 3.0);
+    ros::param::set("/firstnode/queue_size", 3);
+    auto n = node("firstnode");
+    auto m = boost::make_shared<sensor_msgs::LaserScan>(roomScan(ros::Time::now().toSec()));
+    m->scan_time = 0.1f;
+    const auto start = std::chrono::steady_clock::now();
+    n->onScan(m);  // no transform ever: waits (3 - 1) x 0.1 s = 0.2 s, not 3 s
+    EXPECT_GE(secondsSince(start), 0.15);
+    EXPECT_LT(secondsSince(start), 1.5);
+    EXPECT_EQ(n->counters().odom_missing, 1u);
 }
 
 TEST_F(ScanFilterNodeTest, AScanBeforeTheFirstTransformDoesNotWaitForIt) {

@@ -12,6 +12,7 @@ Usage: kfd_launch_test.py BUILD_APPS_DIR ROS_PACKAGE_DIR FAST_BAG_EXE NODELET_EX
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -26,6 +27,11 @@ MANAGER = "kfd_manager"
 # A config the fast bag shows (its defaults keep 5 % of the scans and remove no point): radius
 # outlier removal after the keyframes, which removes a few points of the kept scans.
 RADIUS = "[KFD]\npipeline = keyframe, radius\nradius_m = 0.05\nradius_min_neighbors = 3\n"
+# Each keyframe held for its next scan, one at least every 3rd scan: of the fast bag's 160
+# scans the last (159 = 53 x 3) is a keyframe, held when the filter is stopped (issue 38).
+HELD = ("[KFD]\n[KFD.evidence_denoise]\nnext_scan = true\n"
+        "[KFD.view_keyframe]\nmax_consecutive_drops = 2\n")
+DATASETS = os.environ.get("KFD_DATASETS_DIR", "")
 
 
 class KfdLaunch(live.RosCase):
@@ -71,32 +77,42 @@ class KfdLaunch(live.RosCase):
             return node_api.getPid("/kfd_test")[2]
 
     def run_launch(self, launch, args, filter_node, scan_filtered="/scan_filtered",
-                   external_manager=False, params=False):
-        """Runs the launch file on the fast bag with odom:=none, `rosbag record` outside it;
-        checks the launch runs the filter as `filter_node` (/kfd: kfd_node; the manager: the
-        nodelet) and that its kept scans are kfd-filter's, all of them. With `params`, the
-        launch and kfd-filter take RADIUS (points removed) and removed_as:=inf."""
-        bag = self.fast_bag()
-        filter_args = ["--odom-topic", "none"]
-        if params:
-            config = os.path.join(self.tmp, "radius.ini")
+                   external_manager=False, params=False, held=False, bag=None, stop="launch"):
+        """Runs the launch file on the fast bag (or `bag`, with the launch's default odometry)
+        with odom:=none, `rosbag record` outside it; checks the launch runs the filter as
+        `filter_node` (/kfd: kfd_node; the manager: the nodelet) and that its kept scans are
+        kfd-filter's, all of them. With `params`, the launch and kfd-filter take RADIUS (points
+        removed) and removed_as:=inf; with `held`, HELD (a keyframe held at the end). `stop`:
+        Ctrl-C on the launch ("launch"), `nodelet unload` ("unload") or SIGINT to the external
+        manager ("manager"), each after the bag."""
+        filter_args = [] if bag else ["--odom-topic", "none"]
+        args = list(args) if bag else ["odom:=none"] + list(args)
+        bag = bag or self.fast_bag()
+        for wanted, name, text in ((params, "radius.ini", RADIUS), (held, "held.ini", HELD)):
+            if not wanted:
+                continue
+            config = os.path.join(self.tmp, name)
             with open(config, "w") as f:
-                f.write(RADIUS)
-            args = list(args) + ["config:=" + config, "removed_as:=inf"]
-            filter_args += ["-c", config, "--removed-as", "inf"]
+                f.write(text)
+            args += ["config:=" + config]
+            filter_args += ["-c", config]
+        if params:
+            args += ["removed_as:=inf"]
+            filter_args += ["--removed-as", "inf"]
         out = os.path.join(self.tmp, "live.bag")
         recorder = self.start("record", ["rosbag", "record", "-O", out, "/scan", scan_filtered,
                                          "/kfd/stats"])
         self.wait_for(lambda: len(self.graph()[1].get(scan_filtered, [])) >= 1, 30,
                       "rosbag record to subscribe")
+        manager = None
         if external_manager:
-            self.start("manager", [NODELET_EXE, "manager", "__name:=" + MANAGER])
+            manager = self.start("manager", [NODELET_EXE, "manager", "__name:=" + MANAGER])
             self.wait_for(lambda: self.master.lookupService(
                 "/kfd_test", "/%s/load_nodelet" % MANAGER)[0] == 1, 30, "the nodelet manager")
         if launch == "kfd.launch":
             self.master.setParam("/kfd_test", "/use_sim_time", True)  # kfd_bag.launch sets it
         start = time.monotonic()
-        launched = self.roslaunch(launch, ["odom:=none"] + list(args))
+        launched = self.roslaunch(launch, args)
 
         def running(what):
             def cond():
@@ -137,13 +153,16 @@ class KfdLaunch(live.RosCase):
             self.fail("the filter exited: " + self.log_of("roslaunch"))
         self.assertIsNone(launched.poll(), "the launch stopped: " + self.log_of("roslaunch"))
         seconds = time.monotonic() - start
-        _kill_group(launched)  # SIGINT: roslaunch stops its nodes
-        self.assertNotIn("has died", self.full_log("roslaunch"))
+        self.stop_filter(stop, launched, manager)
         stats, kept, played = self.stop_recording(recorder, out, "/kfd/stats", scan_filtered)
         ref = self.kfd_filter(bag, filter_args)
 
-        # Nothing lost: the recorder saw every scan of the bag, the filter every scan played,
-        # and it published every scan kfd-filter keeps, the last ones too.
+        # Nothing lost: the recorder saw every scan of the bag, the filter every scan played
+        # (none missing), and it published every scan kfd-filter keeps, the last ones too.
+        self.assertEqual(int(stats["scans_missing"]), 0, stats)
+        if held:
+            log = self.full_log("manager" if external_manager else "roslaunch")
+            self.assertIn("stopping (1 held keyframe published)", log)
         self.assertEqual(len(played), len(scans_of(bag, "/scan")))
         self.assertEqual(int(stats["scans_in"]), len(played), stats)
         self.assertEqual(int(stats["scans_kept"]), len(kept), stats)
@@ -158,6 +177,27 @@ class KfdLaunch(live.RosCase):
         print("  %s %s: %d scans played, kept %d (kfd-filter %d), %d removed as +Inf; %.1f s"
               % (launch, " ".join(args).replace(self.tmp + "/", ""), len(played), len(kept),
                  len(ref), removed, seconds), flush=True)
+
+    def stop_filter(self, how, launched, manager):
+        """Stops the filter `how` (run_launch); the launch is gone afterwards."""
+        if how == "launch":
+            _kill_group(launched)  # SIGINT, as Ctrl-C: roslaunch stops its nodes
+            self.assertNotIn("has died", self.full_log("roslaunch"))
+            return
+        if how == "unload":
+            r = subprocess.run([NODELET_EXE, "unload", "/kfd", MANAGER], env=self.env,
+                               capture_output=True, text=True, timeout=30)
+            self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+            time.sleep(1.0)  # the manager goes on without kfd
+            self.assertIsNone(manager.poll(), self.log_of("manager"))
+        # SIGINT to the manager: with kfd loaded, kfd's stop (what it holds published); after
+        # an unload, the manager's own handler again. Either way it exits 0 (and its log is
+        # complete: rosconsole's stdout is buffered).
+        os.kill(manager.pid, signal.SIGINT)
+        manager.wait(timeout=10)
+        self.assertEqual(manager.returncode, 0, self.log_of("manager"))
+        # The loader's bond breaks: the launch (its loader is required) ends by itself.
+        launched.wait(timeout=30)
 
     def run_failing(self, args, key):
         """kfd.launch with `args` stops by itself, naming the config key `key`; returns the
@@ -183,7 +223,27 @@ class KfdLaunch(live.RosCase):
         self.nodelet()
         self.run_launch("kfd_bag.launch", ["bag:=" + os.path.join(self.tmp, "fast.bag"),
                                            "delay:=3", "manager:=" + MANAGER,
-                                           "start_manager:=true"], "/" + MANAGER)
+                                           "start_manager:=true"], "/" + MANAGER, held=True)
+
+    def test_nodelet_unload_publishes_the_held_keyframe(self):
+        self.nodelet()
+        self.run_launch("kfd.launch", ["manager:=" + MANAGER], "/" + MANAGER,
+                        external_manager=True, held=True, stop="unload")
+
+    def test_manager_sigint_publishes_the_held_keyframe(self):
+        self.nodelet()
+        self.run_launch("kfd.launch", ["manager:=" + MANAGER], "/" + MANAGER,
+                        external_manager=True, held=True, stop="manager")
+
+    def test_readme_line_on_a_laser_only_bag_loses_nothing(self):
+        """Issue 38: README's line on a real bag with no odometry (the default odom:=tf): no scan
+        lost while the first ones wait for a transform that never comes, kfd-filter's kept
+        scans, and the diagnostics say the odometry is missing."""
+        bag = os.path.join(DATASETS, "ccny-urg", "demo.bag")
+        if not DATASETS or not os.path.isfile(bag):
+            self.skipTest("dataset missing: %s (KFD_DATASETS_DIR)" % bag)
+        self.run_launch("kfd_bag.launch", ["bag:=" + bag, "rate:=2"], "/kfd", bag=bag)
+        self.assertIn("no odometry for the scan", self.full_log("roslaunch"))
 
     def test_launch_nodelet_into_running_manager_matches_kfd_filter(self):
         self.nodelet()

@@ -11,6 +11,7 @@ Usage: kfd_node_live_test.py BUILD_APPS_DIR DATASETS_DIR FAST_BAG_EXE"""
 import os
 import subprocess
 import sys
+import time
 import unittest
 
 import kfd_ros1_harness as harness  # test/support/python (PYTHONPATH: test/CMakeLists.txt)
@@ -46,8 +47,78 @@ class KfdNodeLive(harness.LiveHarness):
                              node_args=["_next_scan:=true"], filter_args=["-c", ini])
         self.assertEqual(len(kept), self.ref_count)
 
+    def fast_bag(self, seconds="6"):
+        exe = harness.FAST_BAG_EXE
+        if not exe or not os.access(exe, os.X_OK):
+            self.skipTest("no bag writer (kfd_bench_fast_bag: Google Benchmark missing)")
+        bag = os.path.join(self.tmp, "fast.bag")
+        subprocess.run([exe, bag, "none", seconds, "40", "1081", "270", "0.01"], check=True,
+                       stdout=subprocess.DEVNULL)
+        return bag
+
+    def held_keyframe_on_stop(self, how):
+        """Issue 38: stopped `how` (stop_node), the node publishes the keyframe held for its
+        next scan (~next_scan) and the last ~stats that count it: every scan kfd-filter keeps."""
+        # The fast bag's 120 scans, a keyframe at least every 17th: the last one (119 = 7 x 17)
+        # is a keyframe, held when the node is stopped.
+        ini = os.path.join(self.tmp, "next.ini")
+        with open(ini, "w") as f:
+            f.write("[KFD]\n[KFD.evidence_denoise]\nnext_scan = true\n"
+                    "[KFD.view_keyframe]\nmax_consecutive_drops = 16\n")
+        kept, _ = self.check(self.fast_bag("3"), odom="none", stop=how,
+                             node_args=["_config:=" + ini], filter_args=["-c", ini])
+        self.assertEqual(len(kept), self.ref_count)
+        self.assertIn("stopping (1 held keyframe published)", self.log_of("kfd_node"))
+
+    def test_sigint_publishes_the_held_keyframe(self):
+        self.held_keyframe_on_stop("int")
+
+    def test_sigterm_publishes_the_held_keyframe(self):
+        self.held_keyframe_on_stop("term")
+
+    def test_rosnode_kill_publishes_the_held_keyframe(self):
+        self.held_keyframe_on_stop("kill")
+
+    def test_a_stop_ends_a_long_wait_for_odometry(self):
+        """Issue 38: with ~tf_wait:=10 a scan that waits for a transform that never comes does
+        not hold SIGINT up (it took 9.4 s): one scan without scan_time (so the node cannot bound
+        the wait by the scan's pace), the bag's clock stopped after it."""
+        import rosbag
+        one = os.path.join(self.tmp, "one.bag")
+        with rosbag.Bag(self.fast_bag("1")) as src, rosbag.Bag(one, "w") as dst:
+            for topic, m, t in src.read_messages(topics=["/scan"]):
+                m.scan_time = 0.0
+                dst.write(topic, m, t)
+                break
+        self.master.setParam("/kfd_test", "/use_sim_time", True)
+        node = self.start("kfd_node", [self.node_exe, "__name:=kfd_node", "_odom:=tf",
+                                       "_tf_wait:=10"])
+        self.wait_for(lambda: "/kfd_node" in self.graph()[1].get("/scan", []), 30,
+                      lambda: "kfd_node to subscribe: " + self.log_of("kfd_node"))
+        play = self.start("play", ["rosbag", "play", "--clock", "-q", "-d", "1", one])
+        play.wait(timeout=60)
+        time.sleep(1.0)  # the scan waits: 10 s of a stopped clock, at most 20 s of wall time
+        start = time.monotonic()
+        self.stop_node(node, "int")
+        self.assertLess(time.monotonic() - start, 3.0, self.log_of("kfd_node"))
+        self.assertIn("stopping (0 held keyframes published)", self.log_of("kfd_node"))
+
     def test_ccny_laser_only_bag_matches_kfd_filter(self):
         self.check(self.dataset("ccny-urg/demo.bag"), rate=4, odom="none")
+
+
+class KfdNodeHelp(unittest.TestCase):
+    def test_help_answers_without_a_master(self):
+        """Issue 38: `kfd_node --help` tried to reach a master and hung, deaf to SIGINT."""
+        exe = os.path.join(harness.APPS, "kfd_node")
+        if not os.access(exe, os.X_OK):
+            self.skipTest("kfd_node not built: " + exe)
+        env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % harness.free_port())
+        for flag in ("--help", "-h"):
+            r = subprocess.run([exe, flag], env=env, capture_output=True, text=True, timeout=10)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("usage: kfd_node", r.stdout)
+            self.assertIn("~odom (tf | topic | none)", r.stdout)
 
 
 if __name__ == "__main__":
@@ -55,4 +126,4 @@ if __name__ == "__main__":
     harness.DATASETS = os.path.abspath(sys.argv[2]) if len(sys.argv) > 2 and sys.argv[2] else ""
     harness.FAST_BAG_EXE = (os.path.abspath(sys.argv[3])
                             if len(sys.argv) > 3 and sys.argv[3] else "")
-    unittest.main(argv=sys.argv[:1], verbosity=2)  # skips with their reason (test.sh lists them)
+    unittest.main(argv=sys.argv[:1] + sys.argv[4:], verbosity=2)  # skips: test.sh lists them

@@ -429,6 +429,19 @@ TEST(IcpSlamRunner, BadInputIsAClearError) {
     o = options(kSena, dir / "out", kfd::PrefilterMode::Kfd);
     o.config_file = dir / "bad.ini";
     EXPECT_THROW(runAndReport(o), kfd::ConfigError);
+    // Issue 38: MRPT's readers took "1.5" as 1 and "abc" as false, silently.
+    for (const auto& [key, value] : {std::pair<std::string, std::string>{"LOG_FREQUENCY", "1.5"},
+                                     {"SAVE_3D_SCENE", "abc"},
+                                     {"SAVE_POSE_LOG", "2"}}) {
+        o.config_file = configWith(dir / "strict.ini", "MappingApplication", {{key, value}});
+        try {
+            runAndReport(o);
+            ADD_FAILURE() << key << " = " << value << " accepted";
+        } catch (const kfd::ConfigError& e) {
+            EXPECT_EQ(e.key(), key);
+            EXPECT_NE(std::string(e.what()).find("'" + value + "'"), std::string::npos) << e.what();
+        }
+    }
 }
 
 namespace {

@@ -24,6 +24,15 @@ void asScanCsvError(Fn&& fn) {
     }
 }
 
+// A CSV field (RFC 4180): quoted, its quotes doubled, when it holds a comma, a quote or a line
+// break (a sensor label can hold anything); as it is otherwise.
+std::string csvField(const std::string& s) {
+    if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+    std::string q = "\"";
+    for (const char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return q + '"';
+}
+
 }  // namespace
 
 void ScanCsvWriter::open(const std::string& path, const std::string& name,
@@ -42,7 +51,7 @@ void ScanCsvWriter::open(const std::string& path, const std::string& name,
 void ScanCsvWriter::write(const ScanRecord& r, const std::optional<Pose2D>& pose) {
     std::string line =
         format("%zu,%.6f,%s,%d,%s,%zu,%zu,%.2f,%zu,%.2f", r.index, stampForOutput(r.stamp),
-               r.sensor.c_str(), r.kept ? 1 : 0, r.reason, r.points_in, r.removed_noise,
+               csvField(r.sensor).c_str(), r.kept ? 1 : 0, r.reason, r.points_in, r.removed_noise,
                r.surface_m, r.points_out, r.microseconds);
     line += stages_.cells(r.report);
     line += std::isnan(r.icp_goodness)

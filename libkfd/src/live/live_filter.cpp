@@ -27,7 +27,22 @@ std::vector<std::pair<std::string, double>> counterValues(const LiveCounters& c)
             {"scans_skipped", double(c.scans_skipped)},
             {"stamps_unusable", double(c.stamps_unusable)},
             {"callback_errors", double(c.callback_errors)},
-            {"sensors_evicted", double(c.sensors_evicted)}};
+            {"sensors_evicted", double(c.sensors_evicted)},
+            {"scans_missing", double(c.scans_missing)}};
+}
+
+std::vector<std::string> attention(const LiveCounters& c, bool odom_expected) {
+    std::vector<std::string> out;
+    const auto add = [&out](std::size_t n, const std::string& what) {
+        if (n) out.push_back(std::to_string(n) + " " + what);
+    };
+    add(c.scans_missing, "scans missing (gaps in header.seq)");
+    if (odom_expected) add(c.odom_missing, "scans without odometry (odom_missing)");
+    add(c.stamps_unusable, "scans with an unusable stamp");
+    add(c.scans_skipped, "scans of unusable geometry");
+    add(c.callback_errors, "messages whose handling failed");
+    add(c.sensors_evicted, "frames evicted (more than ~max_sensors)");
+    return out;
 }
 
 bool usableStamp(double seconds) {
@@ -46,7 +61,9 @@ void LiveFilter::countError(bool scan) {
     ++counters_.callback_errors;
 }
 
-LiveFilter::LiveFilter(const Params& p) : params_(p), door_(p.pipeline, {}, true) {}
+LiveFilter::LiveFilter(const Params& p) : params_(p), door_(p.pipeline, {}, true) {
+    door_.setMaxSensors(p.max_sensors);
+}
 
 void LiveFilter::reset() {
     door_.reset();  // finishes held keyframes first (queued for takeReady())

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 
 #include "kfd/mrpt/default_stages.h"
@@ -451,6 +452,12 @@ Pipeline::Params loadYaml(const mrpt::containers::yaml& doc, const Pipeline::Par
     if (!doc.isMap()) throw ConfigError("", "the YAML document must be a map of kfd keys");
     const mrpt::containers::yaml root = doc.has("kfd") ? doc["kfd"] : doc;
     if (!root.isMap()) throw ConfigError("kfd", "must be a map of kfd keys");
+    if (doc.has("kfd"))  // a key beside kfd: would be silently ignored
+        for (const auto& kv : doc.asMap())
+            if (const std::string name(kv.first.internalAsStr()); name != "kfd")
+                throw ConfigError(name,
+                                  "beside the top-level kfd: map, which holds every kfd "
+                                  "key: move it under kfd:");
     const StageRegistry& registry = defaultStageRegistry();
     Pipeline::Params p = base ? *base : kfdDefaults();
     ConfigValues values;
@@ -473,6 +480,42 @@ Pipeline::Params loadYaml(const mrpt::containers::yaml& doc, const Pipeline::Par
     return p;
 }
 
+namespace {
+
+// What MRPT's readers would silently cut or turn into a bare "==== MRPT exception ====": a
+// NUL byte (the C string ends there: "3<NUL>junk" read as 3), and in an .ini a ${NAME} no
+// @define before it names.
+void checkConfigBytes(const std::string& text, const std::string& path, bool ini) {
+    std::set<std::string> defined;
+    const auto lines = detail::splitLines(text);
+    for (std::size_t n = 0; n < lines.size(); ++n) {
+        const std::string& line = lines[n];
+        const std::string where = path + " line " + std::to_string(n + 1);
+        if (line.find('\0') != std::string::npos)
+            throw ConfigError("", where + " holds a NUL byte: not a text file");
+        if (!ini) continue;
+        const std::string t = trim(line);
+        if (t.rfind("@define", 0) == 0) {
+            std::istringstream s(t.substr(7));
+            std::string name;
+            if (s >> name) defined.insert(name);
+            continue;
+        }
+        for (auto at = line.find("${"); at != std::string::npos; at = line.find("${", at + 2)) {
+            const auto close = line.find('}', at);
+            const std::string name = line.substr(
+                at + 2, close == std::string::npos ? std::string::npos : close - at - 2);
+            if (close == std::string::npos || !defined.count(name))
+                throw ConfigError("", where + ": ${" + name +
+                                          "} is not defined (an .ini defines it with '@define " +
+                                          name + " VALUE' on a line before; $env{" + name +
+                                          "} reads the environment)");
+        }
+    }
+}
+
+}  // namespace
+
 Pipeline::Params loadConfigFile(const std::string& path, const std::string& section,
                                 std::vector<std::string>* notes) {
     namespace fs = std::filesystem;
@@ -488,6 +531,7 @@ Pipeline::Params loadConfigFile(const std::string& path, const std::string& sect
             throw ConfigError("", "YAML file " + path + " larger than " +
                                       std::to_string(kMaxConfigBytes) + " bytes");
         const std::string text = readWholeFile(path);
+        checkConfigBytes(text, path, false);
         try {
             checkYamlText(text);
         } catch (const ConfigError& e) {
@@ -500,6 +544,7 @@ Pipeline::Params loadConfigFile(const std::string& path, const std::string& sect
         throw ConfigError("", "unknown configuration format '" + ext + "' (use .ini or .yaml)");
     // MRPT's CConfigFile expands @define, ${var}, $env{} and $eval{} while reading and throws
     // its own exceptions for malformed ones (found by test/fuzz/fuzz_ini).
+    checkConfigBytes(readWholeFile(path), path, true);
     std::optional<mrpt::config::CConfigFile> cfg;
     try {
         cfg.emplace(path);

@@ -13,6 +13,9 @@ std::string formatReal(double v) {
 }
 
 double parseReal(const std::string& field, const std::string& t) {
+    // Decimal only: strtod would also read hexadecimal ("0x10" as 16) and "inf"/"nan".
+    if (t.empty() || t.find_first_not_of("0123456789+-.eE") != std::string::npos)
+        throw ParameterError(field, "'" + t + "' is not a number");
     std::size_t pos = 0;
     double v = 0;
     try {

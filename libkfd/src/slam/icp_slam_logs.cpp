@@ -13,9 +13,13 @@
 #include <mrpt/system/filesystem.h>
 #include <mrpt/system/memory.h>
 
+#include <cctype>
+#include <string>
+
 #include "kfd/io/gz_output.h"
 #include "kfd/io/png_output.h"
 #include "kfd/io/source.h"
+#include "kfd/mrpt/config.h"
 #include "kfd/pipeline/format.h"
 
 namespace kfd {
@@ -31,20 +35,48 @@ CPose3D placeOf(const Pose2D& map_origin) {
     return CPose3D(map_origin.x, map_origin.y, 0.0, 0.0, 0.0, 0.0);
 }
 
+std::string trimmed(const std::string& s) {
+    const auto a = s.find_first_not_of(" \t\r");
+    return a == std::string::npos ? "" : s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
+}
+
+// MRPT's read_int reads "1.5" as 1 and read_bool "abc" as false, silently: these read the
+// whole value or refuse it, naming the key.
+int strictInt(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+              const std::string& key, int fallback) {
+    const std::string t = trimmed(cfg.read_string(section, key, ""));
+    if (t.empty()) return fallback;
+    const std::size_t digits = t[0] == '-' || t[0] == '+' ? 1 : 0;
+    if (t.size() == digits || t.size() > digits + 9 ||
+        t.find_first_not_of("0123456789", digits) != std::string::npos)
+        throw ConfigError(key, "'" + t + "' in [" + section + "] is not an integer");
+    return std::stoi(t);
+}
+
+bool strictBool(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+                const std::string& key, bool fallback) {
+    std::string t = trimmed(cfg.read_string(section, key, ""));
+    if (t.empty()) return fallback;
+    for (auto& c : t) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (t == "true" || t == "yes" || t == "on" || t == "1") return true;
+    if (t == "false" || t == "no" || t == "off" || t == "0") return false;
+    throw ConfigError(key, "'" + t + "' in [" + section + "] is not true or false");
+}
+
 }  // namespace
 
 IcpSlamLogParams IcpSlamLogParams::fromConfig(const mrpt::config::CConfigFileBase& cfg,
                                               const std::string& section,
                                               std::vector<std::string>& notices) {
     IcpSlamLogParams p;
-    p.log_frequency = cfg.read_int(section, "LOG_FREQUENCY", p.log_frequency);
-    p.save_pose_log = cfg.read_bool(section, "SAVE_POSE_LOG", p.save_pose_log);
-    p.save_3d_scene = cfg.read_bool(section, "SAVE_3D_SCENE", p.save_3d_scene);
+    p.log_frequency = strictInt(cfg, section, "LOG_FREQUENCY", p.log_frequency);
+    p.save_pose_log = strictBool(cfg, section, "SAVE_POSE_LOG", p.save_pose_log);
+    p.save_3d_scene = strictBool(cfg, section, "SAVE_3D_SCENE", p.save_3d_scene);
     p.camera_follows_robot =
-        cfg.read_bool(section, "CAMERA_3DSCENE_FOLLOWS_ROBOT", p.camera_follows_robot);
-    p.show_laser_scans = cfg.read_bool(section, "SHOW_LASER_SCANS_3D", p.show_laser_scans);
+        strictBool(cfg, section, "CAMERA_3DSCENE_FOLLOWS_ROBOT", p.camera_follows_robot);
+    p.show_laser_scans = strictBool(cfg, section, "SHOW_LASER_SCANS_3D", p.show_laser_scans);
     const std::string key = "[" + section + "] ";
-    if (cfg.read_bool(section, "SHOW_PROGRESS_3D_REAL_TIME", false))
+    if (strictBool(cfg, section, "SHOW_PROGRESS_3D_REAL_TIME", false))
         notices.push_back(key +
                           "SHOW_PROGRESS_3D_REAL_TIME = true ignored: kfd-icp-slam has no window "
                           "(SAVE_3D_SCENE writes the same scenes, for SceneViewer3D)");

@@ -250,9 +250,23 @@ class RosCase(unittest.TestCase):
 class LiveHarness(RosCase):
     """RosCase with kfd_node run live on a bag and compared with kfd-filter."""
 
-    def run_live(self, bag, node_args=(), play_args=(), filter_args=()):
-        """Plays `bag` into kfd_node; returns (recorded kept scans, final stats dict, /scan
-        messages the recorder saw, kfd-filter's kept scans)."""
+    def stop_node(self, node, how):
+        """Stops kfd_node `how`: "int" (SIGINT, Ctrl-C), "term" (SIGTERM) or "kill" (`rosnode
+        kill`, the master's shutdown call); checks it exits 0 within 10 s."""
+        if how == "kill":
+            subprocess.run(["rosnode", "kill", "/kfd_node"], env=self.env, check=True,
+                           capture_output=True, timeout=30)
+        else:
+            os.kill(node.pid, signal.SIGINT if how == "int" else signal.SIGTERM)
+        try:
+            node.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.fail("kfd_node did not stop within 10 s of %s: %s" % (how, self.log_of("kfd_node")))
+        self.assertEqual(node.returncode, 0, self.log_of("kfd_node"))
+
+    def run_live(self, bag, node_args=(), play_args=(), filter_args=(), stop="int"):
+        """Plays `bag` into kfd_node, then stops it (stop_node); returns (recorded kept scans,
+        final stats dict, /scan messages the recorder saw, kfd-filter's kept scans)."""
         out = os.path.join(self.tmp, "live.bag")
         recorder = self.start("record", ["rosbag", "record", "-O", out, "/scan", "/scan_filtered",
                                          "/kfd_node/stats"])
@@ -289,7 +303,7 @@ class LiveHarness(RosCase):
                          time.monotonic() - wall0 - PLAY_DELAY_S)
         self.wait_idle(node.pid)
         self.assertIsNone(node.poll(), "kfd_node died: " + self.log_of("kfd_node"))
-        _kill_group(node)  # SIGINT: it publishes ~stats once more at shutdown
+        self.stop_node(node, stop)  # it publishes what it holds and ~stats once more
         stats, kept, played = self.stop_recording(recorder, out, "/kfd_node/stats",
                                                   "/scan_filtered")
         return kept, stats, played, self.kfd_filter(bag, filter_args)
@@ -310,14 +324,15 @@ class LiveHarness(RosCase):
                 dst.write(topic, raw, t, raw=True)
         return out
 
-    def check(self, bag, seconds=None, rate=1.0, odom="tf", node_args=(), filter_args=()):
+    def check(self, bag, seconds=None, rate=1.0, odom="tf", node_args=(), filter_args=(),
+              stop="int"):
         """The node against kfd-filter on the first `seconds` of `bag`'s scans, played at
-        `rate`."""
+        `rate`, the node stopped `stop` (stop_node)."""
         if seconds:
             bag = self.prefix(bag, seconds)
         node_args = ["_odom:=" + odom] + list(node_args)
         kept, stats, played, ref = self.run_live(
-            bag, node_args, ["-r", str(rate)], ["--odom-topic", odom] + list(filter_args))
+            bag, node_args, ["-r", str(rate)], ["--odom-topic", odom] + list(filter_args), stop)
 
         # Nothing lost: the recorder saw every scan of the bag, the node every scan played.
         self.assertEqual(len(played), len(scans_of(bag, "/scan")))

@@ -39,7 +39,15 @@ struct LiveCounters {
     /// Frames whose state was dropped to keep at most StreamFilter::kDefaultMaxSensors (the
     /// least recently heard first, a held keyframe published first): a flood of frame ids.
     std::size_t sensors_evicted = 0;
+    /// Scans that never arrived: gaps in a frame's header.seq (ROS 1; lost in the subscriber
+    /// queue while a scan waited, or before the node).
+    std::size_t scans_missing = 0;
 };
+
+/// What in `c` a user should look at, in words ("12 scans missing (gaps in header.seq)", ...),
+/// empty when nothing: the node's diagnostics go to WARN with it. `odom_expected`: the node has
+/// an odometry source, so scans without it count.
+std::vector<std::string> attention(const LiveCounters& c, bool odom_expected);
 
 /// s: stamps this close to the end of ROS 1's time (2^32 s) are unusable: the waits and
 /// windows added to a stamp (tf_wait, the odometry's hold) must stay inside it.
@@ -69,6 +77,9 @@ class LiveFilter {
         /// and the scan goes on as the first of a new stream. A scan older by less is out of
         /// order and dropped.
         double reset_jump = 1.0;
+        /// Frames whose state is kept at most (StreamFilter::setMaxSensors): a new frame beyond
+        /// it evicts the one heard from longest ago (its held keyframe finished first).
+        std::size_t max_sensors = StreamFilter::kDefaultMaxSensors;
     };
 
     explicit LiveFilter(const Params& p);
@@ -104,6 +115,8 @@ class LiveFilter {
     /// A received message whose handling threw: counted (scans_in when `scan`,
     /// callback_errors).
     void countError(bool scan);
+    /// `n` scans of a frame never arrived (a gap in its header.seq): counted scans_missing.
+    void countMissing(std::size_t n) { counters_.scans_missing += n; }
     /// Forgets every frame's state (the counters stay); what a time jump does. A held keyframe
     /// is finished first (takeReady()).
     void reset();

@@ -28,6 +28,9 @@ struct NodeConfig {
     RemovedMark removed = RemovedMark::NaN;  // ~removed_as: nan | inf
     double reset_jump = 1.0;                 // ~reset_jump, s (LiveFilter::Params::reset_jump)
     int queue_size = 10;  // ~queue_size: the scan subscriber's and publisher's queues
+    /// ~max_sensors: frame ids whose state is kept at most; a new one beyond it evicts the one
+    /// heard from longest ago (sensors_evicted; memory stays bounded under a flood of ids).
+    int max_sensors = 64;
     /// ~track_topic: where the tracked pose of every scan goes (nav_msgs/Odometry, frame
     /// odom_frame, child base_frame) when the pipeline lists the track stage; "" publishes none.
     std::string track_topic = "tracked_odom";

@@ -14,7 +14,9 @@
 #include <ros/callback_queue.h>
 #include <ros/spinner.h>
 
+#include <atomic>
 #include <condition_variable>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -44,7 +46,7 @@ class ScanFilterNode {
     /// `nh` (`scan`, `odom`, `scan_filtered`, ~track_topic, /diagnostics) and `pnh` (~stats).
     ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh);
     ScanFilterNode(ros::NodeHandle nh, ros::NodeHandle pnh, const NodeConfig& config);
-    /// finish(), and publishes ~stats once more.
+    /// finish(), and publishes ~stats once more (nodelet unload: 0.3 s for them to go out).
     ~ScanFilterNode();
 
     /// One scan (the `scan` subscriber's callback; tests call it directly).
@@ -61,6 +63,9 @@ class ScanFilterNode {
     /// shutting down (kfd_node's main before ROS stops; the destructor too). The scans
     /// published.
     std::size_t finish();
+    /// A stop was asked for (GracefulStop: a signal, rosnode kill): scans are dropped from now
+    /// on, a wait for odometry ends, the held keyframe and the last stats are published.
+    void stop();
 
     const NodeConfig& config() const { return config_; }
     /// The transforms the node looks up (odom_frame -> base_frame, base_frame -> laser); tests
@@ -73,6 +78,9 @@ class ScanFilterNode {
     static std::map<std::string, XmlRpc::XmlRpcValue> privateParams(const ros::NodeHandle& pnh);
 
   private:
+    // The last of the filter, once (a signal's stop and a nodelet unload may race): finish(),
+    // the last stats, a log line. The keyframes it published.
+    std::size_t finishOnce();
     std::size_t publishReady();  // LiveFilter::takeReady's messages on scan_filtered; mutex_ held
     // The track stage's pose of the scan `r` is about, on ~track_topic (and /tf with ~track_tf).
     // onScan's work for a scan with a usable stamp (may throw: onScan catches it).
@@ -85,27 +93,39 @@ class ScanFilterNode {
     /// How long (ROS time, s) a scan may wait for its odometry: ~tf_wait, but at most what the
     /// scan queue absorbs meanwhile, (queue_size - 1) x the median interval between scans.
     double waitBound() const;
-    /// Waits (polling every 0.5 ms) until `ready`, the ROS clock passes stamp + waitBound(), or
-    /// twice that in wall time has passed (the clock may stop: a bag paused or ended).
-    /// Returns whether `ready` came true.
+    /// Waits (polling every 0.5 ms) until `ready`, the ROS clock passes stamp + waitBound(),
+    /// twice that in wall time has passed (the clock may stop: a bag paused or ended), or a
+    /// stop is asked for. Returns whether `ready` came true.
     template <class Ready>
     bool waitFor(const ros::Time& stamp, Ready ready);
     std::optional<Pose2D> odometryAt(const ros::Time& stamp);
     Pose2D mountOf(const std::string& frame_id);
+    // Counts the scans a gap in the frame's header.seq says never arrived; warns once.
+    void checkSequence(const sensor_msgs::LaserScan& m);
+    // Logs (throttled, once for odometry) what the result says was wrong with the scan.
+    void reportScan(const sensor_msgs::LaserScan& m, const ros::Time& stamp, const LiveResult& r,
+                    bool has_odometry);
 
     NodeConfig config_;
     ros::NodeHandle nh_, pnh_;
     mutable std::mutex mutex_;  // the filter, the mounts, the latencies
     LiveFilter filter_;
     std::size_t evicted_seen_ = 0;  // sensors_evicted already warned about
-    std::mutex odom_mutex_;         // the odometry samples (their own thread: see onOdometry)
+    bool warned_missing_ = false;   // scans_missing / odom_missing warned about once
+    bool warned_odom_ = false;
+    std::map<std::string, std::uint32_t> last_seq_;  // per frame, for scans_missing
+    std::atomic<bool> stopping_{false};
+    std::atomic<bool> finished_{false};  // finishOnce ran
+    std::size_t stop_token_ = 0;         // GracefulStop's registration
+    std::mutex odom_mutex_;              // the odometry samples (their own thread: see onOdometry)
     std::condition_variable odom_cv_;
     OdometryBuffer odom_buffer_;
     LatencyStats latency_;  // callback entry to publish return
     LatencyStats work_;     // odometry in hand (or given up on) to publish return: kfd's own
     static constexpr std::size_t kIntervals = 32;  // scan intervals kept for waitBound
     std::vector<double> intervals_;                // the last kIntervals (|stamp difference|), s
-    std::size_t next_interval_ = 0;                // ring position in intervals_
+    double scan_time_ = 0.0;  // the last scan's own scan_time (s), before intervals are known
+    std::size_t next_interval_ = 0;  // ring position in intervals_
     std::optional<ros::Time> last_scan_stamp_;
     // /tf down: the newest transform when a scan's wait last timed out. Until a newer one comes,
     // scans do not wait (laser only at once, counted), so the queue keeps flowing.
