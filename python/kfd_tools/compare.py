@@ -489,7 +489,7 @@ def cmd_run(a):
               file=sys.stderr)
         return 0
     t0 = time.monotonic()
-    failed, interrupted = [], []
+    failed = []
 
     def one(j):
         log, config, mode, k = j
@@ -510,7 +510,7 @@ def cmd_run(a):
             try:
                 fut.result()
             except Interrupted:
-                interrupted.append(j)
+                pass  # recorded in its run.json; counted by stop_runs
             except (CompareError, subprocess.CalledProcessError) as e:
                 failed.append((j, str(e)))
             if not a.quiet:

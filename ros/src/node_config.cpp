@@ -1,5 +1,6 @@
 #include "kfd/ros1/node_config.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <sstream>
@@ -74,10 +75,7 @@ std::string frameParam(const std::string& key, XmlRpcValue v) {
     if (f.empty()) throw ConfigError(key, "is empty: a tf frame id is needed (e.g. odom)");
     if (f[0] == '/')
         throw ConfigError(key, "'" + f + "': tf2 frame ids do not start with '/' (use '" +
-                                   f.substr(f.find_first_not_of('/') == std::string::npos
-                                                ? f.size()
-                                                : f.find_first_not_of('/')) +
-                                   "')");
+                                   f.substr(std::min(f.find_first_not_of('/'), f.size())) + "')");
     for (const char ch : f)
         if (std::isspace(static_cast<unsigned char>(ch)) || ch == '\0')
             throw ConfigError(key, "'" + f + "' holds white space: not a tf frame id");

@@ -355,7 +355,7 @@ void ScanFilterNode::checkSequence(const sensor_msgs::LaserScan& m) {
                 m.header.seq - it->second - 1, m.header.frame_id.c_str(), m.header.seq, it->second);
         warned_missing_ = true;
     }
-    if (it == last_seq_.end() && last_seq_.size() >= StreamFilter::kDefaultMaxSensors)
+    if (it == last_seq_.end() && last_seq_.size() >= std::size_t(config_.max_sensors))
         last_seq_.clear();  // a flood of frame ids: bounded like the door's sensors
     last_seq_[frame] = m.header.seq;
 }

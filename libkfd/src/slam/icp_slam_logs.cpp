@@ -12,6 +12,7 @@
 #include <mrpt/poses/CPose3DPDFGaussian.h>
 #include <mrpt/system/filesystem.h>
 #include <mrpt/system/memory.h>
+#include <mrpt/system/string_utils.h>
 
 #include <cctype>
 #include <string>
@@ -35,16 +36,11 @@ CPose3D placeOf(const Pose2D& map_origin) {
     return CPose3D(map_origin.x, map_origin.y, 0.0, 0.0, 0.0, 0.0);
 }
 
-std::string trimmed(const std::string& s) {
-    const auto a = s.find_first_not_of(" \t\r");
-    return a == std::string::npos ? "" : s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
-}
-
 // MRPT's read_int reads "1.5" as 1 and read_bool "abc" as false, silently: these read the
 // whole value or refuse it, naming the key.
 int strictInt(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
               const std::string& key, int fallback) {
-    const std::string t = trimmed(cfg.read_string(section, key, ""));
+    const std::string t = mrpt::system::trim(cfg.read_string(section, key, ""));
     if (t.empty()) return fallback;
     const std::size_t digits = t[0] == '-' || t[0] == '+' ? 1 : 0;
     if (t.size() == digits || t.size() > digits + 9 ||
@@ -55,7 +51,7 @@ int strictInt(const mrpt::config::CConfigFileBase& cfg, const std::string& secti
 
 bool strictBool(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
                 const std::string& key, bool fallback) {
-    std::string t = trimmed(cfg.read_string(section, key, ""));
+    std::string t = mrpt::system::trim(cfg.read_string(section, key, ""));
     if (t.empty()) return fallback;
     for (auto& c : t) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (t == "true" || t == "yes" || t == "on" || t == "1") return true;
