@@ -48,8 +48,15 @@ TEST(EvidenceFilter, ASpikeInFrontOfAWallThePreviousKeyframeSawThroughIsRemoved)
     EXPECT_EQ(r.points_removed, 1u);  // nothing else
 }
 
+// Step 7 off: the tests of the burst logic below use flat bursts (constant range), which step 7
+// would keep as surfaces.
+EvidenceFilter::Params noSurfaces(EvidenceFilter::Params p) {
+    p.keep_surfaces = false;
+    return p;
+}
+
 TEST(EvidenceFilter, ABurstInFreeSpaceIsRemovedThoughItLooksLikeAnObject) {
-    EvidenceFilter f(exact());
+    EvidenceFilter f(noSurfaces(exact()));
     Clusters c;
     Scan first = room();
     f.filter(first, c);
@@ -58,6 +65,24 @@ TEST(EvidenceFilter, ABurstInFreeSpaceIsRemovedThoughItLooksLikeAnObject) {
     f.filter(second, c);
     for (std::size_t i = 170; i <= 185; ++i) EXPECT_EQ(second.valid[i], 0) << i;
     EXPECT_EQ(second.countValid(), first.countValid() - 16);
+}
+
+TEST(EvidenceFilter, ARunOnALineIsKeptWhateverTheTemporalEvidenceSays) {
+    // The same 16 beams at 1 m (a line: a wall seen from a new viewpoint) are kept by step 7;
+    // 16 beams scattered +-6 cm about 1 m (far off any line at sigma = 1 cm) still go.
+    for (const bool scattered : {false, true}) {
+        EvidenceFilter f(exact());
+        Clusters c;
+        Scan first = room();
+        f.filter(first, c);
+        Scan second = roomAfter(0.1);
+        for (std::size_t i = 170; i <= 185; ++i)
+            test::setRange(second, i, i, scattered ? (i % 2 ? 1.06f : 0.94f) : 1.0f);
+        const auto r = f.filter(second, c);
+        for (std::size_t i = 170; i <= 185; ++i) EXPECT_EQ(second.valid[i], scattered ? 0 : 1) << i;
+        EXPECT_EQ(r.surface_kept, scattered ? 0u : 16u);
+        EXPECT_EQ(r.points_removed, scattered ? 16u : 0u);
+    }
 }
 
 TEST(EvidenceFilter, APersistentThinObjectIsKept) {
@@ -216,7 +241,7 @@ TEST(EvidenceFilter, WhenTheScanJustBeforeWantsTooMuchTheKeyframesAloneDecide) {
     // 1 m back supports them. 20 returns exceed a 5 % bound (18 of 361): without the burst
     // exception (max_confirmed_fraction = 0) the keyframes decide.
     for (const double bound : {0.05, 1.0}) {
-        EvidenceFilter::Params p = withRecent(1);
+        EvidenceFilter::Params p = noSurfaces(withRecent(1));
         p.max_removed_fraction = bound;
         p.max_confirmed_fraction = 0.0;
         EvidenceFilter f(p);
@@ -260,7 +285,7 @@ TEST(EvidenceFilter, ABurstAboveTheBoundIsRemovedWholeWhenTheScanJustBeforeConfi
     // The same 20-beam burst (5.5 % of the returns, above the 5 % bound): the scan just before
     // supports every other return it judged, so the burst is what changed, not the references.
     Scan second;
-    const auto r = burstAfter(withRecent(1), roomAfter(0.98), 170, 189, second);
+    const auto r = burstAfter(noSurfaces(withRecent(1)), roomAfter(0.98), 170, 189, second);
     EXPECT_TRUE(r.recent);
     EXPECT_TRUE(r.confirmed);
     EXPECT_FALSE(r.recent_overruled);
@@ -279,7 +304,7 @@ TEST(EvidenceFilter, ABurstIsNotConfirmedWhenTheScanJustBeforeDisagreesElsewhere
     Scan recent = roomAfter(0.98);
     test::setWall(recent, 100, 159, 4.0 - 0.98 + 1.2);
     for (const double support : {0.9, 0.5}) {
-        EvidenceFilter::Params p = withRecent(1);
+        EvidenceFilter::Params p = noSurfaces(withRecent(1));
         p.confirm_support = support;
         Scan second;
         const auto r = burstAfter(p, recent, 170, 189, second);
@@ -362,7 +387,7 @@ TEST(EvidenceFilter, ABurstOnlyInTheKeyframeIsRemovedWithTheScanJustAfter) {
         Scan key = roomAfter(1.0);
         test::setRange(key, 178, 182, 2.72f);  // its own segment (0.19 m breakpoint)
         const Scan after = roomAfter(1.02);
-        const auto r = keyframeAfter(withNext(next), before, key, &after);
+        const auto r = keyframeAfter(noSurfaces(withNext(next)), before, key, &after);
         EXPECT_TRUE(r.recent);
         EXPECT_EQ(r.next, next);
         for (std::size_t i = 178; i <= 182; ++i) EXPECT_EQ(key.valid[i], next ? 0 : 1) << i;
@@ -373,7 +398,8 @@ TEST(EvidenceFilter, ABurstOnlyInTheKeyframeIsRemovedWithTheScanJustAfter) {
 TEST(EvidenceFilter, ASurfaceThatAppearsInTheKeyframeAndStaysInTheNextScanIsKept) {
     // 12 beams at 2 m (a door swung open, a person stepping in): the keyframe and the scan
     // just after see it, the scan just before and the keyframe before saw the wall through
-    // it. Without the next scan it goes as free space; with it, its support keeps it.
+    // it. Without the next scan it goes as free space (step 7 off; on, it is a line and stays);
+    // with it, its support keeps it.
     auto withSurface = [](Scan s) {
         test::setRange(s, 175, 186, 2.0f);
         return s;
@@ -381,7 +407,7 @@ TEST(EvidenceFilter, ASurfaceThatAppearsInTheKeyframeAndStaysInTheNextScanIsKept
     for (const bool next : {false, true}) {
         Scan key = withSurface(roomAfter(1.0));
         const Scan after = withSurface(roomAfter(1.02));
-        const auto r = keyframeAfter(withNext(next), roomAfter(0.98), key, &after);
+        const auto r = keyframeAfter(noSurfaces(withNext(next)), roomAfter(0.98), key, &after);
         EXPECT_TRUE(r.recent);
         EXPECT_EQ(r.next, next);
         for (std::size_t i = 175; i <= 186; ++i) EXPECT_EQ(key.valid[i], next ? 1 : 0) << i;
@@ -532,6 +558,9 @@ TEST(EvidenceFilter, BadParametersAreRejected) {
     bad([](auto& p) { p.max_confirmed_fraction = -0.1; });
     bad([](auto& p) { p.max_confirmed_fraction = 1.1; });
     bad([](auto& p) { p.confirm_support = 0.0; });
+    bad([](auto& p) { p.surface_min_beams = 1; });
+    bad([](auto& p) { p.surface_sigmas = -1.0; });
+    bad([](auto& p) { p.surface_sigmas = std::nan(""); });
 }
 
 TEST(EvidenceFilter, DegenerateScansAreHandled) {

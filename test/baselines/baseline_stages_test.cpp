@@ -16,22 +16,24 @@ TEST(BaselineStages, RegisteredAfterTheCoreStages) {
     EXPECT_EQ(test::allStages().names(),
               "distance, keyframe, denoise, view_keyframe, range_aware_denoise, "
               "evidence_denoise, odometry_check, fuse, track, motion, dbscan, radius, sor, shadow, "
-              "decimate");
+              "speckle, decimate");
     StageRegistry only;
     registerBaselineStages(only);  // works without the core stages too
-    EXPECT_EQ(only.names(), "motion, dbscan, radius, sor, shadow, decimate");
+    EXPECT_EQ(only.names(), "motion, dbscan, radius, sor, shadow, speckle, decimate");
     EXPECT_THROW(registerBaselineStages(only), Error);  // twice: names are taken
 }
 
 TEST(BaselineStages, KeysKeepTheirFlatNames) {
     std::vector<std::string> names;
-    for (const char* s : {"motion", "dbscan", "radius", "sor", "shadow"})
+    for (const char* s : {"motion", "dbscan", "radius", "sor", "shadow", "speckle"})
         for (const auto& k : test::allStages().find(s)->keys) names.push_back(k.name);
-    EXPECT_EQ(names, (std::vector<std::string>{
-                         "motion_distance_m", "motion_angle_deg", "motion_interval_s",
-                         "dbscan_eps_m", "dbscan_min_pts", "radius_m", "radius_min_neighbors",
-                         "sor_k", "sor_std_mul", "shadow_min_angle_deg", "shadow_max_angle_deg",
-                         "shadow_window", "shadow_neighbors"}));
+    EXPECT_EQ(names,
+              (std::vector<std::string>{
+                  "motion_distance_m", "motion_angle_deg", "motion_interval_s", "dbscan_eps_m",
+                  "dbscan_min_pts", "radius_m", "radius_min_neighbors", "sor_k", "sor_std_mul",
+                  "shadow_min_angle_deg", "shadow_max_angle_deg", "shadow_window",
+                  "shadow_neighbors", "shadow_remove_start", "speckle_radius", "speckle_max_range",
+                  "speckle_max_range_difference", "speckle_window"}));
     // A key names its Params field for the core's errors.
     const StageInfo& sor = *test::allStages().find("sor");
     EXPECT_EQ(sor.keyForField("k")->name, "sor_k");
@@ -45,7 +47,7 @@ TEST(BaselineStages, KeysKeepTheirFlatNames) {
 }
 
 TEST(BaselineStages, DenoisingBaselinesCountAsNoise) {
-    for (const char* s : {"dbscan", "radius", "sor", "shadow"}) {
+    for (const char* s : {"dbscan", "radius", "sor", "shadow", "speckle"}) {
         SCOPED_TRACE(s);
         PipelineParams p;
         p.stages = {"distance", s};

@@ -27,6 +27,19 @@ TEST(ShadowFilter, AVeilingPointBetweenTwoSurfacesIsRemoved) {
     EXPECT_EQ(s.valid[99], 1);   // the box itself stays
 }
 
+TEST(ShadowFilter, TheStartPointGoesTooWhenAsked) {
+    Scan s = test::flatWall(181, deg2rad(90.0), 5.0);
+    test::setRange(s, 60, 99, 2.0);
+    test::insertSpike(s, 100, 3.5);
+    ShadowFilter::Params p;
+    p.neighbors = 1;
+    p.remove_start = true;
+    ShadowFilter(p).filter(s);
+    EXPECT_EQ(s.valid[100], 0);
+    EXPECT_EQ(s.valid[99], 0);  // the box edge whose test failed against the veiling point
+    EXPECT_EQ(s.valid[98], 1);
+}
+
 TEST(ShadowFilter, ASurfaceFacingTheSensorIsKept) {
     Scan s = test::flatWall(181, deg2rad(60.0), 3.0);
     const auto r = ShadowFilter().filter(s);
@@ -65,6 +78,7 @@ std::vector<std::uint8_t> plainShadows(const Scan& s, const ShadowFilter::Params
                  k <= static_cast<long>(i + p.neighbors); ++k)
                 if (k >= 0 && k < static_cast<long>(n) && s.valid[k] && s.range[i] < s.range[k])
                     out[k] = 0;
+            if (p.remove_start) out[i] = 0;
         }
     }
     return out;
@@ -77,6 +91,7 @@ TEST(ShadowFilter, MatchesAPlainReferenceOnRandomScans) {
         ShadowFilter::Params p;
         p.window = 1 + rng() % 3;
         p.neighbors = rng() % 25;
+        p.remove_start = rng() % 2;
         const auto expect = plainShadows(s, p);
         ShadowFilter(p).filter(s);
         EXPECT_EQ(s.valid, expect) << k;

@@ -15,6 +15,7 @@
 #include "kfd/mrpt/scan_adapter.h"
 #include "kfd/mrpt/stream_filter.h"
 #include "kfd/stages/core_stages.h"
+#include "kfd/stages/evidence_denoise_stage.h"
 #include "sanitizer.h"
 
 namespace {
@@ -442,6 +443,35 @@ TEST(StreamFilter, ARemovedPieceOfWallIsFlaggedCountedAndListed) {
             EXPECT_EQ(lines.find("looks like a surface"), std::string::npos) << lines;
         }
     }
+}
+
+// Issue 39: with kfd's defaults no kept scan of a real log loses a run of >= 5 returns that a
+// line fit at the scan's noise calls a surface (the summary's surface_m, 2 cm or 0.5 % of the
+// range RMS); the evidence denoiser without step 7 (keep_surfaces = false) does on fr079.
+std::size_t scansLosingASurface(const std::string& log, bool keep_surfaces) {
+    kfd::Pipeline::Params p = kfd::kfdDefaults();
+    p.get<kfd::EvidenceDenoiseStage>().keep_surfaces = keep_surfaces;
+    kfd::StreamFilter f(p);
+    auto source = kfd::openSource(log);
+    kfd::SourceEntry e;
+    std::size_t kept = 0;
+    while (source->next(e))
+        e.forEachScan([&](const mrpt::obs::CObservation2DRangeScan::Ptr& s) {
+            kept += f.process(*s, e.odometry).keep;
+        });
+    EXPECT_GT(kept, 100u) << log;
+    return f.counters().scans_surface_removed;
+}
+
+TEST(StreamFilter, NoKeptScanOfARealLogLosesASurface) {
+    const std::string d = KFD_DATASETS_DIR;
+    for (const char* name : {"fr079/fr079", "aces/aces", "intel/intel", "mit-csail/mit-csail",
+                             "mit-killian/mit-killian", "mines-urg/exp1", "mines-urg/exp2"}) {
+        const std::string log = d + "/" + name + ".rawlog";
+        if (!std::filesystem::exists(log)) GTEST_SKIP() << "dataset missing: " << log;
+        EXPECT_EQ(scansLosingASurface(log, true), 0u) << log;
+    }
+    EXPECT_GT(scansLosingASurface(d + "/fr079/fr079.rawlog", false), 10u);
 }
 
 // Issue 38: a stream of ever new sensor labels grew the door's memory forever (one pipeline

@@ -1,5 +1,7 @@
 #include "kfd/algorithms/evidence_filter.h"
+
 #include "kfd/algorithms/point_to_line.h"
+#include "kfd/algorithms/surface_run.h"
 
 #include <algorithm>
 #include <cmath>
@@ -128,6 +130,10 @@ void EvidenceFilter::initialize(const Params& p) {
         throw ParameterError("confirm_support", "confirm_support must be in (0, 1]");
     if (p.temporal_scans > 16)
         throw ParameterError("temporal_scans", "temporal_scans must be in [0, 16]");
+    if (p.surface_min_beams < 2 || p.surface_min_beams > 1000)
+        throw ParameterError("surface_min_beams", "surface_min_beams must be in [2, 1000]");
+    if (!(p.surface_sigmas >= 0.0 && p.surface_sigmas <= 100.0))
+        throw ParameterError("surface_sigmas", "surface_sigmas must be in [0, 100]");
     params_ = p;
     raw_.assign(p.temporal_scans, RawScan{});
     residuals_.reserve(2 * p.refine_samples + 2);
@@ -794,15 +800,149 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     // Free returns go unless they lie on a line with their neighbours (a surface the previous
     // keyframe saw a little farther: pose error, a door that moved); every return of a removed
     // segment goes.
+    remove_.assign(n, 0);
     for (std::size_t i = 0; i < n; ++i) {
         if (out.label[i] < 0) continue;
-        if (out.noise[static_cast<std::size_t>(out.label[i])] ||
-            (temporal && kept_ev[i] == kFree && !line_[i])) {
+        remove_[i] = out.noise[static_cast<std::size_t>(out.label[i])] ||
+                     (temporal && kept_ev[i] == kFree && !line_[i]);
+    }
+    // 6. Mixed pixels; 7. surfaces kept.
+    if (params_.veil) res.veils = markVeils(scan, out, sigma, cap);
+    if (params_.keep_surfaces) {
+        SurfaceRunParams sp;
+        sp.min_beams = params_.surface_min_beams;
+        // At the scan's noise, and never stricter than what the summary calls a surface.
+        sp.tolerance_m = std::max(params_.surface_sigmas * sigma, SurfaceRunParams{}.tolerance_m);
+        res.surface_kept = spareSurfaceRuns(scan, remove_.data(), sp);
+    }
+    for (std::size_t i = 0; i < n; ++i)
+        if (remove_[i] && scan.valid[i]) {
             scan.valid[i] = 0;
             ++res.points_removed;
         }
-    }
     return res;
+}
+
+std::size_t EvidenceFilter::markVeils(const Scan& scan, const Clusters& out, double sigma,
+                                      std::size_t cap) {
+    const std::size_t n = scan.range.size(), count = out.count();
+    seg_first_.assign(count, static_cast<std::uint32_t>(n));
+    seg_last_.assign(count, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (out.label[i] < 0) continue;
+        const auto c = static_cast<std::size_t>(out.label[i]);
+        seg_first_[c] = std::min<std::uint32_t>(seg_first_[c], static_cast<std::uint32_t>(i));
+        seg_last_[c] = static_cast<std::uint32_t>(i);
+    }
+    veil_.assign(n, 0);
+    const float margin = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
+    for (std::size_t c = 0; c < count; ++c) {
+        const std::size_t a = seg_first_[c], b = seg_last_[c];
+        if (a >= n) continue;
+        const std::size_t pa = neighbourReturn(scan, a, false), nb = neighbourReturn(scan, b, true);
+        if (out.size[c] <= params_.max_small_points && pa < n && nb < n &&
+            out.label[pa] != out.label[a] && out.label[nb] != out.label[b]) {
+            // A small segment between a nearer and a farther surface.
+            const float near = std::min(scan.range[pa], scan.range[nb]) + margin;
+            const float far = std::max(scan.range[pa], scan.range[nb]) - margin;
+            bool between = near < far;
+            for (std::size_t i = a; i <= b && between; ++i)
+                between =
+                    out.label[i] != out.label[a] || (scan.range[i] > near && scan.range[i] < far);
+            if (between) {
+                for (std::size_t i = a; i <= b; ++i) veil_[i] = out.label[i] == out.label[a];
+                continue;
+            }
+        }
+        veilAtEnd(scan, out, a, false, sigma);
+        veilAtEnd(scan, out, b, true, sigma);
+    }
+    veilRuns(scan, sigma);
+    std::size_t marked = 0;
+    for (std::size_t i = 0; i < n; ++i) marked += veil_[i] && !remove_[i];
+    if (marked > cap) return 0;  // clutter or vegetation, not a few edges: no guess
+    for (std::size_t i = 0; i < n; ++i) remove_[i] |= veil_[i];
+    return marked;
+}
+
+void EvidenceFilter::veilRuns(const Scan& scan, double sigma) {
+    // Runs of 1-3 consecutive returns at one depth strictly between their two neighbours' (one
+    // nearer, one farther), off the line at both ends, with a step along the ray on both sides.
+    const std::size_t n = scan.range.size();
+    const float m = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
+    const float along = static_cast<float>(0.5 * std::sin(res_) / std::tan(lambda_));
+    const float* r = scan.range.data();
+    const std::uint8_t* v = scan.valid.data();
+    for (std::size_t i = 1; i + 1 < n; ++i) {
+        if (!v[i - 1] || !v[i] || line_[i]) continue;
+        for (std::size_t len = 1; len <= std::min<std::size_t>(3, params_.max_small_points);
+             ++len) {
+            const std::size_t b = i + len;
+            if (b >= n || !v[b - 1] || !v[b]) break;
+            float lo = r[i], hi = r[i];
+            for (std::size_t k = i; k < b; ++k) lo = std::min(lo, r[k]), hi = std::max(hi, r[k]);
+            if (hi - lo > 2.0f * m) break;
+            const float near = std::min(r[i - 1], r[b]), far = std::max(r[i - 1], r[b]);
+            const float step = std::max(2.0f * m, along * lo);
+            if (lo - near < step || far - hi < step || line_[b - 1]) continue;
+            for (std::size_t k = i; k < b; ++k) veil_[k] = 1;
+            break;
+        }
+    }
+}
+
+std::size_t EvidenceFilter::neighbourReturn(const Scan& scan, std::size_t i, bool after) const {
+    const std::size_t n = scan.range.size();
+    for (std::size_t k = 1; k <= params_.max_gap_beams + 1; ++k) {
+        if (after ? i + k >= n : k > i) break;
+        const std::size_t j = after ? i + k : i - k;
+        if (scan.valid[j]) return j;
+    }
+    return n;
+}
+
+void EvidenceFilter::veilAtEnd(const Scan& scan, const Clusters& out, std::size_t end, bool last,
+                               double sigma) {
+    // The end's returns, walking inward: end, then its neighbours in the same segment.
+    const std::size_t n = scan.range.size();
+    const std::size_t f = neighbourReturn(scan, end, last);  // across the edge
+    if (f >= n || out.label[f] == out.label[end]) return;
+    const std::size_t most = params_.max_small_points;
+    std::size_t run[kMaxVeil + 2];
+    std::size_t have = 0;
+    for (std::size_t i = end; have < std::min(most, kMaxVeil) + 2;) {
+        run[have++] = i;
+        const std::size_t j = neighbourReturn(scan, i, !last);
+        if (j >= n || out.label[j] != out.label[end]) break;
+        i = j;
+    }
+    const float tol = static_cast<float>(3.0 * kResidualScale * sigma);
+    const float rf = scan.range[f];
+    // The longest end run of L returns that all leave the line through the two returns inside
+    // them toward the other side of the edge, and lie between that line and the other side.
+    for (std::size_t len = std::min(most, have >= 2 ? have - 2 : 0); len >= 1; --len) {
+        const std::size_t i1 = run[len], i2 = run[len + 1];
+        const float x1 = scan.range[i1] * dirs_.cos[i1], y1 = scan.range[i1] * dirs_.sin[i1];
+        const float dx = x1 - scan.range[i2] * dirs_.cos[i2];
+        const float dy = y1 - scan.range[i2] * dirs_.sin[i2];
+        bool veil = true;
+        for (std::size_t k = 0; k < len && veil; ++k) {
+            const std::size_t j = run[k];
+            const float cj = dirs_.cos[j], sj = dirs_.sin[j];
+            const float den = cj * dy - sj * dx;  // the ray crossing the line
+            if (std::abs(den) < 1e-6f) {
+                veil = false;
+                break;
+            }
+            const float pred = (x1 * dy - y1 * dx) / den;
+            const float rj = scan.range[j], e = rj - pred;
+            const bool toward = (rf > pred) ? (e > tol && rj < rf) : (e < -tol && rj > rf);
+            veil = pred > 0.0f && toward;
+        }
+        if (!veil) continue;
+        for (std::size_t k = 0; k < len; ++k) veil_[run[k]] = 1;
+        return;
+    }
 }
 
 bool EvidenceFilter::confirmedByRecent(const Clusters& out, std::size_t valid_in,

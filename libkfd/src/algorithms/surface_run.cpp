@@ -21,11 +21,11 @@ struct LineSums {
     }
 };
 
-// Whether the run of beams [first, last] (its removed returns summed in `s`) looks like a
-// surface; fills `out` when it does.
-bool looksLikeSurface(const Scan& scan, const std::uint8_t* before, std::size_t first,
-                      std::size_t last, const LineSums& s, const SurfaceRunParams& p,
-                      SurfaceRun& out) {
+// Whether the run of beams [first, last] (its removed returns summed in `s`; `removed(i)`: beam
+// i's return is removed) looks like a surface; fills `out` when it does.
+template <class Removed>
+bool looksLikeSurface(const Scan& scan, Removed removed, std::size_t first, std::size_t last,
+                      const LineSums& s, const SurfaceRunParams& p, SurfaceRun& out) {
     if (s.n < p.min_beams) return false;
     const double n = static_cast<double>(s.n);
     const double mx = s.x / n, my = s.y / n;
@@ -42,7 +42,7 @@ bool looksLikeSurface(const Scan& scan, const std::uint8_t* before, std::size_t 
     double lo = 0.0, hi = 0.0, px = 0.0, py = 0.0;
     bool any = false;
     for (std::size_t i = first; i <= last; ++i) {
-        if (!before[i] || scan.valid[i]) continue;
+        if (!removed(i)) continue;
         const double a = scan.geometry.angle(i), r = scan.range[i];
         const double x = r * std::cos(a), y = r * std::sin(a);
         if (any) {  // neighbours close enough to be one surface
@@ -62,34 +62,61 @@ bool looksLikeSurface(const Scan& scan, const std::uint8_t* before, std::size_t 
     return true;
 }
 
-}  // namespace
-
-SurfaceRun longestRemovedSurface(const Scan& scan, const std::uint8_t* before,
-                                 const SurfaceRunParams& p) {
-    SurfaceRun best;
+// Calls `found(run)` for every run of removed returns that looks like a surface. A run: beams
+// whose return is removed (`removed(i)`), up to a beam whose return stays (`kept(i)`); beams
+// with no return (neither) do not break it.
+template <class Removed, class Kept, class Found>
+void forEachSurfaceRun(const Scan& scan, Removed removed, Kept kept, const SurfaceRunParams& p,
+                       Found found) {
     const std::size_t n = std::min(scan.valid.size(), scan.range.size());
     std::size_t first = 0, last = 0;
     LineSums s;
     auto close = [&] {
         SurfaceRun r;
-        if (s.n > 0 && looksLikeSurface(scan, before, first, last, s, p, r) &&
-            r.length_m > best.length_m)
-            best = r;
+        if (s.n > 0 && looksLikeSurface(scan, removed, first, last, s, p, r)) found(r, last);
         s = LineSums{};
     };
     for (std::size_t i = 0; i < n; ++i) {
-        if (!before[i]) continue;  // invalid already: does not break a run
-        if (scan.valid[i]) {       // left valid: the run ends
+        if (kept(i)) {
             close();
             continue;
         }
+        if (!removed(i)) continue;  // no return: does not break a run
         if (s.n == 0) first = i;
         last = i;
         const double a = scan.geometry.angle(i), r = scan.range[i];
         s.add(r * std::cos(a), r * std::sin(a), r);
     }
     close();
+}
+
+}  // namespace
+
+SurfaceRun longestRemovedSurface(const Scan& scan, const std::uint8_t* before,
+                                 const SurfaceRunParams& p) {
+    SurfaceRun best;
+    forEachSurfaceRun(
+        scan, [&](std::size_t i) { return before[i] && !scan.valid[i]; },
+        [&](std::size_t i) { return before[i] && scan.valid[i]; }, p,
+        [&](const SurfaceRun& r, std::size_t) {
+            if (r.length_m > best.length_m) best = r;
+        });
     return best;
+}
+
+std::size_t spareSurfaceRuns(const Scan& scan, std::uint8_t* remove, const SurfaceRunParams& p) {
+    std::size_t spared = 0;
+    forEachSurfaceRun(
+        scan, [&](std::size_t i) { return scan.valid[i] && remove[i]; },
+        [&](std::size_t i) { return scan.valid[i] && !remove[i]; }, p,
+        [&](const SurfaceRun& r, std::size_t last) {
+            for (std::size_t i = r.first; i <= last; ++i)
+                if (scan.valid[i] && remove[i]) {
+                    remove[i] = 0;
+                    ++spared;
+                }
+        });
+    return spared;
 }
 
 }  // namespace kfd

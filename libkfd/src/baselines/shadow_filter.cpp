@@ -41,6 +41,7 @@ ShadowFilter::Result ShadowFilter::filter(Scan& scan) {
         const std::size_t k0 = i > nb ? i - nb : 0, k1 = std::min(n - 1, i + nb);
         for (std::size_t k = k0; k <= k1; ++k)
             if (scan.valid[k] && scan.range[k] > ri) remove_[k] = 1;
+        if (params_.remove_start) remove_[i] = 1;
     }
     for (std::size_t i = 0; i < n; ++i)
         if (remove_[i] && scan.valid[i]) {

@@ -17,7 +17,10 @@ std::vector<StageKey> ShadowStage::keys() {
                        64, [](P& p) -> std::size_t& { return p.window; }),
         keys::count<P>("shadow_neighbors", "neighbors",
                        "shadow stage: beams each side removed when farther (beams)", 0, 1000,
-                       [](P& p) -> std::size_t& { return p.neighbors; })};
+                       [](P& p) -> std::size_t& { return p.neighbors; }),
+        keys::boolean<P>("shadow_remove_start", "remove_start",
+                         "shadow stage: also remove the beam whose angle test failed",
+                         [](P& p) -> bool& { return p.remove_start; })};
 }
 
 }  // namespace kfd

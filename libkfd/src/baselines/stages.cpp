@@ -8,6 +8,7 @@ void registerBaselineStages(StageRegistry& registry) {
     registry.add<RadiusStage>();
     registry.add<SorStage>();
     registry.add<ShadowStage>();
+    registry.add<SpeckleStage>();
     registry.add<DecimateStage>();
 }
 

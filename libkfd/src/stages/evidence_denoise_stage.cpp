@@ -48,7 +48,20 @@ std::vector<StageKey> EvidenceDenoiseStage::keys() {
         keys::boolean<P>("next_scan", "next_scan",
                          "also confirm a keyframe against the scan just after it (one "
                          "scan of latency: the keyframe is output when the next scan arrives)",
-                         [](P& p) -> bool& { return p.next_scan; })};
+                         [](P& p) -> bool& { return p.next_scan; }),
+        keys::boolean<P>("veil", "veil",
+                         "remove mixed pixels between a near and a far surface (step 6)",
+                         [](P& p) -> bool& { return p.veil; }),
+        keys::boolean<P>("keep_surfaces", "keep_surfaces",
+                         "never remove a run of returns on a line at the scan's noise (step 7)",
+                         [](P& p) -> bool& { return p.keep_surfaces; }),
+        keys::count<P>("surface_min_beams", "surface_min_beams",
+                       "returns a run on a line needs to be kept as a surface (step 7)", 2, 1000,
+                       [](P& p) -> std::size_t& { return p.surface_min_beams; }),
+        keys::real<P>("surface_sigmas", "surface_sigmas",
+                      "RMS distance to the line a surface may have, in range noise sigmas "
+                      "(step 7)",
+                      0, 100, false, [](P& p) -> double& { return p.surface_sigmas; })};
 }
 
 bool EvidenceDenoiseStage::finish(Scan& scan, StageReport& report, const ScanReport&,
@@ -66,6 +79,8 @@ bool EvidenceDenoiseStage::finish(Scan& scan, StageReport& report, const ScanRep
     res.confirmed = r.confirmed;
     res.recent = r.recent;
     res.next = r.next;
+    res.veils = r.veils;
+    res.surface_kept = r.surface_kept;
     return endDenoising(clusters_, res, report);
 }
 
@@ -90,6 +105,11 @@ std::vector<StageColumn> EvidenceDenoiseStage::columns() {
     c.push_back(diagnosticColumn<DenoiseResult>(
         "sigma_mm", "the range noise the evidence used (mm; measured, then floored)", "%.2f",
         [](const DenoiseResult& r) { return 1e3 * r.sigma; }));
+    c.push_back(diagnosticColumn<DenoiseResult>("veils", "mixed pixels removed (step 6)", "%zu",
+                                                [](const DenoiseResult& r) { return r.veils; }));
+    c.push_back(diagnosticColumn<DenoiseResult>(
+        "surface_kept", "returns kept because they form a surface (step 7)", "%zu",
+        [](const DenoiseResult& r) { return r.surface_kept; }));
     return c;
 }
 

@@ -1,6 +1,7 @@
-// Removals that look like a surface (issue 37): the longest straight run of returns a denoising
-// stage removed from one scan, so that a summary can flag a keyframe that lost a piece of wall
-// instead of noise. std only.
+// Removals that look like a surface (issues 37, 39): the longest straight run of returns a
+// denoising stage removed from one scan, so that a summary can flag a keyframe that lost a piece
+// of wall instead of noise; and the same test sparing such runs before a denoiser removes them.
+// std only.
 #pragma once
 
 #include <cstddef>
@@ -18,11 +19,11 @@ namespace kfd {
 /// apart than max_gap_beams beam spacings at their range (a surface, not a scatter of spikes
 /// at similar ranges).
 struct SurfaceRunParams {
-    std::size_t min_beams = 8;      // returns
-    double min_length_m = 0.5;      // m, along the fitted line
-    double tolerance_m = 0.02;      // m, RMS distance to the line (the floor)
-    double tolerance_ratio = 0.01;  // of the run's mean range
-    double max_gap_beams = 4.0;     // neighbours at most this many beam spacings apart
+    std::size_t min_beams = 5;       // returns (issue 39: "a run of >= 5 beams on a line")
+    double min_length_m = 0.0;       // m, along the fitted line
+    double tolerance_m = 0.02;       // m, RMS distance to the line (the floor: 2 sigma of SICK)
+    double tolerance_ratio = 0.005;  // of the run's mean range (a Hokuyo's 1 % sigma at 2 m)
+    double max_gap_beams = 4.0;      // neighbours at most this many beam spacings apart
 };
 
 struct SurfaceRun {
@@ -37,5 +38,12 @@ struct SurfaceRun {
 /// Time O(n); no allocation.
 SurfaceRun longestRemovedSurface(const Scan& scan, const std::uint8_t* before,
                                  const SurfaceRunParams& p = {});
+
+/// Spares what looks like a surface before it is removed: `remove` flags the valid returns a
+/// denoiser is about to remove (one flag per beam); every run of them (as above: valid returns
+/// with the flag, broken by a valid return without it) that looks like a surface has its flags
+/// cleared. Returns the returns spared. Time O(n); no allocation.
+std::size_t spareSurfaceRuns(const Scan& scan, std::uint8_t* remove,
+                             const SurfaceRunParams& p = {});
 
 }  // namespace kfd

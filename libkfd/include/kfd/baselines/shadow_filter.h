@@ -17,8 +17,9 @@ namespace kfd {
 /// is computed. When it is below min_angle_deg or above max_angle_deg (the segment runs nearly
 /// along the ray: a veiling point between two surfaces, or a surface seen at grazing
 /// incidence), every valid beam within `neighbors` of i that is farther than r_i is removed.
-/// As in laser_filters, every test reads the input scan. Defaults are laser_filters' example
-/// configuration (10 and 170 degrees, window 1, 20 neighbours).
+/// With remove_start (laser_filters' remove_shadow_start_point, noetic) beam i goes too. As in
+/// laser_filters, every test reads the input scan. Defaults are laser_filters' example
+/// configuration (10 and 170 degrees, window 1, 20 neighbours, the start point kept).
 /// Time O(n (window + neighbors)); memory O(n).
 class ShadowFilter {
   public:
@@ -27,6 +28,7 @@ class ShadowFilter {
         double max_angle_deg = 170.0;  // deg
         std::size_t window = 1;        // beams each side tested against
         std::size_t neighbors = 20;    // beams each side removed when farther
+        bool remove_start = false;     // also remove the beam whose test failed
     };
     struct Result {
         std::size_t points_in = 0;       // valid beams on input

@@ -14,7 +14,8 @@ class ShadowStage : public DenoisingStage<ShadowFilter> {
     static constexpr const char* kName = "shadow";
     static constexpr const char* kHelp =
         "baseline: shadow / veiling point filter (ROS laser_filters' ScanShadowsFilter)";
-    /// Keys: shadow_min_angle_deg, shadow_max_angle_deg, shadow_window, shadow_neighbors.
+    /// Keys: shadow_min_angle_deg, shadow_max_angle_deg, shadow_window, shadow_neighbors,
+    /// shadow_remove_start.
     static std::vector<StageKey> keys();
 
     explicit ShadowStage(const Params& p = {}) : DenoisingStage(p) {}

@@ -1,4 +1,5 @@
-// The baseline stages (motion, dbscan, radius, sor, decimate) and their registration.
+// The baseline stages (motion, dbscan, radius, sor, shadow, speckle, decimate) and their
+// registration.
 #pragma once
 
 #include "kfd/baselines/dbscan_stage.h"
@@ -7,13 +8,14 @@
 #include "kfd/baselines/radius_stage.h"
 #include "kfd/baselines/shadow_stage.h"
 #include "kfd/baselines/sor_stage.h"
+#include "kfd/baselines/speckle_stage.h"
 #include "kfd/pipeline/stage_registry.h"
 
 namespace kfd {
 
 /// Registers the baselines after the core stages: motion (odometry motion filter), dbscan
 /// (DBSCAN denoise), radius (radius outlier removal), sor (statistical outlier removal),
-/// decimate (uniform decimation).
+/// shadow and speckle (ROS laser_filters' two filters), decimate (uniform decimation).
 void registerBaselineStages(StageRegistry& registry);
 
 }  // namespace kfd

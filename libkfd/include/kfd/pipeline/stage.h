@@ -24,7 +24,7 @@ struct Clusters;  // kfd/paper/clusters.h
 class StageReport {
   public:
     /// Room for a stage's diagnostics; larger types are rejected at compile time.
-    static constexpr std::size_t kDiagnosticsBytes = 112;
+    static constexpr std::size_t kDiagnosticsBytes = 128;
 
     const char* name = "";           // the stage's name()
     bool dropped = false;            // this stage dropped the scan (later stages did not run)

@@ -40,6 +40,8 @@ struct DenoiseResult {
     bool confirmed = false;          // evidence: above the bound, confirmed by the scan before
     bool recent = false;             // evidence: the raw scan just before was used
     bool next = false;               // evidence: the raw scan just after was used
+    std::size_t veils = 0;           // evidence: mixed pixels removed (step 6)
+    std::size_t surface_kept = 0;    // evidence: returns kept as a surface (step 7)
 };
 
 /// A denoising stage's start on a scan: the result's variant and points_in, and every valid
