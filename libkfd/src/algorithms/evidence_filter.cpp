@@ -89,6 +89,10 @@ inline void projectPoints(std::size_t m, const float* x, const float* y, float c
     }
 }
 
+/// The step-2 margin between two returns that each carry range noise sigma: 3 sigma of their
+/// difference (3 sqrt(2) sigma).
+inline double pairMargin(double sigma) { return 3.0 * std::sqrt(2.0) * sigma; }
+
 }  // namespace
 
 float EvidenceFilter::approxAtan2(float y, float x) { return fastAtan2(y, x); }
@@ -207,7 +211,7 @@ bool EvidenceFilter::convertInto(const RawScan& w, Reference& r, const Scan& sca
     // Links: the breakpoint test of step 2 between neighbouring returns (one surface).
     const double dt = std::min(static_cast<double>(res_), 0.5 * lambda_);
     const float factor = static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt));
-    const float noise = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
+    const float noise = static_cast<float>(pairMargin(sigma));
     std::uint8_t* link = r.link.data();
     const std::size_t pairs = n > 0 ? n - 1 : 0;
 #pragma omp simd
@@ -326,7 +330,7 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
         const double dt = std::min(static_cast<double>(k) * res_, 0.5 * lambda_);
         factor[k] = static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt));
     }
-    const float noise = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
+    const float noise = static_cast<float>(pairMargin(sigma));
     // Neighbouring returns: one surface within the breakpoint distance or on a line together.
     const float factor1 = factor[1];
     if (n > 0) link[n - 1] = 0;
@@ -419,7 +423,7 @@ EvidenceFilter::Projection EvidenceFilter::projection(const Reference& ref, cons
     Projection pr;
     const double step_t = std::hypot(d.x, d.y), step_r = std::abs(d.phi);
     pr.usable = step_t <= params_.max_step_m && step_r <= params_.max_step_deg * kDeg;
-    pr.m0 = static_cast<float>(3.0 * std::sqrt(2.0) * sigma + params_.pose_trans_error_m +
+    pr.m0 = static_cast<float>(pairMargin(sigma) + params_.pose_trans_error_m +
                                params_.motion_error_fraction * step_t);
     pr.m1 = static_cast<float>(params_.pose_rot_error_deg * kDeg +
                                params_.motion_error_fraction * step_r);
@@ -797,6 +801,14 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     keepAsReference(scan);  // swaps evidence_, x_, y_, link_ away: use the reference's below
     if (!raw_.empty() && params_.temporal) keepRaw(scan);  // before removal: the raw scan
     const std::vector<std::uint8_t>& kept_ev = refs_[0].present ? refs_[0].evidence : evidence_;
+    removeMarked(scan, out, kept_ev, temporal, sigma, cap, res);
+    return res;
+}
+
+void EvidenceFilter::removeMarked(Scan& scan, const Clusters& out,
+                                  const std::vector<std::uint8_t>& kept_ev, bool temporal,
+                                  double sigma, std::size_t cap, Result& res) {
+    const std::size_t n = scan.range.size();
     // Free returns go unless they lie on a line with their neighbours (a surface the previous
     // keyframe saw a little farther: pose error, a door that moved); every return of a removed
     // segment goes.
@@ -820,7 +832,6 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
             scan.valid[i] = 0;
             ++res.points_removed;
         }
-    return res;
 }
 
 std::size_t EvidenceFilter::markVeils(const Scan& scan, const Clusters& out, double sigma,
@@ -835,7 +846,7 @@ std::size_t EvidenceFilter::markVeils(const Scan& scan, const Clusters& out, dou
         seg_last_[c] = static_cast<std::uint32_t>(i);
     }
     veil_.assign(n, 0);
-    const float margin = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
+    const float margin = static_cast<float>(pairMargin(sigma));
     for (std::size_t c = 0; c < count; ++c) {
         const std::size_t a = seg_first_[c], b = seg_last_[c];
         if (a >= n) continue;
@@ -869,7 +880,7 @@ void EvidenceFilter::veilRuns(const Scan& scan, double sigma) {
     // Runs of 1-3 consecutive returns at one depth strictly between their two neighbours' (one
     // nearer, one farther), off the line at both ends, with a step along the ray on both sides.
     const std::size_t n = scan.range.size();
-    const float m = static_cast<float>(3.0 * std::sqrt(2.0) * sigma);
+    const float m = static_cast<float>(pairMargin(sigma));
     const float along = static_cast<float>(0.5 * std::sin(res_) / std::tan(lambda_));
     const float* r = scan.range.data();
     const std::uint8_t* v = scan.valid.data();

@@ -151,7 +151,7 @@ class EvidenceFilter {
         /// Step 6: remove mixed pixels at depth edges.
         bool veil = false;  // off: on SICK logs it costs more real returns than it finds (issue 39)
         /// Step 7: never remove a run of returns on a line (surface_min_beams returns within
-        /// surface_sigmas x sigma RMS of a line).
+        /// RMS max(surface_sigmas x sigma, 2 cm, 0.5 % of their range) of a line).
         bool keep_surfaces = true;
         std::size_t surface_min_beams = 5;  // returns
         double surface_sigmas = 2.0;        // RMS tolerance in units of the range noise sigma
@@ -274,6 +274,10 @@ class EvidenceFilter {
     // Step 5: the smallest noise segments only, up to `cap` returns.
     void capNoise(Clusters& out, std::size_t cap);
     // Step 6: marks mixed pixels in remove_ (at most `cap`; none when more); returns the count.
+    /// Steps 5-7 applied: marked segments and free returns removed, less mixed pixels (6) and
+    /// surfaces kept (7).
+    void removeMarked(Scan& scan, const Clusters& out, const std::vector<std::uint8_t>& kept_ev,
+                      bool temporal, double sigma, std::size_t cap, Result& res);
     std::size_t markVeils(const Scan& scan, const Clusters& out, double sigma, std::size_t cap);
     // Step 6: marks in veil_ the mixed pixels at a segment's first (`last` false) or last
     // beam `end`, walking inward.
