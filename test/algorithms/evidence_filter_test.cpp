@@ -359,6 +359,74 @@ TEST(EvidenceFilter, WithoutOdometryTheScanJustBeforeIsAligned) {
     EXPECT_EQ(r.points_removed, 1u);
 }
 
+// Issue 39, item 2 (track_alignment): where the track stage placed the scans, its poses align
+// them.
+EvidenceFilter::Tracked trackedAt(double x, double rms_m = 0.01) {
+    return EvidenceFilter::Tracked{Pose2D{x, 0.0, 0.0}, rms_m};
+}
+
+EvidenceFilter::Params trackAligned(EvidenceFilter::Params p) {
+    p.track_alignment = true;
+    return p;
+}
+
+TEST(EvidenceFilter, WhereTheTrackerPlacedBothKeyframesItsPosesReplaceOdometryAndAlignment) {
+    // The robot moved 0.1 m; the odometry says 0.6 m (a slip): the tracker's poses are used as
+    // they are and the denoiser runs no alignment of its own.
+    for (const bool use_track : {true, false}) {
+        EvidenceFilter::Params p = exact();
+        p.track_alignment = use_track;
+        EvidenceFilter f(p);
+        Clusters c;
+        Scan first = room();
+        const auto t0 = trackedAt(0.0), t1 = trackedAt(0.1);
+        f.filter(first, c, nullptr, &t0);
+        Scan second = test::flatWall(361, deg2rad(150.0), 3.9);
+        second.odometry = Pose2D{0.6, 0.0, 0.0};
+        test::insertSpike(second, 180, 3.5);
+        const auto r = f.filter(second, c, nullptr, &t1);
+        EXPECT_TRUE(r.temporal);
+        EXPECT_EQ(r.refined, !use_track);
+        if (use_track) {
+            EXPECT_EQ(second.valid[180], 0);
+            EXPECT_EQ(r.points_removed, 1u);
+        }
+    }
+}
+
+TEST(EvidenceFilter, TheRawScanJustBeforeIsPlacedByTheTrackerWithItsResidualAsTheMargin) {
+    EvidenceFilter f(trackAligned(withRecent(1)));
+    Clusters c;
+    Scan first = room();
+    const auto t0 = trackedAt(0.0), tb = trackedAt(0.98, 0.02), t1 = trackedAt(1.0, 0.015);
+    f.filter(first, c, nullptr, &t0);
+    f.observe(roomAfter(0.98), &tb);
+    Scan second = roomAfter(1.0);
+    test::insertSpike(second, 180, 2.88f);
+    const auto r = f.filter(second, c, nullptr, &t1);
+    EXPECT_TRUE(r.recent);
+    EXPECT_FALSE(r.refined);
+    EXPECT_NEAR(r.recent_margin_m, 3.0 * 0.02, 1e-9);  // 3 x the larger residual of the two
+    EXPECT_EQ(second.valid[180], 0);
+    EXPECT_EQ(r.points_removed, 1u);
+}
+
+TEST(EvidenceFilter, AReferenceTheTrackerDidNotPlaceIsAlignedByTheDenoiser) {
+    // The keyframe before was not tracked (the first scan, a lost track): odometry and the
+    // denoiser's own alignment place it, as without a tracker.
+    EvidenceFilter f(trackAligned(exact()));
+    Clusters c;
+    Scan first = room();
+    f.filter(first, c);
+    Scan second = roomAfter(0.1);
+    test::insertSpike(second, 180, 3.6);
+    const auto t1 = trackedAt(0.1);
+    const auto r = f.filter(second, c, nullptr, &t1);
+    EXPECT_TRUE(r.temporal);
+    EXPECT_TRUE(r.refined);
+    EXPECT_EQ(second.valid[180], 0);
+}
+
 TEST(EvidenceFilter, TheKeyframeItselfIsTheScanBeforeTheNextWhenNothingWasDropped) {
     EvidenceFilter f(withRecent(1));
     Clusters c;

@@ -29,9 +29,11 @@
 #include "kfd/pipeline/pipeline.h"
 #include "kfd/stages/fuse_stage.h"
 
+const kfd::ScanReport kNoChain{};  // a dropped scan's report: nothing the fuse stage reads
+
 extern "C" {
 __attribute__((noinline)) void kfd_fx_dropped(kfd::FuseStage& f, const kfd::Scan& s) {
-    f.observeDropped(s);
+    f.observeDropped(s, kNoChain);
 }
 __attribute__((noinline)) void kfd_fx_keyframe(kfd::FuseStage& f, kfd::Scan& s,
                                                kfd::StageReport& sr, const kfd::ScanReport& r) {

@@ -20,6 +20,8 @@
 #include "kfd/algorithms/scan_tracker.h"
 #include "kfd/baselines/dbscan.h"
 #include "kfd/baselines/radius_outlier.h"
+#include "kfd/baselines/shadow_filter.h"
+#include "kfd/baselines/speckle_filter.h"
 #include "kfd/baselines/statistical_outlier.h"
 #include "kfd/mrpt/config.h"
 #include "kfd/mrpt/stream_filter.h"
@@ -94,11 +96,18 @@ struct Context {
         keyframesOnlyParams().get<kfd::EvidenceDenoiseStage>()};
     kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_temporal{
         temporalParams().get<kfd::EvidenceDenoiseStage>()};
+    // The same behind a track stage that placed every scan (issue 39: no alignment of its own).
+    kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_tracked{
+        temporalParams().get<kfd::EvidenceDenoiseStage>()};
     kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_next{
         nextScanParams().get<kfd::EvidenceDenoiseStage>()};
     kfd::DbscanFilter dbscan{kfd::DbscanFilter::Params{0.7, 10}};
     kfd::RadiusOutlierFilter radius{kfd::RadiusOutlierFilter::Params{}};
     kfd::StatisticalOutlierFilter sor{kfd::StatisticalOutlierFilter::Params{}};
+    // laser_filters' definitions (issue 39): speckle 80 m / 0.1 m / window 2, shadows 10-170 deg,
+    // window 1, neighbours 0, the start point removed.
+    kfd::SpeckleFilter speckle{kfd::SpeckleFilter::Params{false, 80.0, 0.1, 2}};
+    kfd::ShadowFilter shadow{kfd::ShadowFilter::Params{10.0, 170.0, 1, 0, true}};
     kfd::Pipeline pipe_dropped{kb::paperParams()};
     kfd::Pipeline pipe_reference{kb::paperParams(kfd::DenoiseVariant::Reference)};
     kfd::Pipeline pipe_range_aware{kb::paperParams(kfd::DenoiseVariant::RangeAware)};
@@ -112,6 +121,7 @@ struct Context {
     std::size_t surprises = 0;  // dropped-set scans kept or keyframe-set scans dropped
 
     Context() {
+        evidence_tracked.trackAtOdometry(0.01f);
         hist.resize(sc.keyframes.size());
         for (std::size_t k = 0; k < hist.size(); ++k) histogram.compute(sc.keyframes[k], hist[k]);
         for (const auto& s : sc.prefix) selector.filter(s);
@@ -182,6 +192,17 @@ __attribute__((noinline)) void kfd_ir_denoise_evidence_temporal(Context& c, std:
     kfd_ir_evidence_observe(c, k);
     kfd_ir_denoise_evidence_temporal_keyframe(c, k);
 }
+// The same with the track stage's poses (issue 39, track_alignment).
+__attribute__((noinline)) void kfd_ir_evidence_observe_tracked(Context& c, std::size_t k) {
+    c.evidence_tracked.observe(c.sc.loop_before[k]);
+}
+__attribute__((noinline)) void kfd_ir_denoise_evidence_tracked_keyframe(Context& c, std::size_t k) {
+    c.sink += c.evidence_tracked.filter(c.work_loop[k]).points_removed;
+}
+__attribute__((noinline)) void kfd_ir_denoise_evidence_tracked(Context& c, std::size_t k) {
+    kfd_ir_evidence_observe_tracked(c, k);
+    kfd_ir_denoise_evidence_tracked_keyframe(c, k);
+}
 // The same keyframe confirmed against the scan just after it too (next_scan): the observe
 // of the scan before and the keyframe's filter with both raw scans.
 __attribute__((noinline)) void kfd_ir_denoise_evidence_next_keyframe(Context& c, std::size_t k) {
@@ -190,6 +211,12 @@ __attribute__((noinline)) void kfd_ir_denoise_evidence_next_keyframe(Context& c,
 __attribute__((noinline)) void kfd_ir_denoise_evidence_next(Context& c, std::size_t k) {
     c.evidence_next.observe(c.sc.loop_before[k]);
     kfd_ir_denoise_evidence_next_keyframe(c, k);
+}
+__attribute__((noinline)) void kfd_ir_speckle_loop(Context& c, std::size_t k) {
+    c.sink += c.speckle.filter(c.work_loop[k]).points_removed;
+}
+__attribute__((noinline)) void kfd_ir_shadow_loop(Context& c, std::size_t k) {
+    c.sink += c.shadow.filter(c.work_loop[k]).points_removed;
 }
 __attribute__((noinline)) void kfd_ir_dbscan_loop(Context& c, std::size_t k) {
     c.sink += c.dbscan.filter(c.work_loop[k]).points_removed;
@@ -249,7 +276,10 @@ const Case kCases[] = {
     {"denoise_range_aware", kfd_ir_denoise_range_aware, false},
     {"denoise_evidence", kfd_ir_denoise_evidence, false, true},
     {"denoise_evidence_temporal", kfd_ir_denoise_evidence_temporal, false, true},
+    {"denoise_evidence_tracked", kfd_ir_denoise_evidence_tracked, false, true},
     {"denoise_evidence_next", kfd_ir_denoise_evidence_next, false, true},
+    {"speckle_loop", kfd_ir_speckle_loop, false, true},
+    {"shadow_loop", kfd_ir_shadow_loop, false, true},
     {"dbscan_loop", kfd_ir_dbscan_loop, false, true},
     {"dbscan", kfd_ir_dbscan, false},
     {"radius_outlier", kfd_ir_radius_outlier, false},
@@ -275,10 +305,16 @@ void warmUp(Context& c, const Case& cs) {
                 c.evidence_temporal.observe(c.sc.loop_before[k]);
                 c.evidence_temporal.filter(c.work_loop[k]);
             }
+            if (name == "denoise_evidence_tracked") {
+                c.evidence_tracked.observe(c.sc.loop_before[k]);
+                c.evidence_tracked.filter(c.work_loop[k]);
+            }
             if (name == "denoise_evidence_next") {
                 c.evidence_next.observe(c.sc.loop_before[k]);
                 c.evidence_next.filter(c.work_loop[k], &c.sc.loop_after[k]);
             }
+            if (name == "speckle_loop") c.speckle.filter(c.work_loop[k]);
+            if (name == "shadow_loop") c.shadow.filter(c.work_loop[k]);
             if (name == "dbscan_loop") c.dbscan.filter(c.work_loop[k]);
         }
         return;

@@ -15,6 +15,7 @@
 #include <mrpt/obs/CObservation2DRangeScan.h>
 
 #include "kfd/algorithms/keyframe_selector.h"
+#include "kfd/algorithms/scan_tracker.h"
 #include "kfd/paper/distance_filter.h"
 #include "kfd/pipeline/pipeline.h"
 #include "kfd/pipeline/scan.h"
@@ -273,14 +274,31 @@ class StageFilter {
     explicit StageFilter(const typename S::Params& p) : stage_(p) {}
     DenoiseResult filter(Scan& scan, const Scan* next = nullptr) {
         StageReport report;
-        stage_.finish(scan, report, chain_, next);
+        stage_.finish(scan, report, chain(scan), next);
         return *report.diagnostics<DenoiseResult>();
     }
-    void observe(const Scan& scan) { stage_.observeDropped(scan); }
+    void observe(const Scan& scan) { stage_.observeDropped(scan, chain(scan)); }
+    /// From now on the chain before the stage holds a track stage that tracked every scan at
+    /// its odometry (the simulated scans' true pose), with this RMS residual (m).
+    void trackAtOdometry(float rms_m) {
+        tracked_ = true;
+        track_.verdict = TrackVerdict::Tracked;
+        track_.rms_m = rms_m;
+    }
 
   private:
+    const ScanReport& chain(const Scan& scan) {
+        if (!tracked_ || !scan.odometry) return chain_;
+        track_.pose = *scan.odometry;
+        tracked_chain_.stage_reports[0].setDiagnostics(track_);
+        tracked_chain_.stage_count = 1;
+        return tracked_chain_;
+    }
     S stage_;
     ScanReport chain_{};
+    bool tracked_ = false;
+    TrackResult track_;
+    ScanReport tracked_chain_{};
 };
 
 /// The MRPT form of a core scan (what a driver gives the door).

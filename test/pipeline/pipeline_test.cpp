@@ -51,7 +51,7 @@ class RecordingStage : public Stage {
         seen_denoised = chain.find<DenoiseResult>() != nullptr;
         return keep_;
     }
-    void observeDropped(const Scan& scan) override {
+    void observeDropped(const Scan& scan, const ScanReport&) override {
         ++observed;
         observed_valid = scan.countValid();
     }

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "kfd/algorithms/scan_tracker.h"
 #include "kfd/paper/distance_filter.h"
 #include "test_scans.h"
 
@@ -330,4 +331,35 @@ TEST(RangeAwareDenoiseStage, RejectsBadParams) {
 }
 
 }  // namespace
+
+// Issue 39, item 2: the stage reads where the track stage placed the scan from the chain.
+ScanReport trackedChain(double x) {
+    TrackResult t;
+    t.verdict = TrackVerdict::Tracked;
+    t.pose = Pose2D{x, 0.0, 0.0};
+    t.rms_m = 0.01f;
+    ScanReport chain;
+    chain.stage_reports[0].setDiagnostics(t);
+    chain.stage_count = 1;
+    return chain;
+}
+
+TEST(EvidenceDenoiseStage, TakesTheTrackersPosesFromTheChain) {
+    // The odometry jumps 5 m (beyond max_step_m: no temporal evidence from it); the track
+    // stage placed both scans 0.1 m apart, and the stage uses that (track_alignment).
+    EvidenceDenoiseStage::Params p;
+    p.track_alignment = true;
+    for (const bool tracked : {true, false}) {
+        EvidenceDenoiseStage stage(p);
+        StageReport report;
+        Scan first = test::flatWall(361, test::deg2rad(150.0), 4.0);
+        first.odometry = Pose2D{};
+        Scan second = test::flatWall(361, test::deg2rad(150.0), 3.9);
+        second.odometry = Pose2D{5.0, 0.0, 0.0};
+        stage.process(first, report, tracked ? trackedChain(0.0) : ScanReport{});
+        stage.process(second, report, tracked ? trackedChain(0.1) : ScanReport{});
+        EXPECT_EQ(report.diagnostics<DenoiseResult>()->temporal, tracked);
+    }
+}
+
 }  // namespace kfd

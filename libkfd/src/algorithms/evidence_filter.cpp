@@ -154,20 +154,23 @@ void EvidenceFilter::reset() {
     raw_next_ = raw_count_ = 0;
 }
 
-void EvidenceFilter::observe(const Scan& scan) {
-    if (!raw_.empty() && params_.temporal) keepRaw(scan);
+void EvidenceFilter::observe(const Scan& scan, const Tracked* tracked) {
+    if (!raw_.empty() && params_.temporal) keepRaw(scan, tracked);
 }
 
-void EvidenceFilter::RawScan::copy(const Scan& scan) {
+void EvidenceFilter::RawScan::copy(const Scan& scan, const Tracked* tracked) {
     geometry = scan.geometry;
     range.assign(scan.range.begin(), scan.range.end());
     valid.assign(scan.valid.begin(), scan.valid.end());
     has_odom = scan.odometry.has_value();
     odom = has_odom ? compose(*scan.odometry, scan.sensor_pose) : Pose2D{};
+    has_track = tracked != nullptr;
+    track = has_track ? compose(tracked->pose, scan.sensor_pose) : Pose2D{};
+    track_rms = has_track ? tracked->rms_m : 0.0;
 }
 
-void EvidenceFilter::keepRaw(const Scan& scan) {
-    raw_[raw_next_].copy(scan);
+void EvidenceFilter::keepRaw(const Scan& scan, const Tracked* tracked) {
+    raw_[raw_next_].copy(scan, tracked);
     raw_next_ = (raw_next_ + 1) % raw_.size();
     raw_count_ = std::min(raw_count_ + 1, raw_.size());
 }
@@ -192,6 +195,9 @@ bool EvidenceFilter::convertInto(const RawScan& w, Reference& r, const Scan& sca
     r.evidence.clear();            // no evidence of its own: nothing is tracked against it
     r.has_odom = w.has_odom;
     r.odom = r.pose = w.odom;
+    r.has_track = w.has_track;
+    r.track = w.track;
+    r.track_rms = w.track_rms;
     // Branch-free passes (this runs once per keyframe over every beam).
     const float* range = w.range.data();
     const std::uint8_t* wv = w.valid.data();
@@ -228,13 +234,18 @@ EvidenceFilter::Projection EvidenceFilter::rawProjection(const Scan& scan, const
                                                          double sigma, double* base) const {
     Projection pr;
     Pose2D d;  // this scan's sensor in the raw scan's frame
-    if (scan.odometry && ref.has_odom)
-        d = between(ref.odom, compose(*scan.odometry, scan.sensor_pose));
-    else if (scan.odometry || ref.has_odom)
-        return pr;  // no common frame
-    if (!projection(ref, d, sigma).usable) return pr;
     double spread = 0.0;
-    if (!refineStep(scan, ref, d, &spread)) return pr;  // no alignment: no margin to trust
+    if (trackedStep(scan, ref, d)) {  // the tracker aligned both: its residual is the spread
+        if (!projection(ref, d, sigma).usable) return pr;
+        spread = std::max(tracked_->rms_m, ref.track_rms);
+    } else {
+        if (scan.odometry && ref.has_odom)
+            d = between(ref.odom, compose(*scan.odometry, scan.sensor_pose));
+        else if (scan.odometry || ref.has_odom)
+            return pr;  // no common frame
+        if (!projection(ref, d, sigma).usable) return pr;
+        if (!refineStep(scan, ref, d, &spread)) return pr;  // no alignment: no margin to trust
+    }
     pr = projection(ref, d, sigma);
     // The margin from what was measured: the larger of the two scans' range noise and the
     // alignment's own residual spread (3 standard deviations), plus the odometry-error share
@@ -258,7 +269,7 @@ EvidenceFilter::Projection EvidenceFilter::nextProjection(const Scan& scan, doub
                                                           Result& res) {
     // Step 3c: the next scan, copied and converted like a raw scan of step 3b, aligned the
     // same way and with the same margins.
-    next_raw_.copy(*next_);
+    next_raw_.copy(*next_, nullptr);  // not tracked yet: aligned by odometry and refined
     if (!convertInto(next_raw_, next_ref_, scan, sigma)) return Projection{};
     double base = 0.0;
     const Projection pr = rawProjection(scan, next_ref_, sigma, &base);
@@ -581,19 +592,20 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
     // 3c. The raw scan just after (next_scan), the same way.
     Projection pn;
     if (recent && next_) pn = nextProjection(scan, sigma, res);
-    // This scan's sensor in the newest keyframe's frame: the odometry step (no motion without
-    // odometry), refined.
+    // This scan's sensor in the newest keyframe's frame: the tracker's step where it placed
+    // both, else the odometry step (no motion without odometry), refined.
     Projection p0;
     const Reference& r0 = refs_[0];
     if (r0.present && r0.geometry == scan.geometry) {
         Pose2D d;
         bool common = true;
-        if (scan.odometry && r0.has_odom)
+        const bool tracked = trackedStep(scan, r0, d);  // else from odometry, then refined
+        if (!tracked && scan.odometry && r0.has_odom)
             d = between(r0.odom, compose(*scan.odometry, scan.sensor_pose));
-        else if (scan.odometry || r0.has_odom)
+        else if (!tracked && (scan.odometry || r0.has_odom))
             common = false;  // odometry appeared or vanished: no common frame
         if (common && projection(r0, d, sigma).usable) {
-            res.refined = refineStep(scan, r0, d);
+            if (!tracked) res.refined = refineStep(scan, r0, d);
             p0 = projection(r0, d, sigma);
             pose_ = compose(r0.pose, d);
             have_pose_ = true;
@@ -715,18 +727,35 @@ void EvidenceFilter::keepAsReference(const Scan& scan) {
     // a new chain, and the older keyframe is no longer in it.
     r.pose = have_pose_ ? pose_ : r.odom;
     if (!have_pose_) refs_[1].present = false;
+    r.has_track = tracked_ != nullptr;
+    r.track = r.has_track ? compose(tracked_->pose, scan.sensor_pose) : Pose2D{};
+    r.track_rms = r.has_track ? tracked_->rms_m : 0.0;
+}
+
+bool EvidenceFilter::trackedStep(const Scan& scan, const Reference& ref, Pose2D& d) const {
+    if (!params_.track_alignment || tracked_ == nullptr || !ref.has_track) return false;
+    d = between(ref.track, compose(tracked_->pose, scan.sensor_pose));
+    return true;
 }
 
 EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out, const Scan* next) {
+    return filter(scan, out, next, nullptr);
+}
+
+EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out, const Scan* next,
+                                              const Tracked* tracked) {
     next_ = params_.next_scan ? next : nullptr;
+    tracked_ = tracked;
     Result res;
     try {
         res = filter(scan, out);
     } catch (...) {
         next_ = nullptr;
+        tracked_ = nullptr;
         throw;
     }
     next_ = nullptr;
+    tracked_ = nullptr;
     return res;
 }
 
@@ -799,7 +828,7 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     // The previous keyframe for the next scan keeps every return (removed ones too: a thin
     // object removed once as unsupported must still support the next view).
     keepAsReference(scan);  // swaps evidence_, x_, y_, link_ away: use the reference's below
-    if (!raw_.empty() && params_.temporal) keepRaw(scan);  // before removal: the raw scan
+    if (!raw_.empty() && params_.temporal) keepRaw(scan, tracked_);  // before removal: the raw scan
     const std::vector<std::uint8_t>& kept_ev = refs_[0].present ? refs_[0].evidence : evidence_;
     removeMarked(scan, out, kept_ev, temporal, sigma, cap, res);
     return res;

@@ -164,7 +164,7 @@ ScanReport Pipeline::process(Scan& scan) {
         if (!keep) {  // the later stages see the dropped scan (Stage::observeDropped)
             for (std::size_t j = i + 1; j < stages_.size(); ++j) {
                 if (held_ && j == held_stage_) t += finishHeld(&scan);
-                stages_[j]->observeDropped(scan);
+                stages_[j]->observeDropped(scan, report);
             }
         }
         if (!endStage(stage, keep, sr, report, t)) break;
@@ -198,7 +198,7 @@ std::chrono::steady_clock::duration Pipeline::finishHeld(const Scan* next) {
         const bool keep = runStage(stage, held_scan_, sr, report, before_, i == held_stage_, next);
         if (!keep) {
             for (std::size_t j = i + 1; j < stages_.size(); ++j)
-                stages_[j]->observeDropped(held_scan_);
+                stages_[j]->observeDropped(held_scan_, report);
         }
         const bool kept = endStage(stage, keep, sr, report, t);
         report.microseconds += sr.microseconds;

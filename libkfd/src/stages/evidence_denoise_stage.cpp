@@ -1,5 +1,6 @@
 #include "kfd/stages/evidence_denoise_stage.h"
 
+#include "kfd/algorithms/scan_tracker.h"
 #include "kfd/pipeline/stage_keys.h"
 
 namespace kfd {
@@ -52,6 +53,10 @@ std::vector<StageKey> EvidenceDenoiseStage::keys() {
         keys::boolean<P>("veil", "veil",
                          "remove mixed pixels between a near and a far surface (step 6)",
                          [](P& p) -> bool& { return p.veil; }),
+        keys::boolean<P>("track_alignment", "track_alignment",
+                         "where the track stage placed a keyframe and a reference, align them "
+                         "by its poses instead of the denoiser's own alignment",
+                         [](P& p) -> bool& { return p.track_alignment; }),
         keys::boolean<P>("keep_surfaces", "keep_surfaces",
                          "never remove a run of returns on a line at the scan's noise (step 7)",
                          [](P& p) -> bool& { return p.keep_surfaces; }),
@@ -64,11 +69,28 @@ std::vector<StageKey> EvidenceDenoiseStage::keys() {
                       0, 100, false, [](P& p) -> double& { return p.surface_sigmas; })};
 }
 
-bool EvidenceDenoiseStage::finish(Scan& scan, StageReport& report, const ScanReport&,
+namespace {
+// Where the track stage (earlier in the chain) placed the scan, when it tracked it.
+const EvidenceFilter::Tracked* trackedBy(const ScanReport& chain, EvidenceFilter::Tracked& t) {
+    const TrackResult* r = chain.find<TrackResult>();
+    if (r == nullptr || !r->tracked()) return nullptr;
+    t.pose = r->pose;
+    t.rms_m = r->rms_m;
+    return &t;
+}
+}  // namespace
+
+void EvidenceDenoiseStage::observeDropped(const Scan& scan, const ScanReport& chain) {
+    EvidenceFilter::Tracked t;
+    filter_.observe(scan, trackedBy(chain, t));
+}
+
+bool EvidenceDenoiseStage::finish(Scan& scan, StageReport& report, const ScanReport& chain,
                                   const Scan* next) {
     DenoiseResult res = startDenoising(scan, DenoiseVariant::Evidence);
     // Marks its segments' noise flags and removes their points itself.
-    const auto r = filter_.filter(scan, clusters_, next);
+    EvidenceFilter::Tracked t;
+    const auto r = filter_.filter(scan, clusters_, next, trackedBy(chain, t));
     res.points_removed += r.points_removed;
     res.temporal = r.temporal;
     res.sigma = r.sigma;

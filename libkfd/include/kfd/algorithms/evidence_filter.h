@@ -126,9 +126,14 @@ class EvidenceFilter {
         double moving_object_m = 0.5;        // m: reach of a moving object between keyframes
         double max_step_m = 2.0;             // m: farther keyframes give no temporal evidence
         double max_step_deg = 45.0;          // deg: the same, in rotation
-        std::size_t refine_iterations = 3;   // Gauss-Newton steps aligning to the keyframe
-        std::size_t refine_samples = 128;    // returns used per step (every n/128-th)
-        double refine_gate_m = 1.0;          // m: pairing gate of the first step (halved after)
+        /// Issue 39: where the tracker placed both scans (Tracked), their step is the tracker's
+        /// and the margin its RMS residual: no alignment of the denoiser's own. Off: it denoises
+        /// better and costs 29 % fewer instructions, but ICP-SLAM after it is significantly
+        /// worse on mit-csail (docs/RESULTS.md, issue 39).
+        bool track_alignment = false;
+        std::size_t refine_iterations = 3;  // Gauss-Newton steps aligning to the keyframe
+        std::size_t refine_samples = 128;   // returns used per step (every n/128-th)
+        double refine_gate_m = 1.0;         // m: pairing gate of the first step (halved after)
         /// Largest share of a scan's valid returns removed (step 5), in (0, 1]; 1 = no bound.
         /// 5 %: issue 22's bound; real bursts cover 0.3-1.2 % of a log's returns (CHANGELOG).
         double max_removed_fraction = 0.05;
@@ -188,6 +193,13 @@ class EvidenceFilter {
     void initialize(const Params& p);  // kfd::ParameterError on bad values
     const Params& params() const { return params_; }
 
+    /// Where the tracker placed a scan (kfd/algorithms/scan_tracker.h, verdict Tracked): the
+    /// robot's tracked pose and the RMS point-to-line residual of its alignment (m).
+    struct Tracked {
+        Pose2D pose;
+        double rms_m = 0.0;
+    };
+
     /// Filters the scan (clears the valid flag of removed returns); `out` receives the
     /// segments as clusters (label per beam, noise flag per segment).
     Result filter(Scan& scan, Clusters& out);
@@ -195,11 +207,14 @@ class EvidenceFilter {
     /// keyframe stage passed it on: dropped or kept, before its own denoising). nullptr or
     /// next_scan off: filter(scan, out). `next` is only read, during the call.
     Result filter(Scan& scan, Clusters& out, const Scan* next);
+    /// The same, with where the tracker placed this scan (nullptr: not tracked). With
+    /// track_alignment, a reference the tracker placed too is aligned by the two poses.
+    Result filter(Scan& scan, Clusters& out, const Scan* next, const Tracked* tracked);
     /// Keeps a copy of a scan not filtered (one the keyframe stage dropped) as a temporal
     /// reference for the next keyframe (step 3b). Copies ranges, flags and odometry into a
     /// ring of temporal_scans preallocated slots: no allocation once they have grown, O(n).
     /// Does nothing when temporal_scans is 0 or temporal is off.
-    void observe(const Scan& scan);
+    void observe(const Scan& scan, const Tracked* tracked = nullptr);
     /// Forget the previous keyframe and the noise estimate (a new sensor or log).
     void reset();
 
@@ -220,6 +235,9 @@ class EvidenceFilter {
         std::vector<std::uint8_t> valid, link, evidence;
         bool has_odom = false;
         Pose2D odom, pose;
+        bool has_track = false;  // the tracker placed it: its sensor's tracked pose
+        Pose2D track;
+        double track_rms = 0.0;
     };
     // A raw scan kept for step 3b: copies, converted only when a keyframe comes.
     struct RawScan {
@@ -228,7 +246,11 @@ class EvidenceFilter {
         std::vector<std::uint8_t> valid;
         bool has_odom = false;
         Pose2D odom;
-        void copy(const Scan& scan);  // ranges, flags, odometry pose (buffers reused)
+        bool has_track = false;
+        Pose2D track;
+        double track_rms = 0.0;
+        // Ranges, flags, odometry and tracked pose (buffers reused).
+        void copy(const Scan& scan, const Tracked* tracked);
     };
     // A reference seen from this scan: the step and the margins (m0 + m1 x range).
     struct Projection {
@@ -263,7 +285,10 @@ class EvidenceFilter {
     bool convertInto(const RawScan& w, Reference& r, const Scan& scan, double sigma);
     // Step 3c: the next scan (next_) as a projection, converted into next_ref_.
     Projection nextProjection(const Scan& scan, double sigma, Result& res);
-    void keepRaw(const Scan& scan);
+    void keepRaw(const Scan& scan, const Tracked* tracked);
+    // With track_alignment, where both this scan (tracked_) and `ref` were tracked: d = this
+    // scan's sensor in ref's frame from the two tracked poses, and true.
+    bool trackedStep(const Scan& scan, const Reference& ref, Pose2D& d) const;
     bool trackedMotion(const Reference& ref, float qx, float qy, float rho, std::size_t k0) const;
     void keepAsReference(const Scan& scan);
     // Step 4: marks noise segments; returns the returns it would remove (`kept_ev`: evidence).
@@ -315,6 +340,7 @@ class EvidenceFilter {
     Reference recent_;                      // a raw scan converted for this keyframe
     std::vector<std::uint8_t> recent_ev_;   // per beam: the raw scan just before's verdict
     const Scan* next_ = nullptr;            // step 3c: the next scan, during filter() only
+    const Tracked* tracked_ = nullptr;      // this scan's tracked pose, during filter() only
     RawScan next_raw_;                      // its copy (reused buffers)
     Reference next_ref_;                    // converted
     mutable std::vector<float> residuals_;  // refineStep's last iteration |e|

@@ -126,8 +126,9 @@ class Stage {
     /// from every scan the sensor took (the denoiser's temporal evidence, issue 25) looks at it
     /// here. Called for every stage after the one that dropped it, in order; must be cheap
     /// (a dropped scan's whole cost is the point of dropping it) and not allocate in steady
-    /// state. The default ignores it.
-    virtual void observeDropped(const Scan& /*scan*/) {}
+    /// state. `chain`: the dropped scan's report so far (the diagnostics of the stages that ran
+    /// on it, e.g. the tracker's pose). The default ignores it.
+    virtual void observeDropped(const Scan& /*scan*/, const ScanReport& /*chain*/) {}
     /// The chain's verdict on a scan this stage's process() ran on: kept (no stage dropped it;
     /// a scan held by a later stage counts as kept) or dropped, called for every such stage in
     /// order once the chain has run, with the scan as the later stages left it. A stage that

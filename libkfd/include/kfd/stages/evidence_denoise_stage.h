@@ -38,7 +38,7 @@ class EvidenceDenoiseStage : public Stage {
         return finish(scan, report, chain, nullptr);
     }
     /// The evidence's temporal part from the scans the keyframe stage drops.
-    void observeDropped(const Scan& scan) override { filter_.observe(scan); }
+    void observeDropped(const Scan& scan, const ScanReport& chain) override;
     void reset() override { filter_.reset(); }
     /// next_scan (with temporal): a keyframe waits for the next scan.
     bool defers() const override { return filter_.params().next_scan && filter_.params().temporal; }

@@ -29,7 +29,7 @@ class FuseStage : public Stage {
     explicit FuseStage(const Params& p = {}) : algo_(p) {}
     const char* name() const override { return kName; }
     bool process(Scan& scan, StageReport& report, const ScanReport& chain) override;
-    void observeDropped(const Scan& scan) override { algo_.observe(scan); }
+    void observeDropped(const Scan& scan, const ScanReport&) override { algo_.observe(scan); }
     void reset() override { algo_.reset(); }
     const ScanFusion& algorithm() const { return algo_; }
 
