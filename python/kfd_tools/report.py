@@ -591,8 +591,15 @@ def pair_table(g):
 
 
 def verdict_lines(g):
-    return ["- " + g.verdicts[p]["text"] for p in g.pairs] or [
-        "No pair to judge (no `%s` runs and no named pair)." % g.baseline]
+    return ["- " + g.verdicts[p]["text"] for p in g.pairs] or [no_pair_line(g)]
+
+
+def no_pair_line(g):
+    """Why a group has no verdict: the baseline has no runs, or nothing to compare it with."""
+    if g.baseline not in g.modes:
+        return "No pair to judge: no `%s` runs (the baseline) and no named pair." % g.baseline
+    return ("No pair to judge: `%s` (the baseline) is the only mode run; run another mode "
+            "beside it (--modes) to get a verdict." % g.baseline)
 
 
 def spread_line(g):

@@ -481,6 +481,22 @@ SUCCEED = ("#!/bin/sh\nmkdir -p \"$4\"\necho '{\"dropped_pct\": 10.0, \"scans_in
            "\"scans_kept\": 90}' > \"$4/summary.json\"\n")
 
 
+class NothingToCompare(Base):
+    """Runs of one mode only: the report says why there is no verdict, in the user's words."""
+
+    def test_the_baseline_alone_asks_for_another_mode(self):
+        for k in range(3):
+            write_run(self.out, "aces", "kfd", k, local=0.1, long=1.0)
+        self.collect(baseline="kfd")
+        self.assertIn("No pair to judge: `kfd` (the baseline) is the only mode run", self.report)
+
+    def test_no_baseline_runs_says_so(self):
+        for k in range(3):
+            write_run(self.out, "aces", "kfd", k, local=0.1, long=1.0)
+        self.collect(baseline="none")
+        self.assertIn("No pair to judge: no `none` runs (the baseline)", self.report)
+
+
 class RunJob(Base):
     def job(self, script):
         exe = os.path.join(self.tmp, "kfd-icp-slam")

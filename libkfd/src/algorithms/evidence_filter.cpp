@@ -164,9 +164,17 @@ void EvidenceFilter::RawScan::copy(const Scan& scan, const Tracked* tracked) {
     valid.assign(scan.valid.begin(), scan.valid.end());
     has_odom = scan.odometry.has_value();
     odom = has_odom ? compose(*scan.odometry, scan.sensor_pose) : Pose2D{};
-    has_track = tracked != nullptr;
-    track = has_track ? compose(tracked->pose, scan.sensor_pose) : Pose2D{};
-    track_rms = has_track ? tracked->rms_m : 0.0;
+    track = SensorTrack::of(scan, tracked);
+}
+
+EvidenceFilter::SensorTrack EvidenceFilter::SensorTrack::of(const Scan& scan,
+                                                            const Tracked* tracked) {
+    SensorTrack t;
+    if (tracked == nullptr) return t;
+    t.present = true;
+    t.pose = compose(tracked->pose, scan.sensor_pose);
+    t.rms_m = tracked->rms_m;
+    return t;
 }
 
 void EvidenceFilter::keepRaw(const Scan& scan, const Tracked* tracked) {
@@ -195,9 +203,7 @@ bool EvidenceFilter::convertInto(const RawScan& w, Reference& r, const Scan& sca
     r.evidence.clear();            // no evidence of its own: nothing is tracked against it
     r.has_odom = w.has_odom;
     r.odom = r.pose = w.odom;
-    r.has_track = w.has_track;
     r.track = w.track;
-    r.track_rms = w.track_rms;
     // Branch-free passes (this runs once per keyframe over every beam).
     const float* range = w.range.data();
     const std::uint8_t* wv = w.valid.data();
@@ -237,7 +243,7 @@ EvidenceFilter::Projection EvidenceFilter::rawProjection(const Scan& scan, const
     double spread = 0.0;
     if (trackedStep(scan, ref, d)) {  // the tracker aligned both: its residual is the spread
         if (!projection(ref, d, sigma).usable) return pr;
-        spread = std::max(tracked_->rms_m, ref.track_rms);
+        spread = std::max(tracked_->rms_m, ref.track.rms_m);
     } else {
         if (scan.odometry && ref.has_odom)
             d = between(ref.odom, compose(*scan.odometry, scan.sensor_pose));
@@ -310,6 +316,30 @@ double EvidenceFilter::estimateSigma(const Scan& scan) {
 }
 
 void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
+    const Breakpoints bp = breakpoints(sigma);
+    linkNeighbours(scan, sigma, bp);
+    std::size_t first_valid = 0, last = 0;
+    labelSegments(scan, bp, out, first_valid, last);
+    joinAcrossSeam(scan, bp, first_valid, last, out);
+    out.mean_range.resize(out.size.size());
+    for (std::size_t c = 0; c < out.size.size(); ++c)
+        out.mean_range[c] = sums_[c] / static_cast<float>(out.size[c]);
+    out.noise.assign(out.size.size(), 0);
+}
+
+EvidenceFilter::Breakpoints EvidenceFilter::breakpoints(double sigma) const {
+    // Breakpoint distance / r_min per beam step, for steps 1..max_gap + 1 (dtheta < lambda).
+    Breakpoints bp;
+    bp.max_step = params_.max_gap_beams + 1;
+    for (std::size_t k = 1; k <= bp.max_step; ++k) {
+        const double dt = std::min(static_cast<double>(k) * res_, 0.5 * lambda_);
+        bp.factor[k] = static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt));
+    }
+    bp.noise = static_cast<float>(pairMargin(sigma));
+    return bp;
+}
+
+void EvidenceFilter::linkNeighbours(const Scan& scan, double sigma, const Breakpoints& bp) {
     const std::size_t n = scan.range.size();
     const float cos_res = std::cos(res_);
     // On a line with both neighbours: |e| <= 3 sqrt(1.5) sigma, written without the division
@@ -334,16 +364,9 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
             static_cast<std::uint8_t>((valid[i - 1] != 0) & (valid[i] != 0) & (valid[i + 1] != 0) &
                                       (std::abs(r * sum - 2.0f * cos_res * a * b) <= tol * sum));
     }
-    // Breakpoint distance / r_min per beam step, for steps 1..max_gap + 1 (dtheta < lambda).
-    const std::size_t max_step = params_.max_gap_beams + 1;
-    float factor[18];
-    for (std::size_t k = 1; k <= max_step; ++k) {
-        const double dt = std::min(static_cast<double>(k) * res_, 0.5 * lambda_);
-        factor[k] = static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt));
-    }
-    const float noise = static_cast<float>(pairMargin(sigma));
     // Neighbouring returns: one surface within the breakpoint distance or on a line together.
-    const float factor1 = factor[1];
+    const float factor1 = bp.factor[1];
+    const float noise = bp.noise;
     if (n > 0) link[n - 1] = 0;
 #pragma omp simd
     for (std::size_t i = 0; i < pairs; ++i) {
@@ -353,7 +376,17 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
             (valid[i] != 0) & (valid[i + 1] != 0) &
             ((dx * dx + dy * dy <= dmax * dmax) | (line[i] & line[i + 1])));
     }
+}
+
+void EvidenceFilter::labelSegments(const Scan& scan, const Breakpoints& bp, Clusters& out,
+                                   std::size_t& first_valid, std::size_t& last) {
     // Segments (at most n): returns across up to max_gap_beams missing beams are tested here.
+    const std::size_t n = scan.range.size();
+    const std::uint8_t* valid = scan.valid.data();
+    const float* range = scan.range.data();
+    const float* x = x_.data();
+    const float* y = y_.data();
+    std::uint8_t* link = link_.data();
     out.label.resize(n);  // every beam written below (-1: no return)
     out.size.resize(n);
     sums_.resize(n);
@@ -361,9 +394,9 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
     std::uint32_t* size = out.size.data();
     float* sums = sums_.data();
     std::size_t count = 0;
-    std::size_t first_valid = 0;
+    first_valid = 0;
     while (first_valid < n && !valid[first_valid]) label[first_valid++] = -1;
-    std::size_t last = n;  // the previous valid beam
+    last = n;  // the previous valid beam
     // The open segment's size and range sum stay in registers until the next one starts.
     std::uint32_t cur_size = 0;
     float cur_sum = 0.0f;
@@ -375,9 +408,9 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
         bool linked = false;
         if (i == last + 1) {
             linked = link[last] != 0;
-        } else if (last < n && i - last <= max_step) {
+        } else if (last < n && i - last <= bp.max_step) {
             const float dx = x[i] - x[last], dy = y[i] - y[last];
-            const float dmax = std::min(range[last], range[i]) * factor[i - last] + noise;
+            const float dmax = std::min(range[last], range[i]) * bp.factor[i - last] + bp.noise;
             linked = dx * dx + dy * dy <= dmax * dmax;
             link[last] = static_cast<std::uint8_t>(linked);
         }
@@ -401,32 +434,30 @@ void EvidenceFilter::segment(const Scan& scan, double sigma, Clusters& out) {
     }
     out.size.resize(count);
     sums_.resize(count);
+}
+
+void EvidenceFilter::joinAcrossSeam(const Scan& scan, const Breakpoints& bp,
+                                    std::size_t first_valid, std::size_t last, Clusters& out) {
     // A scanner closing the circle: the last segment continues the first across the seam.
-    const ScanGeometry& g = scan.geometry;
-    if (out.size.size() > 1 && last < n && first_valid < last) {
-        const double gap = static_cast<double>(n - 1 - last + first_valid) * res_ + g.seamGap();
-        if (gap <= static_cast<double>(max_step) * res_ + 1e-9) {
-            const float dx = x_[first_valid] - x_[last], dy = y_[first_valid] - y_[last];
-            const double dt = std::min(gap, 0.5 * lambda_);
-            const float dmax = std::min(scan.range[last], scan.range[first_valid]) *
-                                   static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt)) +
-                               noise;
-            if (dx * dx + dy * dy <= dmax * dmax) {
-                const std::size_t tail = out.size.size() - 1;
-                for (std::size_t i = 0; i < n; ++i)
-                    if (out.label[i] == static_cast<std::int32_t>(tail)) out.label[i] = 0;
-                out.size[0] += out.size[tail];
-                sums_[0] += sums_[tail];
-                out.size.pop_back();
-                sums_.pop_back();
-                link_[last] = 1;
-            }
-        }
-    }
-    out.mean_range.resize(out.size.size());
-    for (std::size_t c = 0; c < out.size.size(); ++c)
-        out.mean_range[c] = sums_[c] / static_cast<float>(out.size[c]);
-    out.noise.assign(out.size.size(), 0);
+    const std::size_t n = scan.range.size();
+    if (out.size.size() <= 1 || last >= n || first_valid >= last) return;
+    const double gap =
+        static_cast<double>(n - 1 - last + first_valid) * res_ + scan.geometry.seamGap();
+    if (gap > static_cast<double>(bp.max_step) * res_ + 1e-9) return;
+    const float dx = x_[first_valid] - x_[last], dy = y_[first_valid] - y_[last];
+    const double dt = std::min(gap, 0.5 * lambda_);
+    const float dmax = std::min(scan.range[last], scan.range[first_valid]) *
+                           static_cast<float>(std::sin(dt) / std::sin(lambda_ - dt)) +
+                       bp.noise;
+    if (dx * dx + dy * dy > dmax * dmax) return;
+    const std::size_t tail = out.size.size() - 1;
+    for (std::size_t i = 0; i < n; ++i)
+        if (out.label[i] == static_cast<std::int32_t>(tail)) out.label[i] = 0;
+    out.size[0] += out.size[tail];
+    sums_[0] += sums_[tail];
+    out.size.pop_back();
+    sums_.pop_back();
+    link_[last] = 1;
 }
 
 EvidenceFilter::Projection EvidenceFilter::projection(const Reference& ref, const Pose2D& d,
@@ -582,7 +613,6 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
 
 bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, double sigma,
                                       Result& res, bool recent) {
-    const std::size_t n = scan.range.size();
     have_pose_ = false;
     if (!params_.temporal) return false;
     // 3b. The raw scan just before (tight margins from its own alignment), when kept.
@@ -592,65 +622,83 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
     // 3c. The raw scan just after (next_scan), the same way.
     Projection pn;
     if (recent && next_) pn = nextProjection(scan, sigma, res);
+    const Projection p0 = keyframeProjection(scan, sigma, res);
+    if (!pt.usable && !pn.usable && !p0.usable) return false;
+    recent_ev_.assign(pt.usable || pn.usable ? scan.range.size() : 0, kUnknown);
+    const std::size_t listed = listReturnsToJudge(out);
+    const std::size_t unknowns = judgeListed(out, listed, pt, pn, p0, res);
+    supportFromOlder(scan, out, sigma, unknowns, recent, res);
+    return true;
+}
+
+EvidenceFilter::Projection EvidenceFilter::keyframeProjection(const Scan& scan, double sigma,
+                                                              Result& res) {
     // This scan's sensor in the newest keyframe's frame: the tracker's step where it placed
     // both, else the odometry step (no motion without odometry), refined.
     Projection p0;
     const Reference& r0 = refs_[0];
-    if (r0.present && r0.geometry == scan.geometry) {
-        Pose2D d;
-        bool common = true;
-        const bool tracked = trackedStep(scan, r0, d);  // else from odometry, then refined
-        if (!tracked && scan.odometry && r0.has_odom)
-            d = between(r0.odom, compose(*scan.odometry, scan.sensor_pose));
-        else if (!tracked && (scan.odometry || r0.has_odom))
-            common = false;  // odometry appeared or vanished: no common frame
-        if (common && projection(r0, d, sigma).usable) {
-            if (!tracked) res.refined = refineStep(scan, r0, d);
-            p0 = projection(r0, d, sigma);
-            pose_ = compose(r0.pose, d);
-            have_pose_ = true;
-        }
-    }
-    if (!pt.usable && !pn.usable && !p0.usable) return false;
-    recent_ev_.assign(pt.usable || pn.usable ? n : 0, kUnknown);
+    if (!r0.present || r0.geometry != scan.geometry) return p0;
+    Pose2D d;
+    const bool tracked = trackedStep(scan, r0, d);  // else from odometry, then refined
+    if (!tracked && scan.odometry && r0.has_odom)
+        d = between(r0.odom, compose(*scan.odometry, scan.sensor_pose));
+    else if (!tracked && (scan.odometry || r0.has_odom))
+        return p0;  // odometry appeared or vanished: no common frame
+    if (!projection(r0, d, sigma).usable) return p0;
+    if (!tracked) res.refined = refineStep(scan, r0, d);
+    p0 = projection(r0, d, sigma);
+    pose_ = compose(r0.pose, d);
+    have_pose_ = true;
+    return p0;
+}
+
+std::size_t EvidenceFilter::listReturnsToJudge(const Clusters& out) {
     // Every return off a line, every return of a short segment, and every fourth return along
     // a line (enough to tell how much of a surface lies in free space).
-    free_in_.assign(out.count(), 0);
-    supported_in_.assign(out.count(), 0);
-    classified_in_.assign(out.count(), 0);
-    if (unknown_.size() < n) unknown_.resize(n);  // kept at its largest: no refill per scan
+    const std::size_t n = out.label.size();
+    if (unknown_.size() < n) unknown_.resize(n);      // kept at its largest: no refill per scan
+    if (batch_.size() < 5 * n) batch_.resize(5 * n);  // kept at its largest
     const std::int32_t* labels = out.label.data();
     const std::uint32_t* sizes = out.size.data();
     const std::uint8_t* line = line_.data();
-    const float* x = x_.data();
-    const float* y = y_.data();
-    std::uint8_t* evidence = evidence_.data();
-    std::uint32_t* free_in = free_in_.data();
-    std::uint32_t* supported_in = supported_in_.data();
-    std::uint32_t* classified_in = classified_in_.data();
     std::uint32_t* unknown = unknown_.data();
-    std::size_t unknowns = 0;
-    // The returns to classify with their points, then (one omp simd pass) their projections
-    // and bracket positions in the first reference asked.
-    if (batch_.size() < 5 * n) batch_.resize(5 * n);  // kept at its largest
     float* bx = batch_.data();
     float* by = bx + n;
-    float* bqx = by + n;
-    float* bqy = bqx + n;
-    float* bu = bqy + n;
     std::size_t listed = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const std::int32_t label = labels[i];
         if (label < 0) continue;
         if (line[i] && (i & 3u) != 0 && sizes[static_cast<std::size_t>(label)] >= 8) continue;
         unknown[listed] = static_cast<std::uint32_t>(i);
-        bx[listed] = x[i];
-        by[listed] = y[i];
+        bx[listed] = x_[i];
+        by[listed] = y_[i];
         ++listed;
     }
+    return listed;
+}
+
+std::size_t EvidenceFilter::judgeListed(const Clusters& out, std::size_t listed,
+                                        const Projection& pt, const Projection& pn,
+                                        const Projection& p0, Result& res) {
+    free_in_.assign(out.count(), 0);
+    supported_in_.assign(out.count(), 0);
+    classified_in_.assign(out.count(), 0);
+    const std::size_t n = out.label.size();
+    const std::int32_t* labels = out.label.data();
+    const float* x = x_.data();
+    const float* y = y_.data();
+    std::uint32_t* unknown = unknown_.data();
+    // The listed returns' projections and bracket positions in the first reference asked
+    // (one omp simd pass).
+    float* bx = batch_.data();
+    float* by = bx + n;
+    float* bqx = by + n;
+    float* bqy = bqx + n;
+    float* bu = bqy + n;
     const Projection& first_pr = pt.usable ? pt : pn.usable ? pn : p0;
     projectPoints(listed, bx, by, first_pr.c, first_pr.s, first_pr.tx, first_pr.ty, first_,
                   inv_step_, bqx, bqy, bu);
+    std::size_t unknowns = 0;  // written over the list, behind the reading position
     for (std::size_t j = 0; j < listed; ++j) {
         const std::size_t i = unknown[j];
         const auto c = static_cast<std::size_t>(labels[i]);
@@ -667,13 +715,13 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
             if (e == kFree && p0.usable && classify(p0, x[i], y[i], true) == kTracked) e = kTracked;
             if (e == kUnknown && p0.usable) e = classify(p0, x[i], y[i], true);
         }
-        evidence[i] = e;
-        ++classified_in[c];
+        evidence_[i] = e;
+        ++classified_in_[c];
         if (e == kFree) {
-            ++free_in[c];
+            ++free_in_[c];
             ++res.free_points;
         } else if (e == kSupported) {
-            ++supported_in[c];
+            ++supported_in_[c];
             ++res.supported;
         } else if (e == kTracked) {
             ++res.tracked;
@@ -681,12 +729,17 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
             unknown[unknowns++] = static_cast<std::uint32_t>(i);
         }
     }
+    return unknowns;
+}
+
+void EvidenceFilter::supportFromOlder(const Scan& scan, const Clusters& out, double sigma,
+                                      std::size_t unknowns, bool recent, Result& res) {
     // The keyframe before it (and the older raw scans) can support what the newest could not
     // (a thin object between two beams, a return among dropouts); they never overrule free
     // space.
     auto support = [&](const Projection& p) {
         for (std::size_t j = 0; j < unknowns; ++j) {
-            const std::uint32_t i = unknown[j];
+            const std::uint32_t i = unknown_[j];
             if (evidence_[i] == kUnknown && classify(p, x_[i], y_[i], false) == kSupported) {
                 evidence_[i] = kSupported;
                 ++supported_in_[static_cast<std::size_t>(out.label[i])];
@@ -703,7 +756,6 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
         const Projection pa = recentProjection(scan, age, sigma, res);
         if (pa.usable) support(pa);
     }
-    return true;
 }
 
 void EvidenceFilter::keepAsReference(const Scan& scan) {
@@ -727,14 +779,12 @@ void EvidenceFilter::keepAsReference(const Scan& scan) {
     // a new chain, and the older keyframe is no longer in it.
     r.pose = have_pose_ ? pose_ : r.odom;
     if (!have_pose_) refs_[1].present = false;
-    r.has_track = tracked_ != nullptr;
-    r.track = r.has_track ? compose(tracked_->pose, scan.sensor_pose) : Pose2D{};
-    r.track_rms = r.has_track ? tracked_->rms_m : 0.0;
+    r.track = SensorTrack::of(scan, tracked_);
 }
 
 bool EvidenceFilter::trackedStep(const Scan& scan, const Reference& ref, Pose2D& d) const {
-    if (!params_.track_alignment || tracked_ == nullptr || !ref.has_track) return false;
-    d = between(ref.track, compose(tracked_->pose, scan.sensor_pose));
+    if (!params_.track_alignment || tracked_ == nullptr || !ref.track.present) return false;
+    d = between(ref.track.pose, compose(tracked_->pose, scan.sensor_pose));
     return true;
 }
 

@@ -50,15 +50,32 @@ std::size_t ViewSelector::stride(std::size_t beams) const {
 }
 
 ViewMeasure ViewSelector::measure(const Scan& scan, const std::optional<Pose2D>& motion) {
-    const Params& p = params_;
-    const std::size_t beams = scan.range.size();
-    const std::size_t k = stride(beams);
-    const std::size_t n = (beams + k - 1) / k;
+    const std::size_t k = stride(scan.range.size());
+    const std::size_t n = (scan.range.size() + k - 1) / k;
     dirs_.update(scan.geometry);
-
     const bool odometry = (motion || (scan.odometry && kf_odometry_)) && have_keyframe_;
     const bool compare =
         !odometry && have_keyframe_ && kf_geometry_ == scan.geometry && kf_samples_.size() == n;
+    const Samples s = sample(scan, k, compare);
+
+    ViewMeasure m;
+    m.degeneracy = degeneracyOf(s);
+    m.corridor = params_.degeneracy_ratio > 0.0 && m.degeneracy < params_.degeneracy_ratio;
+    if (!have_keyframe_) return m;  // keyframe = true
+    w_sum_ = s.w_sum;
+    wx_ = s.wx;
+    wy_ = s.wy;
+    wq_ = s.wq;
+    points_ = s.points;
+    if (odometry)
+        decideByOdometry(scan, motion, m);
+    else
+        decideByChange(scan, compare, s, m);
+    return m;
+}
+
+ViewSelector::Samples ViewSelector::sample(const Scan& scan, std::size_t k, bool compare) const {
+    const Params& p = params_;
     const float a = static_cast<float>(p.tolerance_m), b = static_cast<float>(tan_b_);
     const float ct = static_cast<float>(p.change_tolerance_m);
     const float cr = static_cast<float>(p.change_tolerance_ratio);
@@ -66,13 +83,10 @@ ViewMeasure ViewSelector::measure(const Scan& scan, const std::optional<Pose2D>&
     // times the sample spacing at that range (incidence up to ~75 deg)
     const float spacing =
         static_cast<float>(4.0 * scan.geometry.resolution() * static_cast<double>(k));
-
-    // float sums: at most max_samples terms each
-    float w_sum = 0, wx = 0, wy = 0, wq = 0;  // moments (sensor frame)
-    float sxx = 0, sxy = 0;                   // scatter of the unit tangents (syy = count - sxx)
-    std::size_t points = 0, tangents = 0, both = 0, changed = 0;
+    Samples s;
     float px = 0, py = 0;
     bool prev = false;
+    const std::size_t beams = scan.range.size();
     const float* range = scan.range.data();
     const std::uint8_t* valid = scan.valid.data();
     const float* cosine = dirs_.cos.data();
@@ -87,19 +101,19 @@ ViewMeasure ViewSelector::measure(const Scan& scan, const std::optional<Pose2D>&
         const float x = r * cosine[i], y = r * sine[i];
         const float t = a + b * r;
         const float w = 1.0f / (t * t);
-        ++points;
-        w_sum += w;
-        wx += w * x;
-        wy += w * y;
-        wq += w * r * r;
+        ++s.points;
+        s.w_sum += w;
+        s.wx += w * x;
+        s.wy += w * y;
+        s.wq += w * r * r;
         if (prev) {
             const float dx = x - px, dy = y - py, d2 = dx * dx + dy * dy;
             const float gate = 0.3f + spacing * r;
             if (d2 > 0.0f && d2 <= gate * gate) {
                 const float inv = 1.0f / d2;
-                sxx += dx * dx * inv;
-                sxy += dx * dy * inv;
-                ++tangents;
+                s.sxx += dx * dx * inv;
+                s.sxy += dx * dy * inv;
+                ++s.tangents;
             }
         }
         px = x;
@@ -108,49 +122,46 @@ ViewMeasure ViewSelector::measure(const Scan& scan, const std::optional<Pose2D>&
         if (compare) {
             const float kr = kf[j];
             if (kr == kr) {  // not NaN
-                ++both;
-                changed += std::abs(r - kr) > ct + cr * r;
+                ++s.both;
+                s.changed += std::abs(r - kr) > ct + cr * r;
             }
         }
     }
+    return s;
+}
 
-    ViewMeasure m;
+double ViewSelector::degeneracyOf(const Samples& s) {
     // Corridor switch: eigenvalues of N = tangents * I - S (S the tangent scatter).
-    if (tangents >= 8) {
-        const double half = 0.5 * static_cast<double>(tangents);
-        const double dxy = static_cast<double>(sxx) - half;  // (sxx - syy) / 2
-        const double h = std::sqrt(dxy * dxy + static_cast<double>(sxy) * sxy);
-        m.degeneracy = std::max(0.0, half - h) / (half + h);
-    }
-    m.corridor = p.degeneracy_ratio > 0.0 && m.degeneracy < p.degeneracy_ratio;
-    if (!have_keyframe_) return m;  // keyframe = true
+    if (s.tangents < 8) return 1.0;
+    const double half = 0.5 * static_cast<double>(s.tangents);
+    const double dxy = static_cast<double>(s.sxx) - half;  // (sxx - syy) / 2
+    const double h = std::sqrt(dxy * dxy + static_cast<double>(s.sxy) * s.sxy);
+    return std::max(0.0, half - h) / (half + h);
+}
 
-    w_sum_ = w_sum;
-    wx_ = wx;
-    wy_ = wy;
-    wq_ = wq;
-    points_ = points;
-    if (odometry) {
-        m.used_odometry = true;
-        const Pose2D rel = motion ? *motion : *odometrySinceKeyframe(scan);
-        m.view_change = viewChange(rel, scan.sensor_pose);
-        if (m.corridor) {
-            const Travel t = travel(Pose2D{}, rel);
-            m.keyframe =
-                t.metres >= p.corridor_translation_m || t.degrees >= p.corridor_rotation_deg;
-        } else
-            m.keyframe = m.view_change >= p.max_view_change;
-        return m;
-    }
+void ViewSelector::decideByOdometry(const Scan& scan, const std::optional<Pose2D>& motion,
+                                    ViewMeasure& m) const {
+    const Params& p = params_;
+    m.used_odometry = true;
+    const Pose2D rel = motion ? *motion : *odometrySinceKeyframe(scan);
+    m.view_change = viewChange(rel, scan.sensor_pose);
+    if (m.corridor) {
+        const Travel t = travel(Pose2D{}, rel);
+        m.keyframe = t.metres >= p.corridor_translation_m || t.degrees >= p.corridor_rotation_deg;
+    } else
+        m.keyframe = m.view_change >= p.max_view_change;
+}
 
+void ViewSelector::decideByChange(const Scan& scan, bool compare, const Samples& s,
+                                  ViewMeasure& m) const {
     // Laser only: the per-beam change test (no common returns: the view is new).
-    m.changed_fraction =
-        (compare && both >= 3) ? static_cast<double>(changed) / static_cast<double>(both) : 1.0;
+    m.changed_fraction = (compare && s.both >= 3)
+                             ? static_cast<double>(s.changed) / static_cast<double>(s.both)
+                             : 1.0;
     if (m.corridor && kf_have_stamp_ && std::isfinite(scan.timestamp))
-        m.keyframe = scan.timestamp - kf_stamp_ >= p.corridor_interval_s;
+        m.keyframe = scan.timestamp - kf_stamp_ >= params_.corridor_interval_s;
     else
-        m.keyframe = m.changed_fraction >= p.max_changed_fraction;
-    return m;
+        m.keyframe = m.changed_fraction >= params_.max_changed_fraction;
 }
 
 double ViewSelector::viewChange(const Pose2D& rel, const Pose2D& s) const {

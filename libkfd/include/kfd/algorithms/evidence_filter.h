@@ -226,6 +226,13 @@ class EvidenceFilter {
 
   private:
     enum Evidence : std::uint8_t { kUnknown = 0, kSupported = 1, kFree = 2, kTracked = 3 };
+    // Where the tracker placed a kept scan's sensor (present = false: not tracked).
+    struct SensorTrack {
+        bool present = false;
+        Pose2D pose;  // the sensor's tracked pose
+        double rms_m = 0.0;
+        static SensorTrack of(const Scan& scan, const Tracked* tracked);
+    };
     // One of the last two keyframes: returns before removal, links, evidence, points, its
     // odometry pose and the pose refined by the chain of alignments (sensor frames).
     struct Reference {
@@ -235,9 +242,7 @@ class EvidenceFilter {
         std::vector<std::uint8_t> valid, link, evidence;
         bool has_odom = false;
         Pose2D odom, pose;
-        bool has_track = false;  // the tracker placed it: its sensor's tracked pose
-        Pose2D track;
-        double track_rms = 0.0;
+        SensorTrack track;
     };
     // A raw scan kept for step 3b: copies, converted only when a keyframe comes.
     struct RawScan {
@@ -246,9 +251,7 @@ class EvidenceFilter {
         std::vector<std::uint8_t> valid;
         bool has_odom = false;
         Pose2D odom;
-        bool has_track = false;
-        Pose2D track;
-        double track_rms = 0.0;
+        SensorTrack track;
         // Ranges, flags, odometry and tracked pose (buffers reused).
         void copy(const Scan& scan, const Tracked* tracked);
     };
@@ -261,10 +264,38 @@ class EvidenceFilter {
 
     void updateTables(const ScanGeometry& g);
     double estimateSigma(const Scan& scan);
+    // Step 2's breakpoint distance over r_min per beam step 1..max_step, and its noise term.
+    struct Breakpoints {
+        float factor[18] = {};
+        float noise = 0.0f;
+        std::size_t max_step = 1;
+    };
+    Breakpoints breakpoints(double sigma) const;
+    // Step 2: segments of linked returns (linkNeighbours, labelSegments, joinAcrossSeam).
     void segment(const Scan& scan, double sigma, Clusters& out);
+    // line_ (on a line with both neighbours) and link_ (one surface with the next beam).
+    void linkNeighbours(const Scan& scan, double sigma, const Breakpoints& bp);
+    // Labels segments across up to max_gap_beams missing beams; first and last valid beams
+    // out (last = n without one).
+    void labelSegments(const Scan& scan, const Breakpoints& bp, Clusters& out,
+                       std::size_t& first_valid, std::size_t& last);
+    // A scanner closing the circle: the last segment joins the first across the seam.
+    void joinAcrossSeam(const Scan& scan, const Breakpoints& bp, std::size_t first_valid,
+                        std::size_t last, Clusters& out);
     // `recent`: use the raw scans of step 3b (false: the keyframes only).
     bool temporalEvidence(const Scan& scan, const Clusters& out, double sigma, Result& res,
                           bool recent);
+    // Step 3a: the newest keyframe seen from this scan (sets pose_; usable = false without it).
+    Projection keyframeProjection(const Scan& scan, double sigma, Result& res);
+    // The returns step 3 judges, in unknown_ with their points in batch_; returns how many.
+    std::size_t listReturnsToJudge(const Clusters& out);
+    // Evidence for the listed returns from the raw neighbours (pt, pn) and the keyframe (p0);
+    // the ones left unknown are listed again in unknown_; returns how many.
+    std::size_t judgeListed(const Clusters& out, std::size_t listed, const Projection& pt,
+                            const Projection& pn, const Projection& p0, Result& res);
+    // Support (never free space) from the older keyframe and the older raw scans.
+    void supportFromOlder(const Scan& scan, const Clusters& out, double sigma, std::size_t unknowns,
+                          bool recent, Result& res);
     Projection projection(const Reference& ref, const Pose2D& d, double sigma) const;
     std::uint8_t classify(const Projection& pr, float x, float y, bool free_test) const;
     // The same for the point (qx, qy) already in the reference's frame, at bracket position u.

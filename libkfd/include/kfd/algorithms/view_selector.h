@@ -90,6 +90,17 @@ class ViewSelector {
   private:
     /// k: every k-th beam is sampled, k = ceil(beams / max_samples) (at least 1).
     std::size_t stride(std::size_t beams) const;
+    // Every k-th return: weighted moments, tangent scatter, and (compare) the changed ranges.
+    struct Samples {
+        float w_sum = 0, wx = 0, wy = 0, wq = 0;  // moments (sensor frame; float: <= max_samples)
+        float sxx = 0, sxy = 0;  // scatter of the unit tangents (syy = tangents - sxx)
+        std::size_t points = 0, tangents = 0, both = 0, changed = 0;
+    };
+    Samples sample(const Scan& scan, std::size_t k, bool compare) const;
+    static double degeneracyOf(const Samples& s);  // lambda_min / lambda_max (1: too few)
+    void decideByOdometry(const Scan& scan, const std::optional<Pose2D>& motion,
+                          ViewMeasure& m) const;
+    void decideByChange(const Scan& scan, bool compare, const Samples& s, ViewMeasure& m) const;
 
     Params params_;
     double tan_b_ = 0.0;
