@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # kfd's denoiser against laser_filters-equivalent baselines (issue 39): kfd's default, kfd
-# before issue 39 (steps 6-7 off), kfd with the tracker's poses (tracked), kfd with step 6
+# before issue 39 (steps 4b, 6-7 off), kfd with the tracker's poses (tracked), kfd with step 6
 # (veil), the paper's Algorithm 2, the `speckle` stage (LaserScanSpeckleFilter, distance: 80 m / 0.1 or 0.3 m / window 2), the
 # `shadow` stage (10-170 deg, window 1, start point removed) and their chain, each after kfd's
 # keyframes, so all are scored on the same kept scans. Injected labelled noise (kfd-inject,
@@ -41,7 +41,7 @@ speckle_section() {
     "$1" "$2" "${3:-false}"
 }
 cp "$def" default.ini
-{ cat "$def"; printf 'veil = false\nkeep_surfaces = false\n'; } > before.ini
+{ cat "$def"; printf 'veil = false\nkeep_surfaces = false\nspikes = false\n'; } > before.ini
 { cat "$def"; printf 'track_alignment = true\n'; } > tracked.ini
 { cat "$def"; printf 'veil = true\n'; } > veil.ini
 { after denoise; } > reference.ini

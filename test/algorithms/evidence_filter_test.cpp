@@ -48,6 +48,69 @@ TEST(EvidenceFilter, ASpikeInFrontOfAWallThePreviousKeyframeSawThroughIsRemoved)
     EXPECT_EQ(r.points_removed, 1u);  // nothing else
 }
 
+EvidenceFilter::Params withSpikes(bool on) {
+    EvidenceFilter::Params p = exact();
+    p.spikes = on;
+    return p;
+}
+
+TEST(EvidenceFilter, ASpikeCloseToItsWallIsRemovedByStep4bAlone) {
+    // 0.15 m in front of the wall at 4 m: within the breakpoint distance, so one segment with
+    // the wall, and no keyframe before it to see through it; only step 4b removes it.
+    for (const bool on : {false, true}) {
+        EvidenceFilter f(withSpikes(on));
+        Clusters c;
+        Scan s = room();
+        test::insertSpike(s, 180, 3.85);
+        const auto r = f.filter(s, c);
+        EXPECT_EQ(s.valid[180], on ? 0 : 1);
+        EXPECT_EQ(r.spikes, on ? 1u : 0u);
+        EXPECT_EQ(r.points_removed, on ? 1u : 0u);
+    }
+}
+
+TEST(EvidenceFilter, ASpikeThePreviousKeyframeSawIsAThinObjectAndStays) {
+    // A pole 0.15 m in front of the wall, seen from both keyframes: supported, kept.
+    EvidenceFilter f(withSpikes(true));
+    Clusters c;
+    Scan first = room();
+    test::insertSpike(first, 180, 3.85);
+    f.filter(first, c);
+    Scan second = room();
+    test::insertSpike(second, 180, 3.85);
+    const auto r = f.filter(second, c);
+    EXPECT_TRUE(r.temporal);
+    EXPECT_EQ(second.valid[180], 1);
+    EXPECT_EQ(r.spikes, 0u);
+}
+
+TEST(EvidenceFilter, AlternatingRangesAreClutterNotSpikes) {
+    // A railing: 100 beams alternating between 4 m and 3.85 m, every one of them off both
+    // neighbours; more than the bound (5 % of 361), so step 4b removes none of them.
+    EvidenceFilter f(withSpikes(true));
+    Clusters c;
+    Scan s = room();
+    for (std::size_t i = 130; i < 230; i += 2) test::insertSpike(s, i, 3.85);
+    const auto r = f.filter(s, c);
+    EXPECT_EQ(r.spikes, 0u);
+    EvidenceFilter off(withSpikes(false));
+    Scan t = room();
+    for (std::size_t i = 130; i < 230; i += 2) test::insertSpike(t, i, 3.85);
+    EXPECT_EQ(r.points_removed, off.filter(t, c).points_removed);
+}
+
+TEST(EvidenceFilter, ReturnsBetweenTheirNeighboursAreNoSpikes) {
+    // A wall at grazing incidence: each range between its neighbours' (a ramp of 2 cm per
+    // beam), nothing for step 4b.
+    EvidenceFilter f(withSpikes(true));
+    Clusters c;
+    Scan s = room();
+    for (std::size_t i = 150; i < 210; ++i)
+        test::setRange(s, i, i, 2.0f + 0.02f * static_cast<float>(i - 150));
+    const auto r = f.filter(s, c);
+    EXPECT_EQ(r.spikes, 0u);
+}
+
 // Step 7 off: the tests of the burst logic below use flat bursts (constant range), which step 7
 // would keep as surfaces.
 EvidenceFilter::Params noSurfaces(EvidenceFilter::Params p) {

@@ -68,6 +68,13 @@ kfd::Pipeline::Params temporalParams() {
     return p;
 }
 
+// The same placed by the track stage's poses (track_alignment, off by default: issue 39).
+kfd::Pipeline::Params trackedParams() {
+    kfd::Pipeline::Params p = temporalParams();
+    p.get<kfd::EvidenceDenoiseStage>().track_alignment = true;
+    return p;
+}
+
 // The same with the scan just after each keyframe too (next_scan, issue 25).
 kfd::Pipeline::Params nextScanParams() {
     kfd::Pipeline::Params p = temporalParams();
@@ -98,7 +105,7 @@ struct Context {
         temporalParams().get<kfd::EvidenceDenoiseStage>()};
     // The same behind a track stage that placed every scan (issue 39: no alignment of its own).
     kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_tracked{
-        temporalParams().get<kfd::EvidenceDenoiseStage>()};
+        trackedParams().get<kfd::EvidenceDenoiseStage>()};
     kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_next{
         nextScanParams().get<kfd::EvidenceDenoiseStage>()};
     kfd::DbscanFilter dbscan{kfd::DbscanFilter::Params{0.7, 10}};

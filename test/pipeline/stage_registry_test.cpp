@@ -62,12 +62,26 @@ TEST(StageRegistry, EachStageOwnsItsKeys) {
               (std::vector<std::string>{"angle_gap_factor", "m_threshold", "jump_lambda_deg",
                                         "jump_sigma_m", "min_object_size_m", "min_points_floor"}));
     EXPECT_EQ(keyNames(*r.find("evidence_denoise")),
-              (std::vector<std::string>{
-                  "min_object_size_m", "incidence_deg", "sigma_m", "max_gap_beams",
-                  "max_small_points", "temporal", "pose_trans_error_m", "pose_rot_error_deg",
-                  "motion_error_fraction", "max_removed_fraction", "max_confirmed_fraction",
-                  "confirm_support", "temporal_scans", "next_scan", "veil", "track_alignment",
-                  "keep_surfaces", "surface_min_beams", "surface_sigmas"}));
+              (std::vector<std::string>{"min_object_size_m",
+                                        "incidence_deg",
+                                        "sigma_m",
+                                        "max_gap_beams",
+                                        "max_small_points",
+                                        "temporal",
+                                        "pose_trans_error_m",
+                                        "pose_rot_error_deg",
+                                        "motion_error_fraction",
+                                        "max_removed_fraction",
+                                        "max_confirmed_fraction",
+                                        "confirm_support",
+                                        "temporal_scans",
+                                        "next_scan",
+                                        "veil",
+                                        "track_alignment",
+                                        "spikes",
+                                        "keep_surfaces",
+                                        "surface_min_beams",
+                                        "surface_sigmas"}));
     EXPECT_EQ(keyNames(*r.find("odometry_check")),
               (std::vector<std::string>{"frozen_changed_fraction", "jump_margin"}));
 }

@@ -897,7 +897,8 @@ void EvidenceFilter::removeMarked(Scan& scan, const Clusters& out,
         remove_[i] = out.noise[static_cast<std::size_t>(out.label[i])] ||
                      (temporal && kept_ev[i] == kFree && !line_[i]);
     }
-    // 6. Mixed pixels; 7. surfaces kept.
+    // 4b. Spikes; 6. mixed pixels; 7. surfaces kept.
+    if (params_.spikes) res.spikes = markSpikes(scan, kept_ev, temporal, sigma, cap);
     if (params_.veil) res.veils = markVeils(scan, out, sigma, cap);
     if (params_.keep_surfaces) {
         SurfaceRunParams sp;
@@ -911,6 +912,48 @@ void EvidenceFilter::removeMarked(Scan& scan, const Clusters& out,
             scan.valid[i] = 0;
             ++res.points_removed;
         }
+}
+
+std::size_t EvidenceFilter::markSpikes(const Scan& scan, const std::vector<std::uint8_t>& kept_ev,
+                                       bool temporal, double sigma, std::size_t cap) {
+    // A return nearer or farther than both neighbours by more than the pair margin, where the
+    // neighbours are one surface across it (step 2's breakpoint test over two beams): a beam
+    // off the surface its neighbours agree on, off a line, that no reference supports.
+    const std::size_t n = scan.range.size();
+    const Breakpoints bp = breakpoints(sigma);
+    const float m = bp.noise;
+    const float factor2 = bp.factor[std::min<std::size_t>(2, bp.max_step)];
+    const float cos2 = std::cos(2.0f * res_);
+    const float* r = scan.range.data();
+    const std::uint8_t* v = scan.valid.data();
+    spikes_.clear();
+    if (n < 3) return 0;
+    // Candidates, branch-free: off both neighbours' ranges (most beams lie between them).
+    off_.resize(n);
+    std::uint8_t* off = off_.data();
+    off[0] = off[n - 1] = 0;
+#pragma omp simd
+    for (std::size_t i = 1; i < n - 1; ++i) {
+        const float lo = std::min(r[i - 1], r[i + 1]), hi = std::max(r[i - 1], r[i + 1]);
+        off[i] = static_cast<std::uint8_t>((r[i] < lo - m) | (r[i] > hi + m));
+    }
+    for (std::size_t i = 1; i + 1 < n; ++i) {
+        if (!off[i]) continue;
+        const float a = r[i - 1], b = r[i + 1];
+        const float lo = std::min(a, b);
+        if (!v[i - 1] || !v[i] || !v[i + 1] || line_[i] || remove_[i]) continue;
+        if (temporal && kept_ev[i] == kSupported) continue;
+        const float dmax = lo * factor2 + m;
+        if (a * a + b * b - 2.0f * a * b * cos2 > dmax * dmax) continue;  // not one surface
+        spikes_.push_back(static_cast<std::uint32_t>(i));
+    }
+    if (spikes_.empty()) return 0;
+    // Within what the bound leaves (step 5): more is clutter (a railing, foliage), not spikes.
+    std::size_t removed = 0;
+    for (std::size_t i = 0; i < n; ++i) removed += remove_[i] & v[i];
+    if (removed + spikes_.size() > cap) return 0;
+    for (const std::uint32_t i : spikes_) remove_[i] = 1;
+    return spikes_.size();
 }
 
 std::size_t EvidenceFilter::markVeils(const Scan& scan, const Clusters& out, double sigma,

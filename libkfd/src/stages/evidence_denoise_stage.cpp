@@ -57,6 +57,10 @@ std::vector<StageKey> EvidenceDenoiseStage::keys() {
                          "where the track stage placed a keyframe and a reference, align them "
                          "by its poses instead of the denoiser's own alignment",
                          [](P& p) -> bool& { return p.track_alignment; }),
+        keys::boolean<P>("spikes", "spikes",
+                         "remove a return beyond both neighbours' ranges that the temporal "
+                         "evidence does not support",
+                         [](P& p) -> bool& { return p.spikes; }),
         keys::boolean<P>("keep_surfaces", "keep_surfaces",
                          "never remove a run of returns on a line at the scan's noise (step 7)",
                          [](P& p) -> bool& { return p.keep_surfaces; }),
@@ -101,6 +105,7 @@ bool EvidenceDenoiseStage::finish(Scan& scan, StageReport& report, const ScanRep
     res.confirmed = r.confirmed;
     res.recent = r.recent;
     res.next = r.next;
+    res.spikes = r.spikes;
     res.veils = r.veils;
     res.surface_kept = r.surface_kept;
     return endDenoising(clusters_, res, report);
@@ -127,6 +132,8 @@ std::vector<StageColumn> EvidenceDenoiseStage::columns() {
     c.push_back(diagnosticColumn<DenoiseResult>(
         "sigma_mm", "the range noise the evidence used (mm; measured, then floored)", "%.2f",
         [](const DenoiseResult& r) { return 1e3 * r.sigma; }));
+    c.push_back(diagnosticColumn<DenoiseResult>("spikes", "spikes removed (step 4b)", "%zu",
+                                                [](const DenoiseResult& r) { return r.spikes; }));
     c.push_back(diagnosticColumn<DenoiseResult>("veils", "mixed pixels removed (step 6)", "%zu",
                                                 [](const DenoiseResult& r) { return r.veils; }));
     c.push_back(diagnosticColumn<DenoiseResult>(

@@ -40,6 +40,7 @@ struct DenoiseResult {
     bool confirmed = false;          // evidence: above the bound, confirmed by the scan before
     bool recent = false;             // evidence: the raw scan just before was used
     bool next = false;               // evidence: the raw scan just after was used
+    std::size_t spikes = 0;          // evidence: spikes removed (step 4b)
     std::size_t veils = 0;           // evidence: mixed pixels removed (step 6)
     std::size_t surface_kept = 0;    // evidence: returns kept as a surface (step 7)
 };
