@@ -929,9 +929,8 @@ std::size_t EvidenceFilter::markSpikes(const Scan& scan, const std::vector<std::
     spikes_.clear();
     if (n < 3) return 0;
     // Candidates, branch-free: off both neighbours' ranges (most beams lie between them).
-    off_.resize(n);
+    off_.resize(n);  // beams 1 .. n - 2 written and read below
     std::uint8_t* off = off_.data();
-    off[0] = off[n - 1] = 0;
 #pragma omp simd
     for (std::size_t i = 1; i < n - 1; ++i) {
         const float lo = std::min(r[i - 1], r[i + 1]), hi = std::max(r[i - 1], r[i + 1]);
