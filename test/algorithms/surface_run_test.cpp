@@ -130,6 +130,22 @@ TEST(SurfaceRun, SparingClearsOnlyTheRunsOnALine) {
     for (std::size_t i = 250; i < 260; ++i) EXPECT_EQ(remove[i], 1) << i;
 }
 
+TEST(SurfaceRun, SparingFindsRunsWhereverTheyStartAfterLongStretchesOfKeptBeams) {
+    // Between runs spareSurfaceRuns skips to the next flagged beam eight at a time: runs that
+    // start at the first beam, just off and on a multiple of eight, and end at the last beam
+    // are all spared, and nothing else is touched.
+    for (const std::size_t start : {0u, 7u, 8u, 9u, 63u, 64u, 65u}) {
+        Scan s = test::flatWall(361, test::deg2rad(120), 3.0);
+        std::vector<std::uint8_t> remove(s.range.size(), 0);
+        for (std::size_t i = start; i < start + 12; ++i) remove[i] = 1;
+        for (std::size_t i = 349; i < 361; ++i) remove[i] = 1;
+        remove[200] = 2;  // any non-zero flag counts as removed
+        EXPECT_EQ(spareSurfaceRuns(s, remove.data()), 24u) << start;
+        for (std::size_t i = 0; i < remove.size(); ++i)
+            EXPECT_EQ(remove[i], i == 200 ? 2 : 0) << start << " " << i;
+    }
+}
+
 TEST(SurfaceRun, SparingAgreesWithTheRemovedSurfaceCheck) {
     // What spareSurfaceRuns leaves flagged, removed, holds no run longestRemovedSurface calls a
     // surface, on random scans with random removals.

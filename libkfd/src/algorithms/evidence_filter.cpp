@@ -140,7 +140,7 @@ void EvidenceFilter::initialize(const Params& p) {
         throw ParameterError("surface_sigmas", "surface_sigmas must be in [0, 100]");
     params_ = p;
     raw_.assign(p.temporal_scans, RawScan{});
-    residuals_.reserve(2 * p.refine_samples + 2);
+    residuals_.reserve(2 * (2 * p.refine_samples + 2));
     align_.reserve(5 * (2 * p.refine_samples + 2));
     lambda_ = p.incidence_deg * kDeg;
     reset();
@@ -388,10 +388,12 @@ void EvidenceFilter::labelSegments(const Scan& scan, const Breakpoints& bp, Clus
     const float* y = y_.data();
     std::uint8_t* link = link_.data();
     out.label.resize(n);  // every beam written below (-1: no return)
-    out.size.resize(n);
-    sums_.resize(n);
+    // Sizes and range sums in buffers kept at their largest (no zero fill per scan); the sizes
+    // are copied out at the end.
+    if (sizes_.size() < n) sizes_.resize(n);
+    if (sums_.size() < n) sums_.resize(n);
     std::int32_t* label = out.label.data();
-    std::uint32_t* size = out.size.data();
+    std::uint32_t* size = sizes_.data();
     float* sums = sums_.data();
     std::size_t count = 0;
     first_valid = 0;
@@ -432,8 +434,7 @@ void EvidenceFilter::labelSegments(const Scan& scan, const Breakpoints& bp, Clus
         size[count - 1] = cur_size;
         sums[count - 1] = cur_sum;
     }
-    out.size.resize(count);
-    sums_.resize(count);
+    out.size.assign(sizes_.begin(), sizes_.begin() + static_cast<std::ptrdiff_t>(count));
 }
 
 void EvidenceFilter::joinAcrossSeam(const Scan& scan, const Breakpoints& bp,
@@ -456,7 +457,6 @@ void EvidenceFilter::joinAcrossSeam(const Scan& scan, const Breakpoints& bp,
     out.size[0] += out.size[tail];
     sums_[0] += sums_[tail];
     out.size.pop_back();
-    sums_.pop_back();
     link_[last] = 1;
 }
 
@@ -556,9 +556,10 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
     // The sampled returns, gathered once; per iteration their projections and bracket
     // positions in one omp simd pass, then the pairs.
     const std::size_t cap = n / stride + 1;  // within the capacity reserved by initialize()
-    residuals_.resize(cap);
+    residuals_.resize(2 * cap);              // two iterations' residuals: the spread's and the next
     align_.resize(5 * cap);
-    float* residuals = residuals_.data();
+    float* spread_of = nullptr;  // the residuals the spread is taken of (the last system used)
+    std::size_t spread_n = 0;
     float* sx = align_.data();
     float* sy = sx + cap;
     float* qxs = sy + cap;
@@ -581,6 +582,7 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
         projectPoints(m, sx, sy, c, s, tx, ty, first, inv_step, qxs, qys, us);
         PointToLineSystem<float> sys;
         std::size_t kept = 0;
+        float* residuals = residuals_.data() + (it % 2) * cap;
         for (std::size_t j = 0; j < m; ++j) {
             const float u = us[j];
             if (!(u >= 0.0f) || !(u < u_max)) continue;
@@ -600,13 +602,16 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
         }
         gate = std::max(0.5 * gate, 0.1);
         if (sys.pairs < 12) break;
-        if (spread) {  // the robust spread of the residuals at the step before this update
-            float* mid = residuals + kept / 2;
-            std::nth_element(residuals, mid, residuals + kept);
-            *spread = 1.4826 * static_cast<double>(*mid);
-        }
+        spread_of = residuals;
+        spread_n = kept;
         if (!sys.step(d)) break;
         changed = true;
+    }
+    if (spread &&
+        spread_of) {  // the robust spread of the last system's residuals (before its step)
+        float* mid = spread_of + spread_n / 2;
+        std::nth_element(spread_of, mid, spread_of + spread_n);
+        *spread = 1.4826 * static_cast<double>(*mid);
     }
     return changed;
 }
@@ -681,6 +686,7 @@ std::size_t EvidenceFilter::judgeListed(const Clusters& out, std::size_t listed,
                                         const Projection& pt, const Projection& pn,
                                         const Projection& p0, Result& res) {
     free_in_.assign(out.count(), 0);
+    free_off_line_in_.assign(out.count(), 0);
     supported_in_.assign(out.count(), 0);
     classified_in_.assign(out.count(), 0);
     const std::size_t n = out.label.size();
@@ -719,6 +725,7 @@ std::size_t EvidenceFilter::judgeListed(const Clusters& out, std::size_t listed,
         ++classified_in_[c];
         if (e == kFree) {
             ++free_in_[c];
+            free_off_line_in_[c] += line_[i] ? 0u : 1u;
             ++res.free_points;
         } else if (e == kSupported) {
             ++supported_in_[c];
@@ -844,7 +851,7 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     const std::size_t valid_in = scan.countValid();
     const auto cap = static_cast<std::size_t>(
         std::floor(params_.max_removed_fraction * static_cast<double>(valid_in)));
-    res.removal_wanted = markNoise(out, res.temporal, evidence_);
+    res.removal_wanted = markNoise(out, res.temporal);
     // 5. Bounded removal: more than the bound disagrees with the references: they are stale.
     // With the raw scan just before, first the keyframes alone (what temporal_scans = 0 does).
     bool temporal = res.temporal;
@@ -861,12 +868,12 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
         res.supported = kf.supported;
         res.tracked = kf.tracked;
         res.recent_overruled = true;
-        wanted = markNoise(out, temporal, evidence_);
+        wanted = markNoise(out, temporal);
     }
     if (wanted > cap && temporal) {
         res.stale_references = true;
         temporal = false;
-        if (markNoise(out, false, evidence_) > cap) {
+        if (markNoise(out, false) > cap) {
             capNoise(out, cap);
             res.capped = true;
         }
@@ -891,11 +898,21 @@ void EvidenceFilter::removeMarked(Scan& scan, const Clusters& out,
     // Free returns go unless they lie on a line with their neighbours (a surface the previous
     // keyframe saw a little farther: pose error, a door that moved); every return of a removed
     // segment goes.
-    remove_.assign(n, 0);
-    for (std::size_t i = 0; i < n; ++i) {
-        if (out.label[i] < 0) continue;
-        remove_[i] = out.noise[static_cast<std::size_t>(out.label[i])] ||
-                     (temporal && kept_ev[i] == kFree && !line_[i]);
+    // Branch-free: the noise flag looked up by label + 1 (0: no return, never noise).
+    noise_by_label_.resize(out.count() + 1);
+    noise_by_label_[0] = 0;
+    std::copy(out.noise.begin(), out.noise.end(), noise_by_label_.begin() + 1);
+    remove_.resize(n);
+    {
+        const std::uint8_t* noise = noise_by_label_.data();
+        const std::int32_t* label = out.label.data();
+        const std::uint8_t* ev = kept_ev.data();
+        const std::uint8_t* line = line_.data();
+        const auto free_counts = static_cast<std::uint8_t>(temporal);
+        std::uint8_t* remove = remove_.data();
+        for (std::size_t i = 0; i < n; ++i)
+            remove[i] = static_cast<std::uint8_t>(
+                noise[label[i] + 1] | (free_counts & (ev[i] == kFree) & (line[i] == 0)));
     }
     // 4b. Spikes; 6. mixed pixels; 7. surfaces kept.
     if (params_.spikes) res.spikes = markSpikes(scan, kept_ev, temporal, sigma, cap);
@@ -907,11 +924,14 @@ void EvidenceFilter::removeMarked(Scan& scan, const Clusters& out,
         sp.tolerance_m = std::max(params_.surface_sigmas * sigma, SurfaceRunParams{}.tolerance_m);
         res.surface_kept = spareSurfaceRuns(scan, remove_.data(), sp);
     }
-    for (std::size_t i = 0; i < n; ++i)
-        if (remove_[i] && scan.valid[i]) {
-            scan.valid[i] = 0;
-            ++res.points_removed;
-        }
+    const std::size_t valid_before = scan.countValid();
+    {
+        const std::uint8_t* remove = remove_.data();
+        std::uint8_t* valid = scan.valid.data();
+#pragma omp simd
+        for (std::size_t i = 0; i < n; ++i) valid[i] = remove[i] ? 0 : valid[i];
+    }
+    res.points_removed += valid_before - scan.countValid();
 }
 
 std::size_t EvidenceFilter::markSpikes(const Scan& scan, const std::vector<std::uint8_t>& kept_ev,
@@ -936,8 +956,11 @@ std::size_t EvidenceFilter::markSpikes(const Scan& scan, const std::vector<std::
         const float lo = std::min(r[i - 1], r[i + 1]), hi = std::max(r[i - 1], r[i + 1]);
         off[i] = static_cast<std::uint8_t>((r[i] < lo - m) | (r[i] > hi + m));
     }
+    // The few candidates, found by memchr over beams i .. n - 2.
     for (std::size_t i = 1; i + 1 < n; ++i) {
-        if (!off[i]) continue;
+        const void* hit = std::memchr(off + i, 1, n - 1 - i);
+        if (hit == nullptr) break;
+        i = static_cast<std::size_t>(static_cast<const std::uint8_t*>(hit) - off);
         const float a = r[i - 1], b = r[i + 1];
         const float lo = std::min(a, b);
         if (!v[i - 1] || !v[i] || !v[i + 1] || line_[i] || remove_[i]) continue;
@@ -1097,8 +1120,7 @@ bool EvidenceFilter::confirmedByRecent(const Clusters& out, std::size_t valid_in
            static_cast<double>(supported) >= params_.confirm_support * static_cast<double>(judged);
 }
 
-std::size_t EvidenceFilter::markNoise(Clusters& out, bool temporal,
-                                      const std::vector<std::uint8_t>& ev) {
+std::size_t EvidenceFilter::markNoise(Clusters& out, bool temporal) {
     small_.resize(out.count());
     for (std::size_t c = 0; c < out.count(); ++c) {
         const double r = std::max(0.05, static_cast<double>(out.mean_range[c]));
@@ -1111,12 +1133,11 @@ std::size_t EvidenceFilter::markNoise(Clusters& out, bool temporal,
         out.noise[c] = (small && !supported) || free ? 1 : 0;
         small_[c] = small ? 1 : 0;
     }
+    // Every return of a noise segment, and the free returns off a line of the others (counted
+    // per segment as they were judged: evidence is never set free after that).
     std::size_t removed = 0;
-    for (std::size_t i = 0; i < out.label.size(); ++i) {
-        if (out.label[i] < 0) continue;
-        removed += out.noise[static_cast<std::size_t>(out.label[i])] ||
-                   (temporal && ev[i] == kFree && !line_[i]);
-    }
+    for (std::size_t c = 0; c < out.count(); ++c)
+        removed += out.noise[c] ? out.size[c] : temporal ? free_off_line_in_[c] : 0u;
     return removed;
 }
 

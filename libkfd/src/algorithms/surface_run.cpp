@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace kfd {
 namespace {
@@ -62,21 +64,35 @@ bool looksLikeSurface(const Scan& scan, Removed removed, std::size_t first, std:
     return true;
 }
 
+// The first beam from i on (n when none) whose flag is not zero: eight beams at a time.
+std::size_t nextNonZero(const std::uint8_t* flags, std::size_t i, std::size_t n) {
+    for (; i + 8 <= n; i += 8) {
+        std::uint64_t word = 0;
+        std::memcpy(&word, flags + i, sizeof word);
+        if (word != 0) break;
+    }
+    while (i < n && flags[i] == 0) ++i;
+    return i;
+}
+
 // Calls `found(run)` for every run of removed returns that looks like a surface. A run: beams
 // whose return is removed (`removed(i)`), up to a beam whose return stays (`kept(i)`); beams
-// with no return (neither) do not break it.
-template <class Removed, class Kept, class Found>
-void forEachSurfaceRun(const Scan& scan, Removed removed, Kept kept, const SurfaceRunParams& p,
-                       Found found) {
+// with no return (neither) do not break it. Between runs, `skip(i)` jumps to a beam at or after
+// i that may be removed (every beam before it is not).
+template <class Removed, class Kept, class Skip, class Found>
+void forEachSurfaceRun(const Scan& scan, Removed removed, Kept kept, Skip skip,
+                       const SurfaceRunParams& p, Found found) {
     const std::size_t n = std::min(scan.valid.size(), scan.range.size());
     std::size_t first = 0, last = 0;
     LineSums s;
-    auto close = [&] {
+    auto close = [&] {  // most beams close an empty run: nothing to reset then
+        if (s.n == 0) return;
         SurfaceRun r;
-        if (s.n > 0 && looksLikeSurface(scan, removed, first, last, s, p, r)) found(r, last);
+        if (looksLikeSurface(scan, removed, first, last, s, p, r)) found(r, last);
         s = LineSums{};
     };
     for (std::size_t i = 0; i < n; ++i) {
+        if (s.n == 0 && (i = skip(i)) >= n) break;  // no run open: on to the next removed return
         if (kept(i)) {
             close();
             continue;
@@ -97,7 +113,8 @@ SurfaceRun longestRemovedSurface(const Scan& scan, const std::uint8_t* before,
     SurfaceRun best;
     forEachSurfaceRun(
         scan, [&](std::size_t i) { return before[i] && !scan.valid[i]; },
-        [&](std::size_t i) { return before[i] && scan.valid[i]; }, p,
+        [&](std::size_t i) { return before[i] && scan.valid[i]; }, [](std::size_t i) { return i; },
+        p,
         [&](const SurfaceRun& r, std::size_t) {
             if (r.length_m > best.length_m) best = r;
         });
@@ -105,10 +122,12 @@ SurfaceRun longestRemovedSurface(const Scan& scan, const std::uint8_t* before,
 }
 
 std::size_t spareSurfaceRuns(const Scan& scan, std::uint8_t* remove, const SurfaceRunParams& p) {
+    const std::size_t n = std::min(scan.valid.size(), scan.range.size());
     std::size_t spared = 0;
     forEachSurfaceRun(
         scan, [&](std::size_t i) { return scan.valid[i] && remove[i]; },
-        [&](std::size_t i) { return scan.valid[i] && !remove[i]; }, p,
+        [&](std::size_t i) { return scan.valid[i] && !remove[i]; },
+        [&](std::size_t i) { return nextNonZero(remove, i, n); }, p,
         [&](const SurfaceRun& r, std::size_t last) {
             for (std::size_t i = r.first; i <= last; ++i)
                 if (scan.valid[i] && remove[i]) {

@@ -1,5 +1,8 @@
 #include "kfd/stages/denoise_result.h"
 
+#include <algorithm>
+#include <cstdint>
+
 #include "kfd/pipeline/stage_registry.h"
 
 namespace kfd {
@@ -25,11 +28,14 @@ DenoiseResult startDenoising(Scan& scan, DenoiseVariant variant) {
     DenoiseResult r;
     r.variant = variant;
     r.points_in = scan.countValid();
-    for (std::size_t i = 0; i < scan.range.size(); ++i)
-        if (scan.valid[i] && !isUsableRange(scan.range[i])) {
-            scan.valid[i] = 0;
-            ++r.points_removed;
-        }
+    // Valid flags of unusable ranges cleared, branch-free (this runs over every beam of every
+    // keyframe); the count from the flags after.
+    const std::size_t n = std::min(scan.range.size(), scan.valid.size());
+    const float* range = scan.range.data();
+    std::uint8_t* valid = scan.valid.data();
+#pragma omp simd
+    for (std::size_t i = 0; i < n; ++i) valid[i] = isUsableRange(range[i]) ? valid[i] : 0;
+    r.points_removed += r.points_in - scan.countValid();
     return r;
 }
 

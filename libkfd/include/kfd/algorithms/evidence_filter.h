@@ -128,7 +128,7 @@ class EvidenceFilter {
         double max_step_deg = 45.0;          // deg: the same, in rotation
         /// Issue 39: where the tracker placed both scans (Tracked), their step is the tracker's
         /// and the margin its RMS residual: no alignment of the denoiser's own. Off: it denoises
-        /// better and costs 29 % fewer instructions, but ICP-SLAM after it is significantly
+        /// better and costs 34 % fewer instructions, but ICP-SLAM after it is significantly
         /// worse on mit-csail (docs/RESULTS.md, issue 39).
         bool track_alignment = false;
         std::size_t refine_iterations = 3;  // Gauss-Newton steps aligning to the keyframe
@@ -330,8 +330,8 @@ class EvidenceFilter {
     bool trackedStep(const Scan& scan, const Reference& ref, Pose2D& d) const;
     bool trackedMotion(const Reference& ref, float qx, float qy, float rho, std::size_t k0) const;
     void keepAsReference(const Scan& scan);
-    // Step 4: marks noise segments; returns the returns it would remove (`kept_ev`: evidence).
-    std::size_t markNoise(Clusters& out, bool temporal, const std::vector<std::uint8_t>& ev);
+    // Step 4: marks noise segments; returns the returns it would remove.
+    std::size_t markNoise(Clusters& out, bool temporal);
     // Step 5: removals beyond the bound that the raw scan just before confirms.
     bool confirmedByRecent(const Clusters& out, std::size_t valid_in, std::size_t wanted) const;
     static constexpr std::size_t kMinConfirmJudged = 16;  // returns judged outside the removal
@@ -365,16 +365,19 @@ class EvidenceFilter {
     std::vector<std::uint8_t> line_;      // per beam: on a line with its two neighbours
     std::vector<std::uint8_t> link_;      // per beam: one surface with the next return
     std::vector<std::uint8_t> evidence_;  // per beam: Evidence
-    std::vector<float> sums_;             // per segment: range sum
+    std::vector<float> sums_;             // per segment: range sum (kept at its largest)
+    std::vector<std::uint32_t> sizes_;    // per segment: returns (labelSegments' buffer)
     std::vector<std::uint32_t> unknown_;  // beams classified unknown against the newest keyframe
     std::vector<float> batch_;            // returns to classify: points, projections, brackets
     std::vector<std::uint32_t> free_in_, supported_in_, classified_in_;  // per segment
-    std::vector<std::uint32_t> order_;                                   // segments by size
-    std::vector<std::uint8_t> small_;                                    // per segment: small
-    std::vector<std::uint8_t> remove_;   // per beam: to be removed (steps 4-7)
-    std::vector<std::uint8_t> veil_;     // per beam: a mixed pixel (step 6)
-    std::vector<std::uint32_t> spikes_;  // the spikes' beams (step 4b)
-    std::vector<std::uint8_t> off_;      // per beam: off both neighbours' ranges (step 4b)
+    std::vector<std::uint32_t> free_off_line_in_;  // per segment: free returns off a line
+    std::vector<std::uint32_t> order_;             // segments by size
+    std::vector<std::uint8_t> small_;              // per segment: small
+    std::vector<std::uint8_t> remove_;             // per beam: to be removed (steps 4-7)
+    std::vector<std::uint8_t> noise_by_label_;     // per label + 1: out.noise (0 for no return)
+    std::vector<std::uint8_t> veil_;               // per beam: a mixed pixel (step 6)
+    std::vector<std::uint32_t> spikes_;            // the spikes' beams (step 4b)
+    std::vector<std::uint8_t> off_;  // per beam: off both neighbours' ranges (step 4b)
     std::vector<std::uint32_t> seg_first_, seg_last_;  // per segment: its first and last beam
     double sigma_smoothed_ = -1.0;
     double measured_smoothed_ = -1.0;       // the same, of the estimates before the floor
