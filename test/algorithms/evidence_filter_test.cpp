@@ -111,6 +111,50 @@ TEST(EvidenceFilter, ReturnsBetweenTheirNeighboursAreNoSpikes) {
     EXPECT_EQ(r.spikes, 0u);
 }
 
+EvidenceFilter::Params withVeil(bool on) {
+    EvidenceFilter::Params p = exact();
+    p.veil = on;
+    return p;
+}
+
+// A 181-beam, 180-degree scanner (1 deg): an object's edge at 2 m (beams 0-89), the wall
+// behind it at 4 m (92-180), and two mixed pixels between them at 3.0 and 3.05 m (90, 91):
+// one segment of two returns, too large at 3 m to be small on a 1-degree scanner.
+Scan edgeWithMixedPixels() {
+    Scan s = test::arc(181, kPi, 4.0);
+    test::setRange(s, 0, 89, 2.0);
+    test::setRange(s, 90, 90, 3.0);
+    test::setRange(s, 91, 91, 3.05);
+    return s;
+}
+
+TEST(EvidenceFilter, MixedPixelsBetweenANearAndAFarSurfaceAreRemovedByStep6Alone) {
+    for (const bool on : {false, true}) {
+        EvidenceFilter f(withVeil(on));
+        Clusters c;
+        Scan s = edgeWithMixedPixels();
+        const auto r = f.filter(s, c);
+        EXPECT_EQ(r.veils, on ? 2u : 0u) << on;
+        EXPECT_EQ(s.valid[90], on ? 0 : 1) << on;
+        EXPECT_EQ(s.valid[91], on ? 0 : 1) << on;
+        EXPECT_EQ(r.points_removed, on ? 2u : 0u) << on;
+    }
+}
+
+TEST(EvidenceFilter, MixedPixelsStayWhenTheyWouldTakeTheScanPastTheBound) {
+    // Eight one-beam spikes at 1 m in the wall are small segments step 4 removes: 8 of the
+    // bound's 9 (5 % of 181). The two mixed pixels would make 10: step 6 removes none.
+    EvidenceFilter f(withVeil(true));
+    Clusters c;
+    Scan s = edgeWithMixedPixels();
+    for (std::size_t i = 110; i < 150; i += 5) test::insertSpike(s, i, 1.0);
+    const auto r = f.filter(s, c);
+    EXPECT_EQ(r.veils, 0u);
+    EXPECT_EQ(s.valid[90], 1);
+    EXPECT_EQ(s.valid[91], 1);
+    EXPECT_EQ(r.points_removed, 8u);
+}
+
 // Step 7 off: the tests of the burst logic below use flat bursts (constant range), which step 7
 // would keep as surfaces.
 EvidenceFilter::Params noSurfaces(EvidenceFilter::Params p) {

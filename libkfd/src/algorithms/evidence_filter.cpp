@@ -543,63 +543,30 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
     const std::size_t n = scan.range.size(), rn = ref.range.size();
     if (params_.refine_iterations == 0 || rn < 2) return false;
     const std::size_t stride = std::max<std::size_t>(1, n / params_.refine_samples);
-    // Raw pointers: the stores below cannot alias the vectors' own pointers then.
-    const std::uint8_t* valid = scan.valid.data();
-    const float* px = x_.data();
-    const float* py = y_.data();
-    const std::uint8_t* rvalid = ref.valid.data();
-    const std::uint8_t* rlink = ref.link.data();
-    const float* rx = ref.x.data();
-    const float* ry = ref.y.data();
-    const float u_max = static_cast<float>(rn - 1);
-    const float first = first_, inv_step = inv_step_;
     // The sampled returns, gathered once; per iteration their projections and bracket
     // positions in one omp simd pass, then the pairs.
     const std::size_t cap = n / stride + 1;  // within the capacity reserved by initialize()
     residuals_.resize(2 * cap);              // two iterations' residuals: the spread's and the next
     align_.resize(5 * cap);
-    float* spread_of = nullptr;  // the residuals the spread is taken of (the last system used)
-    std::size_t spread_n = 0;
     float* sx = align_.data();
     float* sy = sx + cap;
     float* qxs = sy + cap;
     float* qys = qxs + cap;
     float* us = qys + cap;
-    std::size_t m = 0;
-    for (std::size_t i = 0; i < n; i += stride) {
-        if (!valid[i]) continue;
-        sx[m] = px[i];
-        sy[m] = py[i];
-        ++m;
-    }
+    const std::size_t m = sampleReturns(scan, stride, sx, sy);
+    float* spread_of = nullptr;  // the residuals the spread is taken of (the last system used)
+    std::size_t spread_n = 0;
     double gate = params_.refine_gate_m;
     bool changed = false;
     for (std::size_t it = 0; it < params_.refine_iterations; ++it) {
         const float c = static_cast<float>(std::cos(d.phi)),
                     s = static_cast<float>(std::sin(d.phi));
-        const float tx = static_cast<float>(d.x), ty = static_cast<float>(d.y);
-        const float gate_f = static_cast<float>(gate);
-        projectPoints(m, sx, sy, c, s, tx, ty, first, inv_step, qxs, qys, us);
+        projectPoints(m, sx, sy, c, s, static_cast<float>(d.x), static_cast<float>(d.y), first_,
+                      inv_step_, qxs, qys, us);
         PointToLineSystem<float> sys;
-        std::size_t kept = 0;
         float* residuals = residuals_.data() + (it % 2) * cap;
-        for (std::size_t j = 0; j < m; ++j) {
-            const float u = us[j];
-            if (!(u >= 0.0f) || !(u < u_max)) continue;
-            const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
-            if (!rvalid[k0] || !rvalid[k1] || !rlink[k0]) continue;
-            const float qx = qxs[j], qy = qys[j];
-            float nx = ry[k0] - ry[k1], ny = rx[k1] - rx[k0];
-            const float len2 = nx * nx + ny * ny;
-            if (!(len2 > 1e-12f)) continue;
-            const float inv = 1.0f / std::sqrt(len2);
-            nx *= inv;
-            ny *= inv;
-            const float e = nx * (qx - rx[k0]) + ny * (qy - ry[k0]);
-            if (std::abs(e) > gate_f) continue;
-            sys.add(nx, ny, qx, qy, e);
-            residuals[kept++] = std::abs(e);
-        }
+        const std::size_t kept =
+            pairWithLines(ref, m, qxs, qys, us, static_cast<float>(gate), sys, residuals);
         gate = std::max(0.5 * gate, 0.1);
         if (sys.pairs < 12) break;
         spread_of = residuals;
@@ -607,13 +574,54 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
         if (!sys.step(d)) break;
         changed = true;
     }
-    if (spread &&
-        spread_of) {  // the robust spread of the last system's residuals (before its step)
+    // The robust spread of the last system's residuals (before its step).
+    if (spread && spread_of) {
         float* mid = spread_of + spread_n / 2;
         std::nth_element(spread_of, mid, spread_of + spread_n);
         *spread = 1.4826 * static_cast<double>(*mid);
     }
     return changed;
+}
+
+std::size_t EvidenceFilter::sampleReturns(const Scan& scan, std::size_t stride, float* sx,
+                                          float* sy) const {
+    const std::size_t n = scan.range.size();
+    // Raw pointers: the stores below cannot alias the vectors' own pointers then.
+    const std::uint8_t* valid = scan.valid.data();
+    const float* px = x_.data();
+    const float* py = y_.data();
+    std::size_t m = 0;
+    for (std::size_t i = 0; i < n; i += stride) {
+        if (!valid[i]) continue;
+        sx[m] = px[i];
+        sy[m] = py[i];
+        ++m;
+    }
+    return m;
+}
+
+std::size_t EvidenceFilter::pairWithLines(const Reference& ref, std::size_t m, const float* qxs,
+                                          const float* qys, const float* us, float gate,
+                                          PointToLineSystem<float>& sys, float* residuals) {
+    const std::uint8_t* rvalid = ref.valid.data();
+    const std::uint8_t* rlink = ref.link.data();
+    const float* rx = ref.x.data();
+    const float* ry = ref.y.data();
+    const float u_max = static_cast<float>(ref.range.size() - 1);
+    std::size_t kept = 0;
+    for (std::size_t j = 0; j < m; ++j) {
+        const float u = us[j];
+        if (!(u >= 0.0f) || !(u < u_max)) continue;
+        const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
+        if (!rvalid[k0] || !rvalid[k1] || !rlink[k0]) continue;
+        const float qx = qxs[j], qy = qys[j];
+        float nx = 0.0f, ny = 0.0f, e = 0.0f;
+        if (!pointToLine(rx[k0], ry[k0], rx[k1], ry[k1], qx, qy, nx, ny, e)) continue;
+        if (std::abs(e) > gate) continue;
+        sys.add(nx, ny, qx, qy, e);
+        residuals[kept++] = std::abs(e);
+    }
+    return kept;
 }
 
 bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, double sigma,
@@ -819,23 +827,7 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out, const S
 EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     Result res;
     const std::size_t n = scan.range.size();
-    ScanGeometry geom = scan.geometry;
-    geom.beams = n;  // tables follow the data
-    updateTables(geom);
-    x_.resize(n);
-    y_.resize(n);
-    {
-        const float* range = scan.range.data();
-        const float* cs = dirs_.cos.data();
-        const float* sn = dirs_.sin.data();
-        float* x = x_.data();
-        float* y = y_.data();
-#pragma omp simd
-        for (std::size_t i = 0; i < n; ++i) {
-            x[i] = range[i] * cs[i];
-            y[i] = range[i] * sn[i];
-        }
-    }
+    toPoints(scan);
     // 1.-2. Noise, lines and segments.
     const double sigma = estimateSigma(scan);
     res.sigma = sigma;
@@ -852,8 +844,41 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     const auto cap = static_cast<std::size_t>(
         std::floor(params_.max_removed_fraction * static_cast<double>(valid_in)));
     res.removal_wanted = markNoise(out, res.temporal);
-    // 5. Bounded removal: more than the bound disagrees with the references: they are stale.
-    // With the raw scan just before, first the keyframes alone (what temporal_scans = 0 does).
+    // 5. Bounded removal.
+    const bool temporal = boundRemoval(scan, out, sigma, valid_in, cap, res);
+    for (std::size_t c = 0; c < out.count(); ++c) res.small_segments += out.noise[c] & small_[c];
+    // The previous keyframe for the next scan keeps every return (removed ones too: a thin
+    // object removed once as unsupported must still support the next view).
+    keepAsReference(scan);  // swaps evidence_, x_, y_, link_ away: use the reference's below
+    if (!raw_.empty() && params_.temporal) keepRaw(scan, tracked_);  // before removal: the raw scan
+    const std::vector<std::uint8_t>& kept_ev = refs_[0].present ? refs_[0].evidence : evidence_;
+    removeMarked(scan, out, kept_ev, temporal, sigma, cap, res);
+    return res;
+}
+
+void EvidenceFilter::toPoints(const Scan& scan) {
+    const std::size_t n = scan.range.size();
+    ScanGeometry geom = scan.geometry;
+    geom.beams = n;  // tables follow the data
+    updateTables(geom);
+    x_.resize(n);
+    y_.resize(n);
+    const float* range = scan.range.data();
+    const float* cs = dirs_.cos.data();
+    const float* sn = dirs_.sin.data();
+    float* x = x_.data();
+    float* y = y_.data();
+#pragma omp simd
+    for (std::size_t i = 0; i < n; ++i) {
+        x[i] = range[i] * cs[i];
+        y[i] = range[i] * sn[i];
+    }
+}
+
+bool EvidenceFilter::boundRemoval(const Scan& scan, Clusters& out, double sigma,
+                                  std::size_t valid_in, std::size_t cap, Result& res) {
+    // More than the bound disagrees with the references: they are stale. With the raw scan
+    // just before, first the keyframes alone (what temporal_scans = 0 does).
     bool temporal = res.temporal;
     std::size_t wanted = res.removal_wanted;
     if (wanted > cap && temporal && res.recent && confirmedByRecent(out, valid_in, wanted)) {
@@ -862,7 +887,7 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     }
     if (wanted > cap && temporal && res.recent) {
         Result kf;
-        evidence_.assign(n, kUnknown);
+        evidence_.assign(scan.range.size(), kUnknown);
         temporal = temporalEvidence(scan, out, sigma, kf, false);
         res.free_points = kf.free_points;
         res.supported = kf.supported;
@@ -881,14 +906,7 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
         capNoise(out, cap);
         res.capped = true;
     }
-    for (std::size_t c = 0; c < out.count(); ++c) res.small_segments += out.noise[c] & small_[c];
-    // The previous keyframe for the next scan keeps every return (removed ones too: a thin
-    // object removed once as unsupported must still support the next view).
-    keepAsReference(scan);  // swaps evidence_, x_, y_, link_ away: use the reference's below
-    if (!raw_.empty() && params_.temporal) keepRaw(scan, tracked_);  // before removal: the raw scan
-    const std::vector<std::uint8_t>& kept_ev = refs_[0].present ? refs_[0].evidence : evidence_;
-    removeMarked(scan, out, kept_ev, temporal, sigma, cap, res);
-    return res;
+    return temporal;
 }
 
 void EvidenceFilter::removeMarked(Scan& scan, const Clusters& out,
@@ -971,11 +989,18 @@ std::size_t EvidenceFilter::markSpikes(const Scan& scan, const std::vector<std::
     }
     if (spikes_.empty()) return 0;
     // Within what the bound leaves (step 5): more is clutter (a railing, foliage), not spikes.
-    std::size_t removed = 0;
-    for (std::size_t i = 0; i < n; ++i) removed += remove_[i] & v[i];
-    if (removed + spikes_.size() > cap) return 0;
+    if (spikes_.size() > roomUnderBound(scan, cap)) return 0;
     for (const std::uint32_t i : spikes_) remove_[i] = 1;
     return spikes_.size();
+}
+
+std::size_t EvidenceFilter::roomUnderBound(const Scan& scan, std::size_t cap) const {
+    const std::size_t n = std::min(scan.valid.size(), remove_.size());
+    const std::uint8_t* v = scan.valid.data();
+    const std::uint8_t* remove = remove_.data();
+    std::size_t removed = 0;
+    for (std::size_t i = 0; i < n; ++i) removed += remove[i] & v[i];
+    return removed < cap ? cap - removed : 0;
 }
 
 std::size_t EvidenceFilter::markVeils(const Scan& scan, const Clusters& out, double sigma,
@@ -1015,7 +1040,9 @@ std::size_t EvidenceFilter::markVeils(const Scan& scan, const Clusters& out, dou
     veilRuns(scan, sigma);
     std::size_t marked = 0;
     for (std::size_t i = 0; i < n; ++i) marked += veil_[i] && !remove_[i];
-    if (marked > cap) return 0;  // clutter or vegetation, not a few edges: no guess
+    // Within what the bound leaves (step 5, after steps 4 and 4b): more is clutter or
+    // vegetation, not a few edges: no guess.
+    if (marked > roomUnderBound(scan, cap)) return 0;
     for (std::size_t i = 0; i < n; ++i) remove_[i] |= veil_[i];
     return marked;
 }

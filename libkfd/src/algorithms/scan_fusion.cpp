@@ -129,13 +129,8 @@ bool ScanFusion::refine(const Scan& kf, const Slot& slot, Pose2D& d) const {
             if (!(u >= 0.0f) || !(u < static_cast<float>(n - 1))) continue;
             const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
             if (!klink_[k0]) continue;
-            float nx = ky_[k0] - ky_[k1], ny = kx_[k1] - kx_[k0];
-            const float len2 = nx * nx + ny * ny;
-            if (!(len2 > 1e-12f)) continue;
-            const float inv = 1.0f / std::sqrt(len2);
-            nx *= inv;
-            ny *= inv;
-            const float e = nx * (qx - kx_[k0]) + ny * (qy - ky_[k0]);
+            float nx = 0.0f, ny = 0.0f, e = 0.0f;
+            if (!pointToLine(kx_[k0], ky_[k0], kx_[k1], ky_[k1], qx, qy, nx, ny, e)) continue;
             if (!(std::abs(e) <= gate_f)) continue;
             sys.add(nx, ny, qx, qy, e);
         }

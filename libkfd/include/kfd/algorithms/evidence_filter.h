@@ -13,6 +13,9 @@
 
 namespace kfd {
 
+template <class T>
+struct PointToLineSystem;  // kfd/algorithms/point_to_line.h
+
 /// Why: on real scans with injected noise, clustering by size alone finds few outliers and
 /// removes real points (docs/CHANGELOG.md). A one-beam spike 0.2 m in front of a wall, a burst of
 /// 20 beams at 1 m and a chair leg look alike to a clusterer; what differs is the evidence:
@@ -98,7 +101,8 @@ namespace kfd {
 ///     the end of a segment next to a depth edge that leave its line (|e| > 3 sqrt(1.5) sigma
 ///     against the two returns inside them) toward the far side of the edge. Removed whatever
 ///     the temporal evidence says (a veil moves with the viewpoint: its references support it
-///     by chance), within the bound of step 5 on their own. Off by default (veil = false):
+///     by chance), none when they would take the scan's removal beyond the bound of step 5
+///     (what steps 4, 4b and 5 left under it). Off by default (veil = false):
 ///     on the Freiburg logs it found 2 % more mixed pixels for 0.6 % of the real returns.
 ///  7. Surfaces kept (issue 39, keep_surfaces = true): a run of returns about to be removed
 ///     (consecutive beams, beams without a return do not break it) that a line fit calls a
@@ -271,6 +275,12 @@ class EvidenceFilter {
     };
 
     void updateTables(const ScanGeometry& g);
+    // The scan's points in its sensor frame (x_, y_), the tables updated to its geometry.
+    void toPoints(const Scan& scan);
+    // Step 5: removal within the bound (steps 3-4 again on the keyframes alone, then without
+    // temporal evidence, then the smallest segments first); whether temporal evidence stands.
+    bool boundRemoval(const Scan& scan, Clusters& out, double sigma, std::size_t valid_in,
+                      std::size_t cap, Result& res);
     double estimateSigma(const Scan& scan);
     // Step 2's breakpoint distance over r_min per beam step 1..max_step, and its noise term.
     struct Breakpoints {
@@ -312,6 +322,14 @@ class EvidenceFilter {
     // `spread` (optional): 1.4826 x the median |residual| of the last iteration's pairs (m).
     bool refineStep(const Scan& scan, const Reference& ref, Pose2D& d,
                     double* spread = nullptr) const;
+    // refineStep's samples: every stride-th valid return's point into (sx, sy); how many.
+    std::size_t sampleReturns(const Scan& scan, std::size_t stride, float* sx, float* sy) const;
+    // refineStep's pairs: each projected sample (qx, qy at bracket position u in ref) within
+    // `gate` of the reference segment bracketing it, added to `sys`, its |distance| to
+    // `residuals`; returns how many.
+    static std::size_t pairWithLines(const Reference& ref, std::size_t m, const float* qxs,
+                                     const float* qys, const float* us, float gate,
+                                     PointToLineSystem<float>& sys, float* residuals);
     // Step 3b: the newest raw scan as a projection (usable = false when it cannot be used).
     // Steps 3b/3c: a converted raw scan aligned from odometry (or zero motion) and its margin
     // from the alignment (`base`: 3 max(sqrt 2 sigma, s)); usable = false without one.
@@ -345,7 +363,10 @@ class EvidenceFilter {
     // removal beyond `cap`).
     std::size_t markSpikes(const Scan& scan, const std::vector<std::uint8_t>& kept_ev,
                            bool temporal, double sigma, std::size_t cap);
-    // Step 6: marks mixed pixels in remove_ (at most `cap`; none when more); returns the count.
+    // Returns `cap` less the valid returns remove_ already holds (0 when at or past it).
+    std::size_t roomUnderBound(const Scan& scan, std::size_t cap) const;
+    // Step 6: marks mixed pixels in remove_ (none when they would take the scan's removal
+    // beyond `cap`); returns the count.
     std::size_t markVeils(const Scan& scan, const Clusters& out, double sigma, std::size_t cap);
     // Step 6: marks in veil_ the mixed pixels at a segment's first (`last` false) or last
     // beam `end`, walking inward.

@@ -10,6 +10,22 @@
 
 namespace kfd {
 
+/// The unit normal (nx, ny) of the line through a = (ax, ay) and b = (bx, by), and the signed
+/// distance e of q = (qx, qy) from it: one point-line pair. False when a and b coincide (closer
+/// than 1e-6 m).
+inline bool pointToLine(float ax, float ay, float bx, float by, float qx, float qy, float& nx,
+                        float& ny, float& e) {
+    nx = ay - by;
+    ny = bx - ax;
+    const float len2 = nx * nx + ny * ny;
+    if (!(len2 > 1e-12f)) return false;
+    const float inv = 1.0f / std::sqrt(len2);
+    nx *= inv;
+    ny *= inv;
+    e = nx * (qx - ax) + ny * (qy - ay);
+    return true;
+}
+
 /// The upper triangle of J^T J (A) and J^T e (b) over the point-line pairs added, for the
 /// increment (dx, dy, dtheta) of a step q' = R(dtheta) q + (dx, dy). T is the accumulator type
 /// (float in the denoiser, double in the fusion); each pair's products are formed in float.

@@ -60,6 +60,14 @@ class RangeAwareClustering {
         float x, y, r;
     };
 
+    // jump_factor_ and noise_ for angle gaps up to theta (rad) on beams res_ang apart.
+    void updateJumpFactors(double theta, double res_ang);
+    // Beam i (valid) joins the nearest open cluster it reaches (uniting the others it reaches)
+    // or opens one.
+    void addBeam(const Scan& scan, std::size_t i, double theta, double res_ang, Result& res);
+    // A scanner closing the circle: clusters open at the end against the first beams.
+    void joinAcrossSeam(const Scan& scan, double theta, Result& res);
+
     Params params_;
     double sin_lambda_ = 0.0;
     double half_lambda_ = 0.0;
