@@ -926,6 +926,7 @@ void EvidenceFilter::removeMarked(Scan& scan, const Clusters& out,
         const std::int32_t* label = out.label.data();
         const std::uint8_t* ev = kept_ev.data();
         const std::uint8_t* line = line_.data();
+        // Evidence is only ever set for returns in a segment: no free return without a label.
         const auto free_counts = static_cast<std::uint8_t>(temporal);
         std::uint8_t* remove = remove_.data();
         for (std::size_t i = 0; i < n; ++i)
