@@ -852,7 +852,7 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     keepAsReference(scan);  // swaps evidence_, x_, y_, link_ away: use the reference's below
     if (!raw_.empty() && params_.temporal) keepRaw(scan, tracked_);  // before removal: the raw scan
     const std::vector<std::uint8_t>& kept_ev = refs_[0].present ? refs_[0].evidence : evidence_;
-    removeMarked(scan, out, kept_ev, temporal, sigma, cap, res);
+    removeMarked(scan, out, kept_ev, temporal, sigma, valid_in, cap, res);
     return res;
 }
 
@@ -911,7 +911,8 @@ bool EvidenceFilter::boundRemoval(const Scan& scan, Clusters& out, double sigma,
 
 void EvidenceFilter::removeMarked(Scan& scan, const Clusters& out,
                                   const std::vector<std::uint8_t>& kept_ev, bool temporal,
-                                  double sigma, std::size_t cap, Result& res) {
+                                  double sigma, std::size_t valid_in, std::size_t cap,
+                                  Result& res) {
     const std::size_t n = scan.range.size();
     // Free returns go unless they lie on a line with their neighbours (a surface the previous
     // keyframe saw a little farther: pose error, a door that moved); every return of a removed
@@ -943,14 +944,13 @@ void EvidenceFilter::removeMarked(Scan& scan, const Clusters& out,
         sp.tolerance_m = std::max(params_.surface_sigmas * sigma, SurfaceRunParams{}.tolerance_m);
         res.surface_kept = spareSurfaceRuns(scan, remove_.data(), sp);
     }
-    const std::size_t valid_before = scan.countValid();
     {
         const std::uint8_t* remove = remove_.data();
         std::uint8_t* valid = scan.valid.data();
 #pragma omp simd
         for (std::size_t i = 0; i < n; ++i) valid[i] = remove[i] ? 0 : valid[i];
     }
-    res.points_removed += valid_before - scan.countValid();
+    res.points_removed += valid_in - scan.countValid();  // nothing changed valid since step 4
 }
 
 std::size_t EvidenceFilter::markSpikes(const Scan& scan, const std::vector<std::uint8_t>& kept_ev,
@@ -975,11 +975,9 @@ std::size_t EvidenceFilter::markSpikes(const Scan& scan, const std::vector<std::
         const float lo = std::min(r[i - 1], r[i + 1]), hi = std::max(r[i - 1], r[i + 1]);
         off[i] = static_cast<std::uint8_t>((r[i] < lo - m) | (r[i] > hi + m));
     }
-    // The few candidates, found by memchr over beams i .. n - 2.
-    for (std::size_t i = 1; i + 1 < n; ++i) {
-        const void* hit = std::memchr(off + i, 1, n - 1 - i);
-        if (hit == nullptr) break;
-        i = static_cast<std::size_t>(static_cast<const std::uint8_t*>(hit) - off);
+    // The few candidates among beams 1 .. n - 2.
+    for (std::size_t i = Scan::nextNonZero(off, 1, n - 1); i + 1 < n;
+         i = Scan::nextNonZero(off, i + 1, n - 1)) {
         const float a = r[i - 1], b = r[i + 1];
         const float lo = std::min(a, b);
         if (!v[i - 1] || !v[i] || !v[i + 1] || line_[i] || remove_[i]) continue;

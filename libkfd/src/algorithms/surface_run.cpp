@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 
 namespace kfd {
 namespace {
@@ -64,17 +63,6 @@ bool looksLikeSurface(const Scan& scan, Removed removed, std::size_t first, std:
     return true;
 }
 
-// The first beam from i on (n when none) whose flag is not zero: eight beams at a time.
-std::size_t nextNonZero(const std::uint8_t* flags, std::size_t i, std::size_t n) {
-    for (; i + 8 <= n; i += 8) {
-        std::uint64_t word = 0;
-        std::memcpy(&word, flags + i, sizeof word);
-        if (word != 0) break;
-    }
-    while (i < n && flags[i] == 0) ++i;
-    return i;
-}
-
 // Calls `found(run)` for every run of removed returns that looks like a surface. A run: beams
 // whose return is removed (`removed(i)`), up to a beam whose return stays (`kept(i)`); beams
 // with no return (neither) do not break it. Between runs, `skip(i)` jumps to a beam at or after
@@ -127,7 +115,7 @@ std::size_t spareSurfaceRuns(const Scan& scan, std::uint8_t* remove, const Surfa
     forEachSurfaceRun(
         scan, [&](std::size_t i) { return scan.valid[i] && remove[i]; },
         [&](std::size_t i) { return scan.valid[i] && !remove[i]; },
-        [&](std::size_t i) { return nextNonZero(remove, i, n); }, p,
+        [&](std::size_t i) { return Scan::nextNonZero(remove, i, n); }, p,
         [&](const SurfaceRun& r, std::size_t last) {
             for (std::size_t i = r.first; i <= last; ++i)
                 if (scan.valid[i] && remove[i]) {

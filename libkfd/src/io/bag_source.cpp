@@ -409,22 +409,29 @@ struct BagSource::Impl {
                                       Pose2D{choice.mount_x, choice.mount_y, choice.mount_yaw});
     }
 
-    // Reads one message into the queue; false at the end of the bag.
-    bool readOne() {
-        if (at_end) return false;
+    // The bag's next message; null at its end.
+    std::shared_ptr<NativeMessage> nextMessage() {
         auto native = std::make_shared<NativeMessage>();
         // A chunk that cannot be read: BagError "PATH: byte N: ..." (the chunk's record).
         try {
-            if (!cursor->next(*native)) {
-                at_end = true;
-                return false;
-            }
+            if (!cursor->next(*native)) return nullptr;
         } catch (const BagFileError&) {
             throw;
         } catch (const std::exception& e) {
             throw BagError(path + ": message " + std::to_string(messages_read + 1) +
                                ": corrupt or truncated bag (" + e.what() + ")",
                            path);
+        }
+        return native;
+    }
+
+    // Reads one message into the queue; false at the end of the bag.
+    bool readOne() {
+        if (at_end) return false;
+        const std::shared_ptr<NativeMessage> native = nextMessage();
+        if (!native) {
+            at_end = true;
+            return false;
         }
         const NativeMessage& m = *native;
         try {

@@ -1,6 +1,8 @@
 #include "kfd/pipeline/scan.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <cstring>
 
 namespace kfd {
 namespace {
@@ -18,6 +20,16 @@ std::size_t Scan::countNonZero(const std::uint8_t* p, std::size_t n) {
         count += c;
     }
     return count;
+}
+
+std::size_t Scan::nextNonZero(const std::uint8_t* p, std::size_t i, std::size_t n) {
+    for (; i + 8 <= n; i += 8) {
+        std::uint64_t word = 0;
+        std::memcpy(&word, p + i, sizeof word);
+        if (word != 0) break;
+    }
+    while (i < n && p[i] == 0) ++i;
+    return i;
 }
 
 }  // namespace kfd

@@ -175,13 +175,8 @@ void writeLabels(OutputFile& labels, std::size_t k, double t, const std::vector<
     }
 }
 
-}  // namespace
-
-SimulationSummary Simulator::run(const SimulationOptions& o) {
-    SimulationSummary sum = outputNames(o);
-    World world;
-    SensorModel sensor;
-    NoiseInjector noise;
+// The world, sensor and noise the options name, checked: a SimulationError when they are bad.
+void setUp(const SimulationOptions& o, World& world, SensorModel& sensor, NoiseInjector& noise) {
     try {
         world = o.gridmap.empty() ? makeWorld(o.world) : loadWorld(o.gridmap, o.route);
         sensor = sensorModel(o.sensor);
@@ -192,6 +187,16 @@ SimulationSummary Simulator::run(const SimulationOptions& o) {
     if (!(o.speed_mps > 0) || !(o.turn_rate_dps > 0))
         throw SimulationError("speed and turn rate must be > 0");
     if (o.output.empty()) throw SimulationError("no output rawlog given");
+}
+
+}  // namespace
+
+SimulationSummary Simulator::run(const SimulationOptions& o) {
+    SimulationSummary sum = outputNames(o);
+    World world;
+    SensorModel sensor;
+    NoiseInjector noise;
+    setUp(o, world, sensor, noise);
     const auto gt =
         sample(world, sensor.rate_hz, o.speed_mps, o.turn_rate_dps * kDeg, o.duration_s);
     std::mt19937 rng(o.seed);

@@ -3,10 +3,16 @@
 #include "kfd/algorithms/scan_tracker.h"
 #include "kfd/pipeline/stage_keys.h"
 
+#include <utility>
+#include <vector>
+
 namespace kfd {
 
-std::vector<StageKey> EvidenceDenoiseStage::keys() {
-    using P = Params;
+namespace {
+using P = EvidenceDenoiseStage::Params;
+
+// Steps 1-5: segments, the temporal evidence and the bound.
+std::vector<StageKey> methodKeys() {
     return {
         keys::real<P>("min_object_size_m", "min_object_size_m",
                       "width of the smallest object kept without support (m)", 0, 100, false,
@@ -41,7 +47,12 @@ std::vector<StageKey> EvidenceDenoiseStage::keys() {
                       0, 1, false, [](P& p) -> double& { return p.max_confirmed_fraction; }),
         keys::real<P>("confirm_support", "confirm_support",
                       "... when it supports this share of the other returns it judged", 0, 1, true,
-                      [](P& p) -> double& { return p.confirm_support; }),
+                      [](P& p) -> double& { return p.confirm_support; })};
+}
+
+// Which evidence besides the keyframes, and the steps after the bound (4b, 6, 7).
+std::vector<StageKey> optionKeys() {
+    return {
         keys::count<P>("temporal_scans", "temporal_scans",
                        "raw scans kept before a keyframe (the dropped ones) as "
                        "temporal evidence with margins from their alignment; 0 = keyframes only",
@@ -71,6 +82,13 @@ std::vector<StageKey> EvidenceDenoiseStage::keys() {
                       "RMS distance to the line a surface may have, in range noise sigmas "
                       "(step 7)",
                       0, 100, false, [](P& p) -> double& { return p.surface_sigmas; })};
+}
+}  // namespace
+
+std::vector<StageKey> EvidenceDenoiseStage::keys() {
+    std::vector<StageKey> all = methodKeys();
+    for (StageKey& k : optionKeys()) all.push_back(std::move(k));
+    return all;
 }
 
 namespace {

@@ -356,9 +356,10 @@ class EvidenceFilter {
     // Step 5: the smallest noise segments only, up to `cap` returns.
     void capNoise(Clusters& out, std::size_t cap);
     /// Steps 5-7 applied: marked segments and free returns removed, spikes (4b) and mixed
-    /// pixels (6) too, surfaces kept (7).
+    /// pixels (6) too, surfaces kept (7). `valid_in`: the scan's valid returns (step 4's count).
     void removeMarked(Scan& scan, const Clusters& out, const std::vector<std::uint8_t>& kept_ev,
-                      bool temporal, double sigma, std::size_t cap, Result& res);
+                      bool temporal, double sigma, std::size_t valid_in, std::size_t cap,
+                      Result& res);
     // Step 4b: marks spikes in remove_; returns how many (none when they would take the scan's
     // removal beyond `cap`).
     std::size_t markSpikes(const Scan& scan, const std::vector<std::uint8_t>& kept_ev,

@@ -154,6 +154,9 @@ struct Scan {
 
     /// How many of the n bytes at p are not 0.
     static std::size_t countNonZero(const std::uint8_t* p, std::size_t n);
+    /// The first index from i on, below n, whose byte at p is not 0; n when there is none.
+    /// Eight bytes at a time: for sparse flags (a few beams of a scan).
+    static std::size_t nextNonZero(const std::uint8_t* p, std::size_t i, std::size_t n);
 };
 
 }  // namespace kfd
