@@ -227,7 +227,7 @@ TEST(EvidenceFilter, ReferencesThatContradictTooMuchOfAScanAreStale) {
 
 TEST(EvidenceFilter, RemovalIsCappedSmallestSegmentsFirst) {
     // 30 lone returns and one pair, all small and unsupported (no keyframe yet): 32 returns,
-    // above 5 % of 361 (18). The 18 lone returns of the farthest ranges go, nothing else.
+    // above 5 % of 361 (18). The 18 lone returns of the nearest ranges go, nothing else.
     EvidenceFilter f(exact());
     Clusters c;
     Scan s = room(std::nullopt);
@@ -241,7 +241,7 @@ TEST(EvidenceFilter, RemovalIsCappedSmallestSegmentsFirst) {
     EXPECT_EQ(s.valid[330], 1);
     EXPECT_EQ(s.valid[331], 1);
     for (std::size_t k = 0; k < 30; ++k)
-        EXPECT_EQ(s.valid[15 + 10 * k], k >= 12 ? 0 : 1) << k;  // the farthest 18
+        EXPECT_EQ(s.valid[15 + 10 * k], k < 18 ? 0 : 1) << k;  // the nearest 18
 }
 
 TEST(EvidenceFilter, NoBoundRemovesEverySmallSegment) {

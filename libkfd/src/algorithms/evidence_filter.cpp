@@ -1171,10 +1171,12 @@ void EvidenceFilter::capNoise(Clusters& out, std::size_t cap) {
     order_.clear();
     for (std::size_t c = 0; c < out.count(); ++c)
         if (out.noise[c]) order_.push_back(static_cast<std::uint32_t>(c));
-    // Smallest first; among equals the farthest (fewest returns expected of an object there).
+    // Smallest first; among equals the nearest: a real object near the sensor spans more beams
+    // than one far away, so a lone return near it is the less likely object (and the spikes
+    // near the sensor are the ones a capped scan would otherwise keep).
     std::sort(order_.begin(), order_.end(), [&](std::uint32_t a, std::uint32_t b) {
         return out.size[a] != out.size[b] ? out.size[a] < out.size[b]
-                                          : out.mean_range[a] > out.mean_range[b];
+                                          : out.mean_range[a] < out.mean_range[b];
     });
     std::size_t removed = 0;
     for (const std::uint32_t c : order_) {
