@@ -501,21 +501,49 @@ TEST(EvidenceFilter, WhereTheTrackerPlacedBothKeyframesItsPosesReplaceOdometryAn
     }
 }
 
-TEST(EvidenceFilter, TheRawScanJustBeforeIsPlacedByTheTrackerWithItsResidualAsTheMargin) {
-    EvidenceFilter f(trackAligned(withRecent(1)));
+// A keyframe 1 m on from the one before, the raw scan just before it 2 cm back, all three
+// tracked (the raw scan's fit 0.02 m RMS), a spike 0.12 m in front of the wall.
+struct TrackedRawScan {
+    Scan second = roomAfter(1.0);
+    EvidenceFilter::Result r;
+};
+
+TrackedRawScan filterWithATrackedRawScan(const EvidenceFilter::Params& p) {
+    EvidenceFilter f(p);
     Clusters c;
     Scan first = room();
     const auto t0 = trackedAt(0.0), tb = trackedAt(0.98, 0.02), t1 = trackedAt(1.0, 0.015);
     f.filter(first, c, nullptr, &t0);
     f.observe(roomAfter(0.98), &tb);
-    Scan second = roomAfter(1.0);
-    test::insertSpike(second, 180, 2.88f);
-    const auto r = f.filter(second, c, nullptr, &t1);
+    TrackedRawScan out;
+    test::insertSpike(out.second, 180, 2.88f);
+    out.r = f.filter(out.second, c, nullptr, &t1);
+    return out;
+}
+
+TEST(EvidenceFilter, TheRawScanJustBeforeIsPlacedByTheTrackerWithItsResidualAsTheMargin) {
+    const auto [second, r] = filterWithATrackedRawScan(trackAligned(withRecent(1)));
     EXPECT_TRUE(r.recent);
     EXPECT_FALSE(r.refined);
     EXPECT_NEAR(r.recent_margin_m, 3.0 * 0.02, 1e-9);  // 3 x the larger residual of the two
     EXPECT_EQ(second.valid[180], 0);
     EXPECT_EQ(r.points_removed, 1u);
+}
+
+TEST(EvidenceFilter, TrackRawAlignmentPlacesTheRawScanByTheTrackerAndAlignsTheKeyframeItself) {
+    // On (the default): the scan just before takes the tracker's step and residual margin, the
+    // keyframe before is aligned by the denoiser from odometry. Off: the raw scan is aligned
+    // by the denoiser too, its margin 3 sqrt(2) sigma (its alignment's residuals are zero).
+    for (const bool raw : {true, false}) {
+        EvidenceFilter::Params p = withRecent(1);
+        p.track_raw_alignment = raw;
+        const auto [second, r] = filterWithATrackedRawScan(p);
+        EXPECT_TRUE(r.recent);
+        EXPECT_TRUE(r.refined);
+        EXPECT_NEAR(r.recent_margin_m, raw ? 3.0 * 0.02 : 3.0 * std::sqrt(2.0) * 0.01, 1e-6);
+        EXPECT_EQ(second.valid[180], 0);
+        EXPECT_EQ(r.points_removed, 1u);
+    }
 }
 
 TEST(EvidenceFilter, AReferenceTheTrackerDidNotPlaceIsAlignedByTheDenoiser) {

@@ -75,6 +75,14 @@ kfd::Pipeline::Params trackedParams() {
     return p;
 }
 
+// The same with only the raw scan just before placed by them (track_raw_alignment, on by
+// default since issue 39's sixth step; the temporal case above has no track stage).
+kfd::Pipeline::Params rawTrackedParams() {
+    kfd::Pipeline::Params p = temporalParams();
+    p.get<kfd::EvidenceDenoiseStage>().track_raw_alignment = true;
+    return p;
+}
+
 // The same with the scan just after each keyframe too (next_scan, issue 25).
 kfd::Pipeline::Params nextScanParams() {
     kfd::Pipeline::Params p = temporalParams();
@@ -106,6 +114,8 @@ struct Context {
     // The same behind a track stage that placed every scan (issue 39: no alignment of its own).
     kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_tracked{
         trackedParams().get<kfd::EvidenceDenoiseStage>()};
+    kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_raw_tracked{
+        rawTrackedParams().get<kfd::EvidenceDenoiseStage>()};
     kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_next{
         nextScanParams().get<kfd::EvidenceDenoiseStage>()};
     kfd::DbscanFilter dbscan{kfd::DbscanFilter::Params{0.7, 10}};
@@ -129,6 +139,7 @@ struct Context {
 
     Context() {
         evidence_tracked.trackAtOdometry(0.01f);
+        evidence_raw_tracked.trackAtOdometry(0.01f);
         hist.resize(sc.keyframes.size());
         for (std::size_t k = 0; k < hist.size(); ++k) histogram.compute(sc.keyframes[k], hist[k]);
         for (const auto& s : sc.prefix) selector.filter(s);
@@ -210,6 +221,18 @@ __attribute__((noinline)) void kfd_ir_denoise_evidence_tracked(Context& c, std::
     kfd_ir_evidence_observe_tracked(c, k);
     kfd_ir_denoise_evidence_tracked_keyframe(c, k);
 }
+// The same with only the raw scan placed by the track stage's poses (track_raw_alignment).
+__attribute__((noinline)) void kfd_ir_evidence_observe_raw_tracked(Context& c, std::size_t k) {
+    c.evidence_raw_tracked.observe(c.sc.loop_before[k]);
+}
+__attribute__((noinline)) void kfd_ir_denoise_evidence_raw_tracked_keyframe(Context& c,
+                                                                            std::size_t k) {
+    c.sink += c.evidence_raw_tracked.filter(c.work_loop[k]).points_removed;
+}
+__attribute__((noinline)) void kfd_ir_denoise_evidence_raw_tracked(Context& c, std::size_t k) {
+    kfd_ir_evidence_observe_raw_tracked(c, k);
+    kfd_ir_denoise_evidence_raw_tracked_keyframe(c, k);
+}
 // The same keyframe confirmed against the scan just after it too (next_scan): the observe
 // of the scan before and the keyframe's filter with both raw scans.
 __attribute__((noinline)) void kfd_ir_denoise_evidence_next_keyframe(Context& c, std::size_t k) {
@@ -284,6 +307,7 @@ const Case kCases[] = {
     {"denoise_evidence", kfd_ir_denoise_evidence, false, true},
     {"denoise_evidence_temporal", kfd_ir_denoise_evidence_temporal, false, true},
     {"denoise_evidence_tracked", kfd_ir_denoise_evidence_tracked, false, true},
+    {"denoise_evidence_raw_tracked", kfd_ir_denoise_evidence_raw_tracked, false, true},
     {"denoise_evidence_next", kfd_ir_denoise_evidence_next, false, true},
     {"speckle_loop", kfd_ir_speckle_loop, false, true},
     {"shadow_loop", kfd_ir_shadow_loop, false, true},
@@ -315,6 +339,10 @@ void warmUp(Context& c, const Case& cs) {
             if (name == "denoise_evidence_tracked") {
                 c.evidence_tracked.observe(c.sc.loop_before[k]);
                 c.evidence_tracked.filter(c.work_loop[k]);
+            }
+            if (name == "denoise_evidence_raw_tracked") {
+                c.evidence_raw_tracked.observe(c.sc.loop_before[k]);
+                c.evidence_raw_tracked.filter(c.work_loop[k]);
             }
             if (name == "denoise_evidence_next") {
                 c.evidence_next.observe(c.sc.loop_before[k]);

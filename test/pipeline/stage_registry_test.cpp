@@ -78,6 +78,7 @@ TEST(StageRegistry, EachStageOwnsItsKeys) {
                                         "next_scan",
                                         "veil",
                                         "track_alignment",
+                                        "track_raw_alignment",
                                         "spikes",
                                         "keep_surfaces",
                                         "surface_min_beams",

@@ -241,7 +241,7 @@ EvidenceFilter::Projection EvidenceFilter::rawProjection(const Scan& scan, const
     Projection pr;
     Pose2D d;  // this scan's sensor in the raw scan's frame
     double spread = 0.0;
-    if (trackedStep(scan, ref, d)) {  // the tracker aligned both: its residual is the spread
+    if (trackedStep(scan, ref, d, true)) {  // the tracker placed both: its residual is the spread
         if (!projection(ref, d, sigma).usable) return pr;
         spread = std::max(tracked_->rms_m, ref.track.rms_m);
     } else {
@@ -652,7 +652,7 @@ EvidenceFilter::Projection EvidenceFilter::keyframeProjection(const Scan& scan, 
     const Reference& r0 = refs_[0];
     if (!r0.present || r0.geometry != scan.geometry) return p0;
     Pose2D d;
-    const bool tracked = trackedStep(scan, r0, d);  // else from odometry, then refined
+    const bool tracked = trackedStep(scan, r0, d, false);  // else from odometry, then refined
     if (!tracked && scan.odometry && r0.has_odom)
         d = between(r0.odom, compose(*scan.odometry, scan.sensor_pose));
     else if (!tracked && (scan.odometry || r0.has_odom))
@@ -797,8 +797,10 @@ void EvidenceFilter::keepAsReference(const Scan& scan) {
     r.track = SensorTrack::of(scan, tracked_);
 }
 
-bool EvidenceFilter::trackedStep(const Scan& scan, const Reference& ref, Pose2D& d) const {
-    if (!params_.track_alignment || tracked_ == nullptr || !ref.track.present) return false;
+bool EvidenceFilter::trackedStep(const Scan& scan, const Reference& ref, Pose2D& d,
+                                 bool raw) const {
+    const bool use = params_.track_alignment || (raw && params_.track_raw_alignment);
+    if (!use || tracked_ == nullptr || !ref.track.present) return false;
     d = between(ref.track.pose, compose(tracked_->pose, scan.sensor_pose));
     return true;
 }

@@ -59,6 +59,8 @@ struct PointToLineSystem;  // kfd/algorithms/point_to_line.h
 ///     m = 3 max(sqrt(2) sigma, s) + motion_error_fraction x translation
 ///         + range x motion_error_fraction x rotation,
 ///     s = 1.4826 x the median |point-to-line residual| of the alignment's last iteration.
+///     Where the track stage placed both scans (track_raw_alignment, on) their two tracked
+///     poses place it instead and s is the larger of the two fits' RMS residuals.
 ///     Its verdict (free or supported) comes first; the keyframes decide what it left unknown
 ///     (and may still call a free return tracked); older raw scans only add support. Without
 ///     a usable alignment (too few pairs, no common odometry frame) it is not used.
@@ -135,6 +137,12 @@ class EvidenceFilter {
         /// better and costs 34 % fewer instructions, but ICP-SLAM after it is significantly
         /// worse on mit-csail (docs/RESULTS.md, issue 39).
         bool track_alignment = false;
+        /// The same for the raw scan just before a keyframe only (step 3b: one scan step away,
+        /// where odometry glitches most), the keyframe before it still aligned by the denoiser
+        /// (step 3). On: better recall and more real returns kept on every SICK log, 50 000
+        /// fewer instructions per 1081-beam keyframe, ICP-SLAM after it not significantly
+        /// different (docs/RESULTS.md, issue 39). Implied by track_alignment.
+        bool track_raw_alignment = true;
         std::size_t refine_iterations = 3;  // Gauss-Newton steps aligning to the keyframe
         std::size_t refine_samples = 128;   // returns used per step (every n/128-th)
         double refine_gate_m = 1.0;         // m: pairing gate of the first step (halved after)
@@ -343,9 +351,10 @@ class EvidenceFilter {
     // Step 3c: the next scan (next_) as a projection, converted into next_ref_.
     Projection nextProjection(const Scan& scan, double sigma, Result& res);
     void keepRaw(const Scan& scan, const Tracked* tracked);
-    // With track_alignment, where both this scan (tracked_) and `ref` were tracked: d = this
-    // scan's sensor in ref's frame from the two tracked poses, and true.
-    bool trackedStep(const Scan& scan, const Reference& ref, Pose2D& d) const;
+    // With track_alignment (or track_raw_alignment and a raw reference), where both this scan
+    // (tracked_) and `ref` were tracked: d = this scan's sensor in ref's frame from the two
+    // tracked poses, and true.
+    bool trackedStep(const Scan& scan, const Reference& ref, Pose2D& d, bool raw) const;
     bool trackedMotion(const Reference& ref, float qx, float qy, float rho, std::size_t k0) const;
     void keepAsReference(const Scan& scan);
     // Step 4: marks noise segments; returns the returns it would remove.
