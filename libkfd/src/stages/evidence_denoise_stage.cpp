@@ -69,8 +69,8 @@ std::vector<StageKey> optionKeys() {
                          "by its poses instead of the denoiser's own alignment",
                          [](P& p) -> bool& { return p.track_alignment; }),
         keys::boolean<P>("track_raw_alignment", "track_raw_alignment",
-                         "the same for the raw scans around a keyframe only (the scan just "
-                         "before); the keyframe before it still aligned by the denoiser",
+                         "the same for the raw scans kept before a keyframe only "
+                         "(temporal_scans); the keyframe before it still aligned by the denoiser",
                          [](P& p) -> bool& { return p.track_raw_alignment; }),
         keys::boolean<P>("spikes", "spikes",
                          "remove a return beyond both neighbours' ranges that the temporal "

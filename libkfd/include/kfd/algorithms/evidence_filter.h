@@ -137,8 +137,9 @@ class EvidenceFilter {
         /// better and costs 34 % fewer instructions, but ICP-SLAM after it is significantly
         /// worse on mit-csail (docs/RESULTS.md, issue 39).
         bool track_alignment = false;
-        /// The same for the raw scan just before a keyframe only (step 3b: one scan step away,
-        /// where odometry glitches most), the keyframe before it still aligned by the denoiser
+        /// The same for the raw scans kept before a keyframe only (step 3b, temporal_scans; the
+        /// newest one scan step away, where odometry glitches most; not the next scan of step
+        /// 3c, which is not tracked yet), the keyframe before it still aligned by the denoiser
         /// (step 3). On: better recall and more real returns kept on every SICK log, 50 000
         /// fewer instructions per 1081-beam keyframe, ICP-SLAM after it not significantly
         /// different (docs/RESULTS.md, issue 39). Implied by track_alignment.
