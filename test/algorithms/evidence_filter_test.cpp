@@ -546,6 +546,71 @@ TEST(EvidenceFilter, TrackRawAlignmentPlacesTheRawScanByTheTrackerAndAlignsTheKe
     }
 }
 
+// A chair leg (one beam) 2 m ahead in a keyframe; the next keyframe 0.1 m on, both tracked
+// there; the odometry slipped (it says 1.5 m, beyond the alignment's 1 m first gate).
+struct SlippedKeyframe {
+    Scan second = test::flatWall(361, deg2rad(150.0), 3.9);
+    EvidenceFilter::Result r;
+};
+
+SlippedKeyframe filterASlippedKeyframe(const EvidenceFilter::Params& p) {
+    EvidenceFilter f(p);
+    Clusters c;
+    Scan first = room();
+    test::insertSpike(first, 180, 2.0);
+    const auto t0 = trackedAt(0.0), t1 = trackedAt(0.1);
+    f.filter(first, c, nullptr, &t0);
+    SlippedKeyframe out;
+    out.second.odometry = Pose2D{1.5, 0.0, 0.0};
+    test::insertSpike(out.second, 180, 1.9);
+    out.r = f.filter(out.second, c, nullptr, &t1);
+    return out;
+}
+
+TEST(EvidenceFilter, TrackKeyframeStartAlignsTheKeyframeFromTheTrackersStepNotOdometry) {
+    // On: the denoiser's own alignment starts from the tracker's 0.1 m and runs its last
+    // step; the keyframe before saw the leg there: kept. Off (the default): it starts from the
+    // slipped odometry, no return pairs within the gate, the step stays wrong and the leg,
+    // supported by nothing, goes as a lone return.
+    for (const bool start : {true, false}) {
+        EvidenceFilter::Params p = withRecent(0);  // the keyframes alone: no raw scan before
+        p.track_keyframe_start = start;
+        const auto [second, r] = filterASlippedKeyframe(p);
+        EXPECT_TRUE(r.temporal);
+        EXPECT_EQ(r.refined, start);
+        EXPECT_EQ(second.valid[180], start ? 1 : 0);
+    }
+}
+
+TEST(EvidenceFilter, WithNoTrackedRefineIterationsTheTrackersStepIsUsedAsItIs) {
+    EvidenceFilter::Params p = withRecent(0);
+    p.track_keyframe_start = true;
+    p.tracked_refine_iterations = 0;
+    const auto [second, r] = filterASlippedKeyframe(p);
+    EXPECT_FALSE(r.refined);
+    EXPECT_EQ(second.valid[180], 1);
+}
+
+TEST(EvidenceFilter, WithoutOdometryTheTrackersStepStartsTheAlignment) {
+    // Laser only, the sensor 1.2 m on (a walking sensor between keyframes), the leg 2 m from
+    // where the keyframe before was. Tracked (by default, track_keyframe_start off): the
+    // alignment starts from the tracker's step and the leg is supported. Not tracked: from
+    // zero motion it finds no pairs and the keyframe's beam seems to pass through the leg.
+    for (const bool tracked : {true, false}) {
+        EvidenceFilter f(withRecent(0));
+        Clusters c;
+        Scan first = room(std::nullopt);
+        test::insertSpike(first, 180, 2.0);
+        const auto t0 = trackedAt(0.0), t1 = trackedAt(1.2);
+        f.filter(first, c, nullptr, tracked ? &t0 : nullptr);
+        Scan second = test::flatWall(361, deg2rad(150.0), 2.8);
+        test::insertSpike(second, 180, 0.8);
+        const auto r = f.filter(second, c, nullptr, tracked ? &t1 : nullptr);
+        EXPECT_EQ(r.refined, tracked);
+        EXPECT_EQ(second.valid[180], tracked ? 1 : 0);
+    }
+}
+
 TEST(EvidenceFilter, AReferenceTheTrackerDidNotPlaceIsAlignedByTheDenoiser) {
     // The keyframe before was not tracked (the first scan, a lost track): odometry and the
     // denoiser's own alignment place it, as without a tracker.
@@ -756,6 +821,9 @@ TEST(EvidenceFilter, BadParametersAreRejected) {
     bad([](auto& p) { p.moving_object_m = std::numeric_limits<double>::infinity(); });
     bad([](auto& p) { p.max_step_m = 0.0; });
     bad([](auto& p) { p.refine_samples = 0; });
+    bad([](auto& p) { p.tracked_refine_iterations = 4; });  // more than refine_iterations (3)
+    bad([](auto& p) { p.tracked_refine_samples = 0; });
+    bad([](auto& p) { p.tracked_refine_samples = 129; });  // more than refine_samples (128)
     bad([](auto& p) { p.max_removed_fraction = 0.0; });
     bad([](auto& p) { p.max_removed_fraction = 1.5; });
     bad([](auto& p) { p.max_confirmed_fraction = -0.1; });

@@ -83,6 +83,14 @@ kfd::Pipeline::Params rawTrackedParams() {
     return p;
 }
 
+// The same with the keyframe's own alignment started from their poses (track_keyframe_start,
+// off by default; on by itself where the scans carry no odometry).
+kfd::Pipeline::Params keyframeStartParams() {
+    kfd::Pipeline::Params p = rawTrackedParams();
+    p.get<kfd::EvidenceDenoiseStage>().track_keyframe_start = true;
+    return p;
+}
+
 // The same with the scan just after each keyframe too (next_scan, issue 25).
 kfd::Pipeline::Params nextScanParams() {
     kfd::Pipeline::Params p = temporalParams();
@@ -116,6 +124,8 @@ struct Context {
         trackedParams().get<kfd::EvidenceDenoiseStage>()};
     kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_raw_tracked{
         rawTrackedParams().get<kfd::EvidenceDenoiseStage>()};
+    kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_keyframe_start{
+        keyframeStartParams().get<kfd::EvidenceDenoiseStage>()};
     kb::StageFilter<kfd::EvidenceDenoiseStage> evidence_next{
         nextScanParams().get<kfd::EvidenceDenoiseStage>()};
     kfd::DbscanFilter dbscan{kfd::DbscanFilter::Params{0.7, 10}};
@@ -140,6 +150,7 @@ struct Context {
     Context() {
         evidence_tracked.trackAtOdometry(0.01f);
         evidence_raw_tracked.trackAtOdometry(0.01f);
+        evidence_keyframe_start.trackAtOdometry(0.01f);
         hist.resize(sc.keyframes.size());
         for (std::size_t k = 0; k < hist.size(); ++k) histogram.compute(sc.keyframes[k], hist[k]);
         for (const auto& s : sc.prefix) selector.filter(s);
@@ -233,6 +244,18 @@ __attribute__((noinline)) void kfd_ir_denoise_evidence_raw_tracked(Context& c, s
     kfd_ir_evidence_observe_raw_tracked(c, k);
     kfd_ir_denoise_evidence_raw_tracked_keyframe(c, k);
 }
+// The same with the keyframe's alignment started from the tracker's step (track_keyframe_start).
+__attribute__((noinline)) void kfd_ir_evidence_observe_keyframe_start(Context& c, std::size_t k) {
+    c.evidence_keyframe_start.observe(c.sc.loop_before[k]);
+}
+__attribute__((noinline)) void kfd_ir_denoise_evidence_keyframe_start_keyframe(Context& c,
+                                                                               std::size_t k) {
+    c.sink += c.evidence_keyframe_start.filter(c.work_loop[k]).points_removed;
+}
+__attribute__((noinline)) void kfd_ir_denoise_evidence_keyframe_start(Context& c, std::size_t k) {
+    kfd_ir_evidence_observe_keyframe_start(c, k);
+    kfd_ir_denoise_evidence_keyframe_start_keyframe(c, k);
+}
 // The same keyframe confirmed against the scan just after it too (next_scan): the observe
 // of the scan before and the keyframe's filter with both raw scans.
 __attribute__((noinline)) void kfd_ir_denoise_evidence_next_keyframe(Context& c, std::size_t k) {
@@ -308,6 +331,7 @@ const Case kCases[] = {
     {"denoise_evidence_temporal", kfd_ir_denoise_evidence_temporal, false, true},
     {"denoise_evidence_tracked", kfd_ir_denoise_evidence_tracked, false, true},
     {"denoise_evidence_raw_tracked", kfd_ir_denoise_evidence_raw_tracked, false, true},
+    {"denoise_evidence_keyframe_start", kfd_ir_denoise_evidence_keyframe_start, false, true},
     {"denoise_evidence_next", kfd_ir_denoise_evidence_next, false, true},
     {"speckle_loop", kfd_ir_speckle_loop, false, true},
     {"shadow_loop", kfd_ir_shadow_loop, false, true},
@@ -343,6 +367,10 @@ void warmUp(Context& c, const Case& cs) {
             if (name == "denoise_evidence_raw_tracked") {
                 c.evidence_raw_tracked.observe(c.sc.loop_before[k]);
                 c.evidence_raw_tracked.filter(c.work_loop[k]);
+            }
+            if (name == "denoise_evidence_keyframe_start") {
+                c.evidence_keyframe_start.observe(c.sc.loop_before[k]);
+                c.evidence_keyframe_start.filter(c.work_loop[k]);
             }
             if (name == "denoise_evidence_next") {
                 c.evidence_next.observe(c.sc.loop_before[k]);

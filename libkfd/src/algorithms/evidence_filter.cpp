@@ -126,6 +126,11 @@ void EvidenceFilter::initialize(const Params& p) {
     if (p.refine_iterations > 20 || p.refine_samples < 1 || !(p.refine_gate_m > 0.0) ||
         !std::isfinite(p.refine_gate_m))
         throw ParameterError("refine", "refine_iterations <= 20, refine_samples >= 1, gate > 0");
+    if (p.tracked_refine_iterations > p.refine_iterations ||
+        p.tracked_refine_samples > p.refine_samples || p.tracked_refine_samples < 1)
+        throw ParameterError("tracked_refine",
+                             "tracked_refine_iterations <= refine_iterations, "
+                             "1 <= tracked_refine_samples <= refine_samples");
     if (!(p.max_removed_fraction > 0.0 && p.max_removed_fraction <= 1.0))
         throw ParameterError("max_removed_fraction", "max_removed_fraction must be in (0, 1]");
     if (!(p.max_confirmed_fraction >= 0.0 && p.max_confirmed_fraction <= 1.0))
@@ -534,15 +539,16 @@ bool EvidenceFilter::trackedMotion(const Reference& ref, float qx, float qy, flo
     return false;
 }
 
-bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& d,
-                                double* spread) const {
+bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& d, double* spread,
+                                std::size_t skip, std::size_t samples) const {
     // Projective point-to-line alignment: each sampled return is projected into the reference
     // scan and paired with the reference segment between its two bracketing beams (when they
     // are one surface); Gauss-Newton on the distances to those lines corrects the step. The
     // gate halves per iteration down to 0.1 m; too few pairs keep the step as it is.
     const std::size_t n = scan.range.size(), rn = ref.range.size();
-    if (params_.refine_iterations == 0 || rn < 2) return false;
-    const std::size_t stride = std::max<std::size_t>(1, n / params_.refine_samples);
+    if (params_.refine_iterations <= skip || rn < 2) return false;
+    const std::size_t stride =
+        std::max<std::size_t>(1, n / (samples > 0 ? samples : params_.refine_samples));
     // The sampled returns, gathered once; per iteration their projections and bracket
     // positions in one omp simd pass, then the pairs.
     const std::size_t cap = n / stride + 1;  // within the capacity reserved by initialize()
@@ -556,9 +562,9 @@ bool EvidenceFilter::refineStep(const Scan& scan, const Reference& ref, Pose2D& 
     const std::size_t m = sampleReturns(scan, stride, sx, sy);
     float* spread_of = nullptr;  // the residuals the spread is taken of (the last system used)
     std::size_t spread_n = 0;
-    double gate = params_.refine_gate_m;
+    double gate = std::max(std::ldexp(params_.refine_gate_m, -static_cast<int>(skip)), 0.1);
     bool changed = false;
-    for (std::size_t it = 0; it < params_.refine_iterations; ++it) {
+    for (std::size_t it = skip; it < params_.refine_iterations; ++it) {
         const float c = static_cast<float>(std::cos(d.phi)),
                     s = static_cast<float>(std::sin(d.phi));
         projectPoints(m, sx, sy, c, s, static_cast<float>(d.x), static_cast<float>(d.y), first_,
@@ -646,19 +652,28 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
 
 EvidenceFilter::Projection EvidenceFilter::keyframeProjection(const Scan& scan, double sigma,
                                                               Result& res) {
-    // This scan's sensor in the newest keyframe's frame: the tracker's step where it placed
-    // both, else the odometry step (no motion without odometry), refined.
+    // This scan's sensor in the newest keyframe's frame (track_alignment: the tracker's step
+    // where it placed both), refined from a start: the odometry step where both scans carry
+    // odometry (and track_keyframe_start is off), else the tracker's step where it placed both
+    // (its alignment did the schedule's first steps), else zero motion (laser only).
     Projection p0;
     const Reference& r0 = refs_[0];
     if (!r0.present || r0.geometry != scan.geometry) return p0;
     Pose2D d;
-    const bool tracked = trackedStep(scan, r0, d, false);  // else from odometry, then refined
-    if (!tracked && scan.odometry && r0.has_odom)
+    const bool tracked = trackedStep(scan, r0, d, false);
+    const bool odometry = scan.odometry && r0.has_odom;
+    const bool start =
+        !tracked && (params_.track_keyframe_start || !odometry) && placedByTracker(scan, r0, d);
+    const std::size_t skip =
+        start ? params_.refine_iterations - params_.tracked_refine_iterations : 0;
+    if (!tracked && !start && odometry)
         d = between(r0.odom, compose(*scan.odometry, scan.sensor_pose));
-    else if (!tracked && (scan.odometry || r0.has_odom))
+    else if (!tracked && !start && (scan.odometry || r0.has_odom))
         return p0;  // odometry appeared or vanished: no common frame
     if (!projection(r0, d, sigma).usable) return p0;
-    if (!tracked) res.refined = refineStep(scan, r0, d);
+    if (!tracked)
+        res.refined =
+            refineStep(scan, r0, d, nullptr, skip, start ? params_.tracked_refine_samples : 0);
     p0 = projection(r0, d, sigma);
     pose_ = compose(r0.pose, d);
     have_pose_ = true;
@@ -800,7 +815,11 @@ void EvidenceFilter::keepAsReference(const Scan& scan) {
 bool EvidenceFilter::trackedStep(const Scan& scan, const Reference& ref, Pose2D& d,
                                  bool raw) const {
     const bool use = params_.track_alignment || (raw && params_.track_raw_alignment);
-    if (!use || tracked_ == nullptr || !ref.track.present) return false;
+    return use && placedByTracker(scan, ref, d);
+}
+
+bool EvidenceFilter::placedByTracker(const Scan& scan, const Reference& ref, Pose2D& d) const {
+    if (tracked_ == nullptr || !ref.track.present) return false;
     d = between(ref.track.pose, compose(tracked_->pose, scan.sensor_pose));
     return true;
 }

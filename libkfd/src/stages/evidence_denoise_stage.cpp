@@ -72,6 +72,17 @@ std::vector<StageKey> optionKeys() {
                          "the same for the raw scans kept before a keyframe only "
                          "(temporal_scans); the keyframe before it still aligned by the denoiser",
                          [](P& p) -> bool& { return p.track_raw_alignment; }),
+        keys::boolean<P>("track_keyframe_start", "track_keyframe_start",
+                         "where the track stage placed a keyframe and the one before, start the "
+                         "denoiser's own alignment between them from its poses, not odometry "
+                         "(without odometry: always)",
+                         [](P& p) -> bool& { return p.track_keyframe_start; }),
+        keys::count<P>("tracked_refine_iterations", "tracked_refine_iterations",
+                       "... and run only the last this many of its 3 Gauss-Newton steps", 0, 3,
+                       [](P& p) -> std::size_t& { return p.tracked_refine_iterations; }),
+        keys::count<P>("tracked_refine_samples", "tracked_refine_samples",
+                       "... with this many of a keyframe's returns per step (of 128)", 1, 128,
+                       [](P& p) -> std::size_t& { return p.tracked_refine_samples; }),
         keys::boolean<P>("spikes", "spikes",
                          "remove a return beyond both neighbours' ranges that the temporal "
                          "evidence does not support",

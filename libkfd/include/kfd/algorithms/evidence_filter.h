@@ -144,9 +144,20 @@ class EvidenceFilter {
         /// fewer instructions per 1081-beam keyframe, ICP-SLAM after it not significantly
         /// different (docs/RESULTS.md, issue 39). Implied by track_alignment.
         bool track_raw_alignment = true;
-        std::size_t refine_iterations = 3;  // Gauss-Newton steps aligning to the keyframe
-        std::size_t refine_samples = 128;   // returns used per step (every n/128-th)
-        double refine_gate_m = 1.0;         // m: pairing gate of the first step (halved after)
+        /// Step 3's keyframe alignment (track_alignment off), where the track stage placed this
+        /// scan and the keyframe and the scans carry no odometry (a moving sensor, laser only:
+        /// always), or with track_keyframe_start also where they do: it starts from the
+        /// tracker's step instead of odometry's (or zero motion) and runs only the last
+        /// tracked_refine_iterations steps of the schedule, with tracked_refine_samples returns
+        /// (the gate already halved for the steps skipped). 198 000 instructions per 1081-beam
+        /// keyframe instead of 241 000 and more real returns kept, but ICP-SLAM after it drifts
+        /// on mit-csail in every run, as with track_alignment: off (docs/RESULTS.md, issue 39).
+        bool track_keyframe_start = false;
+        std::size_t tracked_refine_iterations = 1;  // <= refine_iterations
+        std::size_t tracked_refine_samples = 32;    // <= refine_samples: returns per step then
+        std::size_t refine_iterations = 3;          // Gauss-Newton steps aligning to the keyframe
+        std::size_t refine_samples = 128;           // returns used per step (every n/128-th)
+        double refine_gate_m = 1.0;  // m: pairing gate of the first step (halved after)
         /// Largest share of a scan's valid returns removed (step 5), in (0, 1]; 1 = no bound.
         /// 5 %: issue 22's bound; real bursts cover 0.3-1.2 % of a log's returns (CHANGELOG).
         double max_removed_fraction = 0.05;
@@ -329,8 +340,10 @@ class EvidenceFilter {
     std::uint8_t classifyAt(const Projection& pr, float qx, float qy, float u,
                             bool free_test) const;
     // `spread` (optional): 1.4826 x the median |residual| of the last iteration's pairs (m).
-    bool refineStep(const Scan& scan, const Reference& ref, Pose2D& d,
-                    double* spread = nullptr) const;
+    // `skip`: the schedule's first steps already done (by the tracker): not run, gate halved;
+    // then `samples` returns per step (0: refine_samples).
+    bool refineStep(const Scan& scan, const Reference& ref, Pose2D& d, double* spread = nullptr,
+                    std::size_t skip = 0, std::size_t samples = 0) const;
     // refineStep's samples: every stride-th valid return's point into (sx, sy); how many.
     std::size_t sampleReturns(const Scan& scan, std::size_t stride, float* sx, float* sy) const;
     // refineStep's pairs: each projected sample (qx, qy at bracket position u in ref) within
@@ -356,6 +369,8 @@ class EvidenceFilter {
     // (tracked_) and `ref` were tracked: d = this scan's sensor in ref's frame from the two
     // tracked poses, and true.
     bool trackedStep(const Scan& scan, const Reference& ref, Pose2D& d, bool raw) const;
+    // Where both this scan and `ref` were tracked: d from the two tracked poses, and true.
+    bool placedByTracker(const Scan& scan, const Reference& ref, Pose2D& d) const;
     bool trackedMotion(const Reference& ref, float qx, float qy, float rho, std::size_t k0) const;
     void keepAsReference(const Scan& scan);
     // Step 4: marks noise segments; returns the returns it would remove.
