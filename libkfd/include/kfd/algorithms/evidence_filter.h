@@ -36,9 +36,12 @@ struct PointToLineSystem;  // kfd/algorithms/point_to_line.h
 ///     the second test keeps far walls seen at grazing angles in one piece, which the
 ///     breakpoint (and laser_filters' shadow filter) cut into single points.
 ///  3. Temporal evidence from the last two keyframes this filter saw. The step from the newest
-///     comes from odometry (or zero motion when the scans carry none), refined by a projective
-///     point-to-line alignment (refine_iterations x refine_samples returns). Each return is
-///     moved into the keyframe's sensor frame and compared with the beams bracketing it:
+///     comes from odometry, refined by a projective point-to-line alignment (refine_iterations
+///     x refine_samples returns); where the scans carry no odometry it starts from the step of
+///     the track stage's poses when it placed both (its last tracked_refine_iterations x
+///     tracked_refine_samples only; track_keyframe_start: also with odometry), else from zero
+///     motion. Each return is moved into the keyframe's sensor frame and compared with the
+///     beams bracketing it:
 ///     - free: both bracketing beams reached beyond it by more than m: the keyframe saw
 ///       through this place (an outlier, or a moving object: a free return within
 ///       moving_object_m of a return that was free in the keyframe is "tracked" and kept);
