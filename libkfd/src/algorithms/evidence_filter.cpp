@@ -666,10 +666,12 @@ EvidenceFilter::Projection EvidenceFilter::keyframeProjection(const Scan& scan, 
         !tracked && (params_.track_keyframe_start || !odometry) && placedByTracker(scan, r0, d);
     const std::size_t skip =
         start ? params_.refine_iterations - params_.tracked_refine_iterations : 0;
-    if (!tracked && !start && odometry)
-        d = between(r0.odom, compose(*scan.odometry, scan.sensor_pose));
-    else if (!tracked && !start && (scan.odometry || r0.has_odom))
-        return p0;  // odometry appeared or vanished: no common frame
+    if (!tracked && !start) {
+        if (odometry)
+            d = between(r0.odom, compose(*scan.odometry, scan.sensor_pose));
+        else if (scan.odometry || r0.has_odom)
+            return p0;  // odometry appeared or vanished: no common frame
+    }
     if (!projection(r0, d, sigma).usable) return p0;
     if (!tracked)
         res.refined =
