@@ -343,6 +343,18 @@ TEST(Config, BadViewSelectorKeysAreErrorsNamingTheKey) {
     }
 }
 
+TEST(Config, BadKeyframeAlignmentKeysAreErrorsNamingTheKey) {
+    // Issue 39's seventh step: the evidence denoiser's start from the tracker's poses.
+    EXPECT_EQ(errorKey("[KFD]\ntrack_keyframe_start = sometimes\n"), "track_keyframe_start");
+    EXPECT_EQ(errorKey("[KFD]\ntracked_refine_iterations = 4\n"), "tracked_refine_iterations");
+    EXPECT_EQ(errorKey("[KFD]\ntracked_refine_iterations = 1.5\n"), "tracked_refine_iterations");
+    EXPECT_EQ(errorKey("[KFD]\ntracked_refine_samples = 0\n"), "tracked_refine_samples");
+    EXPECT_EQ(errorKey("[KFD]\ntracked_refine_samples = 129\n"), "tracked_refine_samples");
+    EXPECT_EQ(errorKey("[KFD]\ntrack_keyframe_start = true\ntracked_refine_iterations = 0\n"
+                       "tracked_refine_samples = 1\n"),
+              "<no error>");
+}
+
 TEST(Config, KeyTableIsDerivedFromTheStageRegistry) {
     const auto& reg = kfd::defaultStageRegistry();
     std::vector<std::string> want{"pipeline", "selector", "variant"};  // then each key once
