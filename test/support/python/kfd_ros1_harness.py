@@ -101,6 +101,20 @@ def free_port():
         return s.getsockname()[1]
 
 
+class _TimeoutTransport(xmlrpc.client.Transport):
+    """An XML-RPC transport whose calls give up after `timeout` s: a port that accepts and
+    never answers (a process other than rosmaster on it) would block a plain ServerProxy."""
+
+    def __init__(self, timeout):
+        super().__init__()
+        self._timeout = timeout
+
+    def make_connection(self, host):
+        conn = super().make_connection(host)
+        conn.timeout = self._timeout
+        return conn
+
+
 def scans_of(bag_path, topic):
     import rosbag
     with rosbag.Bag(bag_path) as b:
@@ -149,19 +163,37 @@ class RosCase(unittest.TestCase):
         _TAGS.add(self.tmp)
         self.addCleanup(_TAGS.discard, self.tmp)
         self.addCleanup(_kill_tagged, self.tmp)  # runs after the groups are stopped
-        port = free_port()
-        self.uri = "http://127.0.0.1:%d" % port
-        self.env = dict(os.environ)
-        for k in ("ROS_HOSTNAME", "ROS_NAMESPACE"):
-            self.env.pop(k, None)
-        self.env.update(ROS_MASTER_URI=self.uri, ROS_IP="127.0.0.1",
-                        ROS_HOME=os.path.join(self.tmp, "ros_home"),
-                        ROS_LOG_DIR=os.path.join(self.tmp, "ros_log"))
-        self.master = xmlrpc.client.ServerProxy(self.uri)
-        self.addCleanup(self.master("close"))
-        self.start("roscore", ["roscore", "-p", str(port)])
-        self.wait_for(lambda: self.master.getSystemState("/kfd_test")[0] == 1, 30,
-                      "roscore on " + self.uri)
+        self.start_roscore()
+
+    def start_roscore(self, attempts=3, seconds=45):
+        """A roscore of its own on a free port (self.uri, self.master, self.env). The port is
+        free when chosen but another test's ROS node may bind it before rosmaster does (CI
+        runs two tests at a time): when roscore exits or does not answer, it tries again on
+        another port, and a last failure shows roscore's log."""
+        for attempt in range(1, attempts + 1):
+            port = free_port()
+            self.uri = "http://127.0.0.1:%d" % port
+            self.env = dict(os.environ)
+            for k in ("ROS_HOSTNAME", "ROS_NAMESPACE"):
+                self.env.pop(k, None)
+            self.env.update(ROS_MASTER_URI=self.uri, ROS_IP="127.0.0.1",
+                            ROS_HOME=os.path.join(self.tmp, "ros_home"),
+                            ROS_LOG_DIR=os.path.join(self.tmp, "ros_log"))
+            self.master = xmlrpc.client.ServerProxy(self.uri, transport=_TimeoutTransport(10))
+            self.addCleanup(self.master("close"))
+            name = "roscore" if attempt == 1 else "roscore%d" % attempt
+            core = self.start(name, ["roscore", "-p", str(port)])
+            end = time.monotonic() + seconds
+            while time.monotonic() < end and core.poll() is None:
+                try:
+                    if self.master.getSystemState("/kfd_test")[0] == 1:
+                        return
+                except (ConnectionError, OSError, xmlrpc.client.Fault):
+                    pass
+                time.sleep(0.1)
+            _kill_group(core)
+        self.fail("roscore did not answer on %s in %d attempts; its log:\n%s"
+                  % (self.uri, attempts, self.log_of(name)))
 
 
     def stop_recording(self, recorder, out, stats_topic, filtered_topic):
