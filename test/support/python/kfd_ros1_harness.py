@@ -167,9 +167,9 @@ class RosCase(unittest.TestCase):
 
     def start_roscore(self, attempts=3, seconds=45):
         """A roscore of its own on a free port (self.uri, self.master, self.env). The port is
-        free when chosen but another test's ROS node may bind it before rosmaster does (CI
-        runs two tests at a time): when roscore exits or does not answer, it tries again on
-        another port, and a last failure shows roscore's log."""
+        free when chosen, but another process may bind it before rosmaster does, and CI once
+        saw a roscore that never answered (its log was not kept): when roscore exits or does
+        not answer, it tries again on another port, and a last failure shows roscore's log."""
         for attempt in range(1, attempts + 1):
             port = free_port()
             self.uri = "http://127.0.0.1:%d" % port
