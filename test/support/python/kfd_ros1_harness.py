@@ -183,14 +183,9 @@ class RosCase(unittest.TestCase):
             self.addCleanup(self.master("close"))
             name = "roscore" if attempt == 1 else "roscore%d" % attempt
             core = self.start(name, ["roscore", "-p", str(port)])
-            end = time.monotonic() + seconds
-            while time.monotonic() < end and core.poll() is None:
-                try:
-                    if self.master.getSystemState("/kfd_test")[0] == 1:
-                        return
-                except (ConnectionError, OSError, xmlrpc.client.Fault):
-                    pass
-                time.sleep(0.1)
+            if self.poll_until(lambda: self.master.getSystemState("/kfd_test")[0] == 1, seconds,
+                         lambda: core.poll() is None):
+                return
             _kill_group(core)
         self.fail("roscore did not answer on %s in %d attempts; its log:\n%s"
                   % (self.uri, attempts, self.log_of(name)))
@@ -225,16 +220,23 @@ class RosCase(unittest.TestCase):
         except OSError:
             return ""
 
-    def wait_for(self, cond, seconds, what):
+    @staticmethod
+    def poll_until(cond, seconds, alive=lambda: True):
+        """True once cond() holds, checked every 0.1 s (a connection or XML-RPC error counts
+        as not yet); False after `seconds`, or as soon as alive() is false."""
         end = time.monotonic() + seconds
-        while time.monotonic() < end:
+        while time.monotonic() < end and alive():
             try:
                 if cond():
-                    return
+                    return True
             except (ConnectionError, OSError, xmlrpc.client.Fault):
                 pass
             time.sleep(0.1)
-        self.fail("timed out waiting for " + (what() if callable(what) else what))
+        return False
+
+    def wait_for(self, cond, seconds, what):
+        if not self.poll_until(cond, seconds):
+            self.fail("timed out waiting for " + (what() if callable(what) else what))
 
     def graph(self):
         _, _, (pubs, subs, _) = self.master.getSystemState("/kfd_test")
