@@ -333,12 +333,37 @@ TEST(EvidenceFilter, ASpikeNearAWallIsRemovedWithTheScanJustBeforeTheKeyframe) {
         EXPECT_TRUE(r.temporal);
         EXPECT_EQ(r.recent, kept > 0);
         if (kept == 0) {
-            EXPECT_EQ(second.valid[180], 1);  // the wide keyframe margin supports it
-            EXPECT_EQ(r.points_removed, 0u);
+            // The keyframe saw a smooth wall there: that supports the wall, not the spike.
+            EXPECT_EQ(second.valid[180], 0);
+            EXPECT_EQ(r.spikes, 1u);
         } else {
             EXPECT_EQ(second.valid[180], 0);
             EXPECT_EQ(r.points_removed, 1u);
             EXPECT_NEAR(r.recent_margin_m, 3.0 * std::sqrt(2.0) * 0.01, 1e-6);  // sigma-bound
+        }
+    }
+}
+
+TEST(EvidenceFilter, ASpikeTheKeyframeSawAsAnObjectTooIsKept) {
+    // The same spike 0.12 m before the wall, without the scan just before: kept where the
+    // keyframe 1 m back saw a return off its own wall there (a thin object seen twice), and,
+    // with spike_object_support off, where it saw only the wall within its wide margin.
+    for (const bool object : {false, true}) {
+        for (const bool object_support : {false, true}) {
+            EvidenceFilter::Params p = withRecent(0);
+            p.spike_object_support = object_support;
+            EvidenceFilter f(p);
+            Clusters c;
+            Scan first = room();
+            if (object) test::insertSpike(first, 180, 3.88);
+            f.filter(first, c);
+            Scan second = roomAfter(1.0);
+            test::insertSpike(second, 180, 2.88f);
+            const auto r = f.filter(second, c);
+            EXPECT_TRUE(r.temporal);
+            const bool kept = object || !object_support;
+            EXPECT_EQ(second.valid[180], kept ? 1 : 0) << object << object_support;
+            EXPECT_EQ(r.points_removed, kept ? 0u : 1u) << object << object_support;
         }
     }
 }

@@ -83,6 +83,7 @@ TEST(StageRegistry, EachStageOwnsItsKeys) {
                                         "tracked_refine_iterations",
                                         "tracked_refine_samples",
                                         "spikes",
+                                        "spike_object_support",
                                         "keep_surfaces",
                                         "surface_min_beams",
                                         "surface_sigmas"}));

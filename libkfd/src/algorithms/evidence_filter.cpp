@@ -646,6 +646,12 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
     recent_ev_.assign(pt.usable || pn.usable ? scan.range.size() : 0, kUnknown);
     const std::size_t listed = listReturnsToJudge(out);
     const std::size_t unknowns = judgeListed(out, listed, pt, pn, p0, res);
+    if (params_.spike_object_support && !spike_candidates_.empty()) {
+        object_support_.assign(scan.range.size(), 0);
+        markObjectSupport(pt);
+        markObjectSupport(pn);
+        markObjectSupport(p0);
+    }
     supportFromOlder(scan, out, sigma, unknowns, recent, res);
     return true;
 }
@@ -778,13 +784,20 @@ void EvidenceFilter::supportFromOlder(const Scan& scan, const Clusters& out, dou
                 ++res.supported;
             }
         }
+        if (params_.spike_object_support && !spike_candidates_.empty()) markObjectSupport(p);
     };
+    // A spike that only a smooth surface supported so far: an older view may have seen an
+    // object there.
+    bool pending = false;
+    if (params_.spike_object_support)
+        for (const std::uint32_t i : spike_candidates_)
+            pending = pending || (evidence_[i] == kSupported && !object_support_[i]);
     const Reference& r1 = refs_[1];
-    if (have_pose_ && r1.present && r1.geometry == scan.geometry && unknowns > 0) {
+    if (have_pose_ && r1.present && r1.geometry == scan.geometry && (unknowns > 0 || pending)) {
         const Projection p1 = projection(r1, between(r1.pose, pose_), sigma);
         if (p1.usable) support(p1);
     }
-    for (std::size_t age = 1; recent && age < raw_count_ && unknowns > 0; ++age) {
+    for (std::size_t age = 1; recent && age < raw_count_ && (unknowns > 0 || pending); ++age) {
         const Projection pa = recentProjection(scan, age, sigma, res);
         if (pa.usable) support(pa);
     }
@@ -857,6 +870,8 @@ EvidenceFilter::Result EvidenceFilter::filter(Scan& scan, Clusters& out) {
     res.sigma_measured = params_.sigma_m > 0.0 ? 0.0 : std::max(0.0, measured_smoothed_);
     segment(scan, sigma, out);
     res.segments = out.count();
+    spike_candidates_.clear();
+    if (params_.spikes) findSpikeCandidates(scan, sigma);
 
     // 3. Temporal evidence from the last two keyframes.
     evidence_.assign(n, kUnknown);
@@ -958,7 +973,7 @@ void EvidenceFilter::removeMarked(Scan& scan, const Clusters& out,
                 noise[label[i] + 1] | (free_counts & (ev[i] == kFree) & (line[i] == 0)));
     }
     // 4b. Spikes; 6. mixed pixels; 7. surfaces kept.
-    if (params_.spikes) res.spikes = markSpikes(scan, kept_ev, temporal, sigma, cap);
+    if (params_.spikes) res.spikes = markSpikes(scan, kept_ev, temporal, cap);
     if (params_.veil) res.veils = markVeils(scan, out, sigma, cap);
     if (params_.keep_surfaces) {
         SurfaceRunParams sp;
@@ -976,11 +991,10 @@ void EvidenceFilter::removeMarked(Scan& scan, const Clusters& out,
     res.points_removed += valid_in - scan.countValid();  // nothing changed valid since step 4
 }
 
-std::size_t EvidenceFilter::markSpikes(const Scan& scan, const std::vector<std::uint8_t>& kept_ev,
-                                       bool temporal, double sigma, std::size_t cap) {
+void EvidenceFilter::findSpikeCandidates(const Scan& scan, double sigma) {
     // A return nearer or farther than both neighbours by more than the pair margin, where the
     // neighbours are one surface across it (step 2's breakpoint test over two beams): a beam
-    // off the surface its neighbours agree on, off a line, that no reference supports.
+    // off the surface its neighbours agree on, off a line.
     const std::size_t n = scan.range.size();
     const Breakpoints bp = breakpoints(sigma);
     const float m = bp.noise;
@@ -988,9 +1002,10 @@ std::size_t EvidenceFilter::markSpikes(const Scan& scan, const std::vector<std::
     const float cos2 = std::cos(2.0f * res_);
     const float* r = scan.range.data();
     const std::uint8_t* v = scan.valid.data();
-    spikes_.clear();
-    if (n < 3) return 0;
-    // Candidates, branch-free: off both neighbours' ranges (most beams lie between them).
+    spike_candidates_.clear();
+    spike_margin_ = m;
+    if (n < 3) return;
+    // Branch-free: off both neighbours' ranges (most beams lie between them).
     off_.resize(n);  // beams 1 .. n - 2 written and read below
     std::uint8_t* off = off_.data();
 #pragma omp simd
@@ -1002,12 +1017,61 @@ std::size_t EvidenceFilter::markSpikes(const Scan& scan, const std::vector<std::
     for (std::size_t i = Scan::nextNonZero(off, 1, n - 1); i + 1 < n;
          i = Scan::nextNonZero(off, i + 1, n - 1)) {
         const float a = r[i - 1], b = r[i + 1];
-        const float lo = std::min(a, b);
-        if (!v[i - 1] || !v[i] || !v[i + 1] || line_[i] || remove_[i]) continue;
-        if (temporal && kept_ev[i] == kSupported) continue;
-        const float dmax = lo * factor2 + m;
+        if (!v[i - 1] || !v[i] || !v[i + 1] || line_[i]) continue;
+        const float dmax = std::min(a, b) * factor2 + m;
         if (a * a + b * b - 2.0f * a * b * cos2 > dmax * dmax) continue;  // not one surface
-        spikes_.push_back(static_cast<std::uint32_t>(i));
+        spike_candidates_.push_back(static_cast<std::uint32_t>(i));
+    }
+}
+
+void EvidenceFilter::markObjectSupport(const Projection& pr) {
+    if (!pr.usable) return;
+    for (const std::uint32_t i : spike_candidates_) {
+        // Only the supported ones: a reference that did not support a return (no return of
+        // it within the margin) cannot have seen an object there either.
+        if (evidence_[i] != kSupported || object_support_[i]) continue;
+        const float qx = pr.c * x_[i] - pr.s * y_[i] + pr.tx;
+        const float qy = pr.s * x_[i] + pr.c * y_[i] + pr.ty;
+        if (objectSupported(pr, qx, qy, (fastAtan2(qy, qx) - first_) * inv_step_))
+            object_support_[i] = 1;
+    }
+}
+
+bool EvidenceFilter::objectSupported(const Projection& pr, float qx, float qy, float u) const {
+    // classifyAt's support by a return, restricted to returns that are not inside a smooth
+    // surface of the reference.
+    const Reference& ref = *pr.ref;
+    const std::size_t rn = ref.range.size();
+    if (!(u >= 0.0f) || !(u < static_cast<float>(rn - 1))) return false;
+    const std::size_t k0 = static_cast<std::size_t>(u), k1 = k0 + 1;
+    const float rho = std::sqrt(qx * qx + qy * qy);
+    const float m = pr.m0 + pr.m1 * rho + rho * res_;
+    const std::size_t lo = k0 > 0 ? k0 - 1 : 0, hi = std::min(rn - 1, k1 + 1);
+    const float* range = ref.range.data();
+    const std::uint8_t* valid = ref.valid.data();
+    for (std::size_t k = lo; k <= hi; ++k) {
+        if (!valid[k]) continue;
+        const float dx = qx - ref.x[k], dy = qy - ref.y[k];
+        if (dx * dx + dy * dy > m * m) continue;
+        const bool smooth = k > 0 && k + 1 < rn && valid[k - 1] && valid[k + 1] &&
+                            std::abs(range[k] - range[k - 1]) <= spike_margin_ &&
+                            std::abs(range[k] - range[k + 1]) <= spike_margin_;
+        if (!smooth) return true;
+    }
+    return false;
+}
+
+std::size_t EvidenceFilter::markSpikes(const Scan& scan, const std::vector<std::uint8_t>& kept_ev,
+                                       bool temporal, std::size_t cap) {
+    // Step 4b: the candidates (findSpikeCandidates) that step 4 left and no reference supports
+    // (with spike_object_support: where no reference saw an object).
+    spikes_.clear();
+    for (const std::uint32_t i : spike_candidates_) {
+        if (remove_[i]) continue;
+        if (temporal && kept_ev[i] == kSupported &&
+            (!params_.spike_object_support || object_support_[i]))
+            continue;
+        spikes_.push_back(i);
     }
     if (spikes_.empty()) return 0;
     // Within what the bound leaves (step 5): more is clutter (a railing, foliage), not spikes.

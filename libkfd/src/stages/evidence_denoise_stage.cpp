@@ -87,6 +87,10 @@ std::vector<StageKey> optionKeys() {
                          "remove a return beyond both neighbours' ranges that the temporal "
                          "evidence does not support",
                          [](P& p) -> bool& { return p.spikes; }),
+        keys::boolean<P>("spike_object_support", "spike_object_support",
+                         "... and count a reference's support for a spike only where that "
+                         "reference saw an object there, not a smooth surface",
+                         [](P& p) -> bool& { return p.spike_object_support; }),
         keys::boolean<P>("keep_surfaces", "keep_surfaces",
                          "never remove a run of returns on a line at the scan's noise (step 7)",
                          [](P& p) -> bool& { return p.keep_surfaces; }),

@@ -187,6 +187,14 @@ class EvidenceFilter {
         /// spikes found on six real logs (three seeds) for at most 0.08 points of real returns;
         /// ICP-SLAM not significantly different (R = 20; docs/RESULTS.md, issue 39).
         bool spikes = true;
+        /// Step 4b: a reference keeps a spike only where it saw an object there too (one of its
+        /// returns within the support margin that is itself off its neighbours' ranges by more
+        /// than the pair margin, or beside a dropout); a reference that saw only a smooth
+        /// surface there (each such return within the pair margin of both neighbours) supports
+        /// the surface, not the spike. Off: any support keeps it (the third step's test). On:
+        /// isolated spikes +0 to +2.4 points on six real logs (held-out seeds 3901, 5077), real
+        /// returns kept -0.005 to -0.05 points (docs/RESULTS.md, issue 39).
+        bool spike_object_support = true;
         /// Step 6: remove mixed pixels at depth edges.
         bool veil = false;  // off: on SICK logs it costs more real returns than it finds (issue 39)
         /// Step 7: never remove a run of returns on a line (surface_min_beams returns within
@@ -391,7 +399,17 @@ class EvidenceFilter {
     // Step 4b: marks spikes in remove_; returns how many (none when they would take the scan's
     // removal beyond `cap`).
     std::size_t markSpikes(const Scan& scan, const std::vector<std::uint8_t>& kept_ev,
-                           bool temporal, double sigma, std::size_t cap);
+                           bool temporal, std::size_t cap);
+    // Step 4b's geometry, before step 3: the returns off both neighbours' ranges by the pair
+    // margin where the neighbours are one surface across them, off a line (spike_candidates_).
+    void findSpikeCandidates(const Scan& scan, double sigma);
+    // Step 4b: marks in object_support_ the supported candidates that pr's reference saw an
+    // object at.
+    void markObjectSupport(const Projection& pr);
+    // A return of pr's reference within the support margin of (qx, qy) (its frame, bracket
+    // position u) that is not inside a smooth surface: off a neighbour's range by more than
+    // the pair margin, or beside a dropout or the scan's end.
+    bool objectSupported(const Projection& pr, float qx, float qy, float u) const;
     // Returns `cap` less the valid returns remove_ already holds (0 when at or past it).
     std::size_t roomUnderBound(const Scan& scan, std::size_t cap) const;
     // Step 6: marks mixed pixels in remove_ (none when they would take the scan's removal
@@ -428,6 +446,9 @@ class EvidenceFilter {
     std::vector<std::uint8_t> veil_;               // per beam: a mixed pixel (step 6)
     std::vector<std::uint32_t> spikes_;            // the spikes' beams (step 4b)
     std::vector<std::uint8_t> off_;  // per beam: off both neighbours' ranges (step 4b)
+    std::vector<std::uint32_t> spike_candidates_;      // step 4b's beams before the evidence
+    std::vector<std::uint8_t> object_support_;         // per beam: a reference saw an object there
+    float spike_margin_ = 0.0f;                        // step 4b's pair margin (m)
     std::vector<std::uint32_t> seg_first_, seg_last_;  // per segment: its first and last beam
     double sigma_smoothed_ = -1.0;
     double measured_smoothed_ = -1.0;       // the same, of the estimates before the floor
