@@ -646,12 +646,10 @@ bool EvidenceFilter::temporalEvidence(const Scan& scan, const Clusters& out, dou
     recent_ev_.assign(pt.usable || pn.usable ? scan.range.size() : 0, kUnknown);
     const std::size_t listed = listReturnsToJudge(out);
     const std::size_t unknowns = judgeListed(out, listed, pt, pn, p0, res);
-    if (params_.spike_object_support && !spike_candidates_.empty()) {
-        object_support_.assign(scan.range.size(), 0);
-        markObjectSupport(pt);
-        markObjectSupport(pn);
-        markObjectSupport(p0);
-    }
+    object_support_.assign(spike_candidates_.size(), 0);
+    markObjectSupport(pt);
+    markObjectSupport(pn);
+    markObjectSupport(p0);
     supportFromOlder(scan, out, sigma, unknowns, recent, res);
     return true;
 }
@@ -784,14 +782,15 @@ void EvidenceFilter::supportFromOlder(const Scan& scan, const Clusters& out, dou
                 ++res.supported;
             }
         }
-        if (params_.spike_object_support && !spike_candidates_.empty()) markObjectSupport(p);
+        markObjectSupport(p);
     };
     // A spike that only a smooth surface supported so far: an older view may have seen an
     // object there.
     bool pending = false;
     if (params_.spike_object_support)
-        for (const std::uint32_t i : spike_candidates_)
-            pending = pending || (evidence_[i] == kSupported && !object_support_[i]);
+        for (std::size_t j = 0; j < spike_candidates_.size(); ++j)
+            pending =
+                pending || (evidence_[spike_candidates_[j]] == kSupported && !object_support_[j]);
     const Reference& r1 = refs_[1];
     if (have_pose_ && r1.present && r1.geometry == scan.geometry && (unknowns > 0 || pending)) {
         const Projection p1 = projection(r1, between(r1.pose, pose_), sigma);
@@ -1025,15 +1024,16 @@ void EvidenceFilter::findSpikeCandidates(const Scan& scan, double sigma) {
 }
 
 void EvidenceFilter::markObjectSupport(const Projection& pr) {
-    if (!pr.usable) return;
-    for (const std::uint32_t i : spike_candidates_) {
+    if (!pr.usable || !params_.spike_object_support) return;
+    for (std::size_t j = 0; j < spike_candidates_.size(); ++j) {
         // Only the supported ones: a reference that did not support a return (no return of
         // it within the margin) cannot have seen an object there either.
-        if (evidence_[i] != kSupported || object_support_[i]) continue;
+        const std::uint32_t i = spike_candidates_[j];
+        if (evidence_[i] != kSupported || object_support_[j]) continue;
         const float qx = pr.c * x_[i] - pr.s * y_[i] + pr.tx;
         const float qy = pr.s * x_[i] + pr.c * y_[i] + pr.ty;
         if (objectSupported(pr, qx, qy, (fastAtan2(qy, qx) - first_) * inv_step_))
-            object_support_[i] = 1;
+            object_support_[j] = 1;
     }
 }
 
@@ -1066,10 +1066,11 @@ std::size_t EvidenceFilter::markSpikes(const Scan& scan, const std::vector<std::
     // Step 4b: the candidates (findSpikeCandidates) that step 4 left and no reference supports
     // (with spike_object_support: where no reference saw an object).
     spikes_.clear();
-    for (const std::uint32_t i : spike_candidates_) {
+    for (std::size_t j = 0; j < spike_candidates_.size(); ++j) {
+        const std::uint32_t i = spike_candidates_[j];
         if (remove_[i]) continue;
         if (temporal && kept_ev[i] == kSupported &&
-            (!params_.spike_object_support || object_support_[i]))
+            (!params_.spike_object_support || object_support_[j]))
             continue;
         spikes_.push_back(i);
     }

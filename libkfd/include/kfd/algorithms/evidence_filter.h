@@ -403,8 +403,8 @@ class EvidenceFilter {
     // Step 4b's geometry, before step 3: the returns off both neighbours' ranges by the pair
     // margin where the neighbours are one surface across them, off a line (spike_candidates_).
     void findSpikeCandidates(const Scan& scan, double sigma);
-    // Step 4b: marks in object_support_ the supported candidates that pr's reference saw an
-    // object at.
+    // Step 4b (spike_object_support): marks in object_support_ the supported candidates that
+    // pr's reference saw an object at.
     void markObjectSupport(const Projection& pr);
     // A return of pr's reference within the support margin of (qx, qy) (its frame, bracket
     // position u) that is not inside a smooth surface: off a neighbour's range by more than
@@ -447,7 +447,7 @@ class EvidenceFilter {
     std::vector<std::uint32_t> spikes_;            // the spikes' beams (step 4b)
     std::vector<std::uint8_t> off_;  // per beam: off both neighbours' ranges (step 4b)
     std::vector<std::uint32_t> spike_candidates_;      // step 4b's beams before the evidence
-    std::vector<std::uint8_t> object_support_;         // per beam: a reference saw an object there
+    std::vector<std::uint8_t> object_support_;         // per candidate: a reference saw an object
     float spike_margin_ = 0.0f;                        // step 4b's pair margin (m)
     std::vector<std::uint32_t> seg_first_, seg_last_;  // per segment: its first and last beam
     double sigma_smoothed_ = -1.0;
