@@ -269,6 +269,28 @@ TEST(EvidenceFilter, WithoutAPreviousKeyframeOnlyLoneReturnsAreRemoved) {
     EXPECT_EQ(r.points_removed, 1u);
 }
 
+TEST(EvidenceFilter, APairOfReturnsBetweenDropoutsIsASurfaceNotASmallSegment) {
+    // No keyframe yet: only small segments go. Two wall returns amid 18 dropouts (a dark patch
+    // of the wall) stay with dropout_fragments; a pair 2 m before the wall, flanked by its
+    // returns, and a lone return amid dropouts go either way.
+    for (const bool on : {true, false}) {
+        EvidenceFilter::Params p = exact();
+        p.dropout_fragments = on;
+        EvidenceFilter f(p);
+        Clusters c;
+        Scan s = room(std::nullopt);
+        for (std::size_t i = 196; i <= 213; ++i) s.valid[i] = i == 204 || i == 205 ? 1 : 0;
+        test::setRange(s, 100, 101, 2.0);
+        for (std::size_t i = 296; i <= 304; ++i) s.valid[i] = i == 300 ? 1 : 0;
+        f.filter(s, c);
+        EXPECT_EQ(s.valid[204], on ? 1 : 0) << on;
+        EXPECT_EQ(s.valid[205], on ? 1 : 0) << on;
+        EXPECT_EQ(s.valid[100], 0) << on;
+        EXPECT_EQ(s.valid[101], 0) << on;
+        EXPECT_EQ(s.valid[300], 0) << on;
+    }
+}
+
 TEST(EvidenceFilter, AWallAtGrazingIncidenceStaysOneSegment) {
     // A wall 0.5 m to the side running along the view: consecutive returns are far apart and
     // nearly along the beam (the breakpoint cuts it), but they lie on a line.

@@ -67,6 +67,7 @@ TEST(StageRegistry, EachStageOwnsItsKeys) {
                                         "sigma_m",
                                         "max_gap_beams",
                                         "max_small_points",
+                                        "dropout_fragments",
                                         "temporal",
                                         "pose_trans_error_m",
                                         "pose_rot_error_deg",

@@ -383,6 +383,14 @@ void EvidenceFilter::linkNeighbours(const Scan& scan, double sigma, const Breakp
     }
 }
 
+void EvidenceFilter::reserveSegmentBuffers(std::size_t n) {
+    // Sizes, range sums and flanked flags per segment (at most n), in buffers kept at their
+    // largest (no zero fill per scan); the sizes are copied out at the end.
+    if (sizes_.size() < n) sizes_.resize(n);
+    if (sums_.size() < n) sums_.resize(n);
+    if (flanked_.size() < n) flanked_.resize(n);
+}
+
 void EvidenceFilter::labelSegments(const Scan& scan, const Breakpoints& bp, Clusters& out,
                                    std::size_t& first_valid, std::size_t& last) {
     // Segments (at most n): returns across up to max_gap_beams missing beams are tested here.
@@ -393,13 +401,11 @@ void EvidenceFilter::labelSegments(const Scan& scan, const Breakpoints& bp, Clus
     const float* y = y_.data();
     std::uint8_t* link = link_.data();
     out.label.resize(n);  // every beam written below (-1: no return)
-    // Sizes and range sums in buffers kept at their largest (no zero fill per scan); the sizes
-    // are copied out at the end.
-    if (sizes_.size() < n) sizes_.resize(n);
-    if (sums_.size() < n) sums_.resize(n);
-    std::int32_t* label = out.label.data();
+    reserveSegmentBuffers(n);
     std::uint32_t* size = sizes_.data();
     float* sums = sums_.data();
+    std::uint8_t* flanked = flanked_.data();
+    std::int32_t* label = out.label.data();
     std::size_t count = 0;
     first_valid = 0;
     while (first_valid < n && !valid[first_valid]) label[first_valid++] = -1;
@@ -422,10 +428,14 @@ void EvidenceFilter::labelSegments(const Scan& scan, const Breakpoints& bp, Clus
             link[last] = static_cast<std::uint8_t>(linked);
         }
         if (!linked) {
+            // Flanked (step 4): another segment's return within max_gap_beams + 1 beams.
+            const auto near = static_cast<std::uint8_t>(last < n && i - last <= bp.max_step);
             if (count > 0) {
                 size[count - 1] = cur_size;
                 sums[count - 1] = cur_sum;
+                flanked[count - 1] |= near;
             }
+            flanked[count] = near;
             ++count;
             cur_size = 0;
             cur_sum = 0.0f;
@@ -461,6 +471,7 @@ void EvidenceFilter::joinAcrossSeam(const Scan& scan, const Breakpoints& bp,
         if (out.label[i] == static_cast<std::int32_t>(tail)) out.label[i] = 0;
     out.size[0] += out.size[tail];
     sums_[0] += sums_[tail];
+    flanked_[0] |= flanked_[tail];
     out.size.pop_back();
     link_[last] = 1;
 }
@@ -1241,7 +1252,8 @@ std::size_t EvidenceFilter::markNoise(Clusters& out, bool temporal) {
         const double need = res_ > 0.0f ? std::ceil(params_.min_object_size_m / (r * res_)) : 1.0;
         const auto bar = static_cast<std::size_t>(
             std::min(static_cast<double>(params_.max_small_points) + 1.0, std::max(2.0, need)));
-        const bool small = out.size[c] < bar;
+        const bool fragment = params_.dropout_fragments && out.size[c] >= 2 && !flanked_[c];
+        const bool small = out.size[c] < bar && !fragment;
         const bool supported = temporal && supported_in_[c] > 0;
         const bool free = temporal && classified_in_[c] > 0 && 2 * free_in_[c] >= classified_in_[c];
         out.noise[c] = (small && !supported) || free ? 1 : 0;

@@ -26,6 +26,10 @@ std::vector<StageKey> methodKeys() {
         keys::count<P>("max_small_points", "max_small_points",
                        "segments of at most this many points may be small", 0, 1000,
                        [](P& p) -> std::size_t& { return p.max_small_points; }),
+        keys::boolean<P>("dropout_fragments", "dropout_fragments",
+                         "a segment of 2+ returns between dropouts (no other return within "
+                         "max_gap_beams + 1 beams) is a surface, never small",
+                         [](P& p) -> bool& { return p.dropout_fragments; }),
         keys::boolean<P>("temporal", "temporal",
                          "compare with the previous keyframe (needs odometry)",
                          [](P& p) -> bool& { return p.temporal; }),
