@@ -332,12 +332,13 @@ class EvidenceFilter {
     void segment(const Scan& scan, double sigma, Clusters& out);
     // line_ (on a line with both neighbours) and link_ (one surface with the next beam).
     void linkNeighbours(const Scan& scan, double sigma, const Breakpoints& bp);
+    // Sizes, range sums and flanked flags per segment, at least n each (labelSegments).
+    void reserveSegmentBuffers(std::size_t n);
     // Labels segments across up to max_gap_beams missing beams; first and last valid beams
-    // out (last = n without one).
+    // out (last = n without one); flanked_: another segment's return within max_gap_beams + 1.
     void labelSegments(const Scan& scan, const Breakpoints& bp, Clusters& out,
                        std::size_t& first_valid, std::size_t& last);
     // A scanner closing the circle: the last segment joins the first across the seam.
-    void reserveSegmentBuffers(std::size_t n);
     void joinAcrossSeam(const Scan& scan, const Breakpoints& bp, std::size_t first_valid,
                         std::size_t last, Clusters& out);
     // `recent`: use the raw scans of step 3b (false: the keyframes only).
